@@ -1,0 +1,436 @@
+//! The collapse engine: schedule, legality, apply.
+//!
+//! One [`Simplifier`] drives a mesh from start to finish as a small state machine, so that it
+//! can stop after any number of operations and resume later (watchdogs, frame deadlines) and
+//! still give exactly the bytes of a one-shot run: one-shot *is* stepping with an unlimited
+//! budget.
+//!
+//! ```text
+//! Mean ─> Flags ─┬─ Greedy: Keys ─> Queue (pop cheapest, re-check, collapse, update around it)
+//!                └─ Passes: Pairs (sweep vertices in index order, pair, collapse) ─> next pass: Mean
+//! ```
+//!
+//! Termination: every collapse removes a vertex, so there are fewer collapses than vertices.
+//! Between two collapses the queue only re-keys a popped vertex to its exact current cost (so
+//! its next pop collapses it) or drops it, so at most `2·V` pops separate two collapses; each
+//! pass of `Passes` visits each vertex once, and a pass without a collapse ends the run. Every
+//! operation below is bounded by the valences involved.
+
+use crate::cost::Cost;
+use crate::feature::{self, Mean};
+use crate::heap::Heap;
+use crate::index::Index;
+use crate::legality::{self, Rules};
+use crate::mesh::{flag, Mesh, NIL};
+use crate::report::{Rejections, Report, Stop};
+use crate::{Config, Schedule};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// Summing D for the feature threshold.
+    Mean,
+    /// Setting feature flags.
+    Flags,
+    /// Greedy: computing every vertex's cheapest collapse.
+    Keys,
+    /// Greedy: collapsing from the queue.
+    Queue,
+    /// Passes: pairing vertices in index order.
+    Pairs,
+    /// Finished.
+    Done(Stop),
+}
+
+/// A simplification in progress; see [`Workspace::start`](crate::Workspace::start).
+///
+/// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
+/// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
+/// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
+    mesh: Mesh<'a, L, I>,
+    heap: Heap<'a, L>,
+    config: Config,
+    rules: Rules,
+    cost: C,
+    target: usize,
+    phase: Phase,
+    /// Vertex cursor of the current sweep.
+    v: usize,
+    mean: Mean,
+    threshold: f32,
+    features: usize,
+    locked: usize,
+    used_in: usize,
+    collapses: usize,
+    passes: u32,
+    pass_collapses: usize,
+    /// A legal collapse was skipped because it cost more than `max_cost`.
+    over_cost: bool,
+    pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
+    rejected: Rejections,
+}
+
+impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
+    pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
+        let by_ratio = (config.target_ratio as f64 * mesh.valid_in as f64) as usize;
+        let target = if config.target_triangles > by_ratio {
+            config.target_triangles
+        } else {
+            by_ratio
+        };
+        let (mut locked, mut used_in) = (0, 0);
+        for v in 0..mesh.vertex_count() {
+            locked += mesh.has(v, flag::LOCKED) as usize;
+            used_in += mesh.has(v, flag::USED) as usize;
+        }
+        Simplifier {
+            mesh,
+            heap,
+            rules: Rules::new(&config),
+            config,
+            cost,
+            target,
+            phase: Phase::Mean,
+            v: 0,
+            mean: Mean::default(),
+            threshold: f32::INFINITY,
+            features: 0,
+            locked,
+            used_in,
+            collapses: 0,
+            passes: 0,
+            pass_collapses: 0,
+            over_cost: false,
+            pass_triangles: heapless::Vec::new(),
+            rejected: Rejections::default(),
+        }
+    }
+
+    /// Runs at most `budget` operations and returns `true` once the run is finished.
+    ///
+    /// An operation is one vertex visited by a sweep, one queue pop, or one collapse with the
+    /// updates around it; each is bounded by the valences involved. A budget of 0 does nothing.
+    pub fn step(&mut self, budget: u32) -> bool {
+        let mut ops = 0;
+        while ops < budget {
+            if let Phase::Done(_) = self.phase {
+                return true;
+            }
+            self.operate();
+            ops += 1;
+        }
+        matches!(self.phase, Phase::Done(_))
+    }
+
+    /// Live triangles now.
+    pub fn live_triangles(&self) -> usize {
+        self.mesh.live
+    }
+
+    /// The live triangles now, in buffer order (the order [`Simplifier::finish`] keeps).
+    pub fn triangles(&self) -> impl Iterator<Item = [I; 3]> + '_ {
+        self.mesh.tris.iter().copied().filter(|t| t[0] != t[1])
+    }
+
+    /// The report so far (`stop` is [`Stop::Running`] until the run is finished).
+    pub fn report(&self) -> Report {
+        let stop = match self.phase {
+            Phase::Done(s) => s,
+            _ => Stop::Running,
+        };
+        let mut used = 0;
+        for v in 0..self.mesh.vertex_count() {
+            used += (self.mesh.first(v) != NIL) as usize;
+        }
+        Report {
+            triangles_in: self.mesh.triangle_count(),
+            degenerate_dropped: self.mesh.degenerate,
+            duplicates_dropped: self.mesh.duplicates,
+            triangles_out: self.mesh.live,
+            target_triangles: self.target,
+            target_reached: self.mesh.live <= self.target,
+            stop,
+            collapses: self.collapses,
+            vertices_removed: self.used_in.saturating_sub(used),
+            locked_vertices: self.locked,
+            feature_vertices: self.features,
+            passes: self.passes,
+            pass_triangles: self.pass_triangles.clone(),
+            rejected: self.rejected,
+        }
+    }
+
+    /// Compacts the result into the front of the caller's buffer and returns the report.
+    /// Finishing early (before `step` returned `true`) keeps the valid mesh reached so far.
+    pub fn finish(mut self) -> Report {
+        let report = self.report();
+        let n = self.mesh.compact();
+        #[cfg(feature = "defmt")]
+        defmt::debug!(
+            "tinydecimate: {} -> {} triangles, {} collapses",
+            report.triangles_in,
+            n,
+            report.collapses
+        );
+        Report {
+            triangles_out: n,
+            ..report
+        }
+    }
+
+    fn done(&mut self, stop: Stop) {
+        if self.config.schedule == Schedule::Greedy || self.pass_collapses > 0 {
+            self.log_pass();
+        }
+        self.phase = Phase::Done(stop);
+    }
+
+    fn log_pass(&mut self) {
+        // Full log: later passes are still counted in `passes`.
+        let _ = self.pass_triangles.push(self.mesh.live as u32);
+    }
+
+    /// One operation of the state machine.
+    fn operate(&mut self) {
+        let nv = self.mesh.vertex_count();
+        match self.phase {
+            Phase::Done(_) => {}
+            Phase::Mean => {
+                if self.v == 0 {
+                    if self.mesh.live <= self.target {
+                        return self.done(Stop::Target);
+                    }
+                    self.mean = Mean::default();
+                }
+                if self.v < nv {
+                    if self.config.features {
+                        let d = feature::variation(&self.mesh, self.v, self.config.feature_mode);
+                        self.mean.add(d);
+                    }
+                    self.v += 1;
+                } else {
+                    self.threshold = self.mean.threshold(self.config.lambda);
+                    self.phase = Phase::Flags;
+                    self.v = 0;
+                    self.features = 0;
+                }
+            }
+            Phase::Flags => {
+                if self.v < nv {
+                    let v = self.v;
+                    let is = self.is_feature(v);
+                    self.mesh.set_flag(v, flag::FEATURE, is);
+                    self.mesh.set_flag(v, flag::DONE, false);
+                    self.features += is as usize;
+                    self.v += 1;
+                } else {
+                    self.v = 0;
+                    self.passes += 1;
+                    self.pass_collapses = 0;
+                    self.phase = match self.config.schedule {
+                        Schedule::Greedy => Phase::Keys,
+                        Schedule::Passes => Phase::Pairs,
+                    };
+                }
+            }
+            Phase::Keys => {
+                if self.v < nv {
+                    self.rekey(self.v);
+                    self.v += 1;
+                } else {
+                    self.phase = Phase::Queue;
+                }
+            }
+            Phase::Queue => self.pop(),
+            Phase::Pairs => self.pair(),
+        }
+    }
+
+    fn is_feature(&self, v: usize) -> bool {
+        self.config.features
+            && feature::variation(&self.mesh, v, self.config.feature_mode)
+                .is_some_and(|d| d > self.threshold)
+    }
+
+    /// The cheapest legal collapse of `from` onto one of its neighbours: `(cost, to)`.
+    /// Ties go to the lower vertex number.
+    fn best(&mut self, from: usize) -> Option<(f32, usize)> {
+        let f = self.mesh.flags(from);
+        if f & flag::USED == 0 || f & (flag::LOCKED | flag::FEATURE) != 0 {
+            return None;
+        }
+        let mut best: Option<(f32, usize)> = None;
+        let (mesh, rules, cost, rejected) = (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
+        mesh.for_each_neighbour(from, |to| {
+            match legality::evaluate(mesh, rules, cost, from, to) {
+                Ok(c) => {
+                    if best.is_none_or(|(bc, bt)| c < bc || (c == bc && to < bt)) {
+                        best = Some((c, to));
+                    }
+                }
+                Err(r) => rejected.count(r),
+            }
+        });
+        best
+    }
+
+    /// Greedy: recompute `v`'s key.
+    fn rekey(&mut self, v: usize) {
+        match self.best(v) {
+            Some((c, _)) => self.heap.set(v, c),
+            None => self.heap.remove(v),
+        }
+    }
+
+    /// Greedy: one pop of the queue.
+    fn pop(&mut self) {
+        if self.mesh.live <= self.target {
+            return self.done(Stop::Target);
+        }
+        let Some((v, key)) = self.heap.peek() else {
+            return self.done(Stop::NoLegalCollapse);
+        };
+        if key > self.config.max_cost {
+            return self.done(Stop::MaxCost);
+        }
+        match self.best(v) {
+            None => self.heap.remove(v),
+            // Its neighbourhood changed since it was keyed: queue it at its true cost.
+            Some((c, _)) if c > key => self.heap.set(v, c),
+            Some((_, to)) => {
+                self.heap.remove(v);
+                self.collapse_greedy(v, to);
+            }
+        }
+    }
+
+    /// Greedy: collapse `a -> b`, then refresh feature flags (seed 004 eq. 5 with a running
+    /// mean) and queue keys around `b`.
+    fn collapse_greedy(&mut self, a: usize, b: usize) {
+        let mode = self.config.feature_mode;
+        let features = self.config.features;
+        if features {
+            // D changes for a, b and every vertex of a's triangles; take the old values out.
+            let mean = &mut self.mean;
+            let mesh = &self.mesh;
+            mean.sub(feature::variation(mesh, a, mode));
+            mesh.for_each_neighbour(a, |x| mean.sub(feature::variation(mesh, x, mode)));
+            mesh.for_each_neighbour(b, |x| {
+                if x != a && !mesh.adjacent(a, x) {
+                    mean.sub(feature::variation(mesh, x, mode))
+                }
+            });
+        }
+        self.mesh.collapse(a, b);
+        self.collapses += 1;
+        if features {
+            let mean = &mut self.mean;
+            let mesh = &self.mesh;
+            mean.add(feature::variation(mesh, b, mode));
+            mesh.for_each_neighbour(b, |x| mean.add(feature::variation(mesh, x, mode)));
+            self.threshold = self.mean.threshold(self.config.lambda);
+            let is = self.is_feature(b);
+            self.mesh.set_flag(b, flag::FEATURE, is);
+            self.for_neighbours(b, |s, x| {
+                let is = s.is_feature(x);
+                s.mesh.set_flag(x, flag::FEATURE, is);
+            });
+        }
+        self.rekey(b);
+        self.for_neighbours(b, |s, x| s.rekey(x));
+    }
+
+    /// Calls `f(self, x)` for each neighbour `x` of `v`, re-walking the list so that `f` may
+    /// change flags and keys (never adjacency).
+    fn for_neighbours(&mut self, v: usize, mut f: impl FnMut(&mut Self, usize)) {
+        let mut i = 0;
+        loop {
+            // The i-th distinct neighbour; adjacency does not change inside `f`.
+            let mut n = 0;
+            let mut found = NIL;
+            self.mesh.for_each_neighbour(v, |x| {
+                if n == i {
+                    found = x;
+                }
+                n += 1;
+            });
+            if found == NIL {
+                break;
+            }
+            f(self, found);
+            i += 1;
+        }
+    }
+
+    /// Passes: try to pair the vertex under the cursor (seed 004 Algorithm 3), or end the pass.
+    fn pair(&mut self) {
+        if self.mesh.live <= self.target {
+            return self.done(Stop::Target);
+        }
+        let nv = self.mesh.vertex_count();
+        if self.v >= nv {
+            // End of pass (Algorithm 4's outer loop).
+            #[cfg(feature = "defmt")]
+            defmt::debug!(
+                "tinydecimate: pass {} -> {} triangles",
+                self.passes,
+                self.mesh.live
+            );
+            if self.pass_collapses == 0 {
+                let stop = if self.over_cost {
+                    Stop::MaxCost
+                } else {
+                    Stop::NoLegalCollapse
+                };
+                return self.done(stop);
+            }
+            self.log_pass();
+            if self.passes >= self.config.max_passes {
+                self.phase = Phase::Done(Stop::MaxPasses);
+                return;
+            }
+            self.phase = Phase::Mean;
+            self.v = 0;
+            self.over_cost = false;
+            return;
+        }
+        let v = self.v;
+        self.v += 1;
+        let skip = flag::DONE | flag::FEATURE | flag::LOCKED;
+        if !self.mesh.has(v, flag::USED) || self.mesh.has(v, skip) {
+            return;
+        }
+        // Cheapest legal collapse between v and an unpaired neighbour, in either direction:
+        // Algorithm 1 moves the endpoint whose W is smaller.
+        let mut best: Option<(f32, usize, usize)> = None;
+        let (mesh, rules, cost, rejected) = (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
+        mesh.for_each_neighbour(v, |y| {
+            if mesh.has(y, flag::DONE) {
+                return;
+            }
+            for (from, to) in [(v, y), (y, v)] {
+                match legality::evaluate(mesh, rules, cost, from, to) {
+                    Ok(c) => {
+                        let better = best.is_none_or(|(bc, bf, bt)| {
+                            c < bc || (c == bc && (from, to) < (bf, bt))
+                        });
+                        if better {
+                            best = Some((c, from, to));
+                        }
+                    }
+                    Err(r) => rejected.count(r),
+                }
+            }
+        });
+        if let Some((c, from, to)) = best {
+            if c > self.config.max_cost {
+                self.over_cost = true;
+                return;
+            }
+            self.mesh.collapse(from, to);
+            self.mesh.set_flag(to, flag::DONE, true);
+            self.collapses += 1;
+            self.pass_collapses += 1;
+        }
+    }
+}

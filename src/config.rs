@@ -1,0 +1,160 @@
+//! What to simplify to, and how.
+
+/// Which vertices the collapse engine tries first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Schedule {
+    /// Always collapse the cheapest legal edge of the whole mesh (indexed priority queue).
+    /// The priority is the paper's normal variation W scaled by the squared edge length, so
+    /// that it measures how far the surface moves, not only how far normals turn.
+    Greedy,
+    /// The paper's own schedule (seed 004, Algorithms 3-4): each pass recomputes feature
+    /// flags, sweeps vertices in index order and pairs each unprocessed non-feature vertex with
+    /// the neighbour giving its cheapest legal collapse; both are then done for the pass.
+    Passes,
+}
+
+/// How the feature test (seed 004 §3, eq. 3-5) weighs a vertex's normal variation D.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FeatureMode {
+    /// D as in the paper: the sum over ordered pairs of adjacent triangles. D grows with the
+    /// square of the valence k, so high-valence vertices are more often features.
+    Paper,
+    /// D / k²: the mean pairwise variation, independent of valence.
+    ValenceNormalized,
+}
+
+/// Simplification settings. Build with [`Config::new`] and the `with_*` methods; the engine
+/// checks them in [`Workspace::start`](crate::Workspace::start).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// Collapse order.
+    pub schedule: Schedule,
+    /// Stop at or below this many triangles (`0`: use [`Config::target_ratio`] only).
+    pub target_triangles: usize,
+    /// Stop at or below this fraction of the valid input triangles, in `[0, 1]`.
+    pub target_ratio: f32,
+    /// Never perform a collapse whose cost exceeds this (in the schedule's cost units).
+    pub max_cost: f32,
+    /// Stop after this many passes ([`Schedule::Passes`] only); at least 1.
+    pub max_passes: u32,
+    /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1. Negative or
+    /// non-finite values are rejected; `f32::INFINITY` is not allowed either (use
+    /// [`Config::features`] = `false` to turn features off).
+    pub lambda: f32,
+    /// Detect and keep feature vertices at all.
+    pub features: bool,
+    /// How D is normalised before the feature test.
+    pub feature_mode: FeatureMode,
+    /// Feature vertices may be the kept endpoint of a collapse (the paper says no: they take no
+    /// part in any collapse).
+    pub feature_targets: bool,
+    /// Reject a collapse that turns a remaining triangle's normal by more than this many degrees,
+    /// in `(0, 180)`.
+    pub max_normal_turn_deg: f32,
+    /// Reject a collapse that leaves a triangle with quality (`4√3·area / Σ edge²`, 1 for an
+    /// equilateral triangle) below this, unless the triangle was already worse. In `[0, 1)`.
+    pub min_quality: f32,
+    /// Weight of the boundary retreat (squared distance of a removed boundary vertex to the new
+    /// boundary edge) against the normal variation. Non-negative.
+    pub boundary_weight: f32,
+}
+
+impl Config {
+    /// The defaults: greedy schedule, 10 % of the triangles, λ = 1 with the paper's D,
+    /// features neither removed nor targets, 60° normal-turn limit.
+    pub const fn new() -> Self {
+        Config {
+            schedule: Schedule::Greedy,
+            target_triangles: 0,
+            target_ratio: 0.1,
+            max_cost: f32::INFINITY,
+            max_passes: 32,
+            lambda: 1.0,
+            features: true,
+            feature_mode: FeatureMode::Paper,
+            feature_targets: false,
+            max_normal_turn_deg: 60.0,
+            min_quality: 0.05,
+            boundary_weight: 1.0,
+        }
+    }
+
+    /// Sets the schedule.
+    pub const fn with_schedule(mut self, schedule: Schedule) -> Self {
+        self.schedule = schedule;
+        self
+    }
+
+    /// Stops at this fraction of the input triangles.
+    pub const fn with_ratio(mut self, ratio: f32) -> Self {
+        self.target_ratio = ratio;
+        self
+    }
+
+    /// Stops at this triangle count (takes precedence over the ratio when it is higher).
+    pub const fn with_target_triangles(mut self, triangles: usize) -> Self {
+        self.target_triangles = triangles;
+        self
+    }
+
+    /// Sets the feature factor λ.
+    pub const fn with_lambda(mut self, lambda: f32) -> Self {
+        self.lambda = lambda;
+        self
+    }
+
+    /// Sets how D is normalised.
+    pub const fn with_feature_mode(mut self, mode: FeatureMode) -> Self {
+        self.feature_mode = mode;
+        self
+    }
+
+    /// Sets the maximum number of passes.
+    pub const fn with_max_passes(mut self, passes: u32) -> Self {
+        self.max_passes = passes;
+        self
+    }
+
+    /// Sets the maximum collapse cost.
+    pub const fn with_max_cost(mut self, cost: f32) -> Self {
+        self.max_cost = cost;
+        self
+    }
+
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        use crate::{ConfigField as F, Error};
+        let bad = |field| Err(Error::InvalidConfig { field });
+        if !(self.target_ratio >= 0.0 && self.target_ratio <= 1.0) {
+            return bad(F::TargetRatio);
+        }
+        if self.max_cost.is_nan() || self.max_cost < 0.0 {
+            return bad(F::MaxCost);
+        }
+        if self.max_passes == 0 {
+            return bad(F::MaxPasses);
+        }
+        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+            return bad(F::Lambda);
+        }
+        if !(self.max_normal_turn_deg > 0.0 && self.max_normal_turn_deg < 180.0) {
+            return bad(F::MaxNormalTurn);
+        }
+        if !(self.min_quality >= 0.0 && self.min_quality < 1.0) {
+            return bad(F::MinQuality);
+        }
+        if !(self.boundary_weight.is_finite() && self.boundary_weight >= 0.0) {
+            return bad(F::BoundaryWeight);
+        }
+        Ok(())
+    }
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self::new()
+    }
+}

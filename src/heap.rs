@@ -1,0 +1,153 @@
+//! Indexed binary min-heap of vertices keyed by the cost of their cheapest collapse.
+//!
+//! Three arrays in the workspace: the heap of vertex numbers, each vertex's slot in it, and
+//! each vertex's key. Ties are broken on the vertex number, so the order is total and the same
+//! on every machine.
+
+use crate::index::Index;
+use core::cmp::Ordering;
+
+pub(crate) struct Heap<'a, L: Index> {
+    heap: &'a mut [L],
+    pos: &'a mut [L],
+    key: &'a mut [f32],
+    len: usize,
+}
+
+impl<'a, L: Index> Heap<'a, L> {
+    pub(crate) fn new(heap: &'a mut [L], pos: &'a mut [L], key: &'a mut [f32]) -> Self {
+        for p in pos.iter_mut() {
+            *p = L::NIL;
+        }
+        Heap {
+            heap,
+            pos,
+            key,
+            len: 0,
+        }
+    }
+
+    fn at(&self, slot: usize) -> usize {
+        self.heap.get(slot).map_or(usize::MAX, |v| v.to_usize())
+    }
+
+    fn key_of(&self, v: usize) -> f32 {
+        self.key.get(v).copied().unwrap_or(f32::INFINITY)
+    }
+
+    fn slot_of(&self, v: usize) -> Option<usize> {
+        match self.pos.get(v) {
+            Some(&p) if p != L::NIL => Some(p.to_usize()),
+            _ => None,
+        }
+    }
+
+    /// `(key, vertex)` order; keys are never NaN (costs are sanitised by the engine) but
+    /// `total_cmp` keeps the order total regardless.
+    fn less(&self, u: usize, w: usize) -> bool {
+        match self.key_of(u).total_cmp(&self.key_of(w)) {
+            Ordering::Less => true,
+            Ordering::Greater => false,
+            Ordering::Equal => u < w,
+        }
+    }
+
+    fn place(&mut self, slot: usize, v: usize) {
+        if let Some(h) = self.heap.get_mut(slot) {
+            *h = L::narrow(v);
+        }
+        if let Some(p) = self.pos.get_mut(v) {
+            *p = L::narrow(slot);
+        }
+    }
+
+    fn up(&mut self, mut slot: usize) {
+        let v = self.at(slot);
+        while slot > 0 {
+            let parent = (slot - 1) / 2;
+            let u = self.at(parent);
+            if !self.less(v, u) {
+                break;
+            }
+            self.place(slot, u);
+            slot = parent;
+        }
+        self.place(slot, v);
+    }
+
+    fn down(&mut self, mut slot: usize) {
+        let v = self.at(slot);
+        loop {
+            let l = 2 * slot + 1;
+            if l >= self.len {
+                break;
+            }
+            let r = l + 1;
+            let mut child = l;
+            if r < self.len && self.less(self.at(r), self.at(l)) {
+                child = r;
+            }
+            let u = self.at(child);
+            if !self.less(u, v) {
+                break;
+            }
+            self.place(slot, u);
+            slot = child;
+        }
+        self.place(slot, v);
+    }
+
+    /// Inserts `v` with `key`, or moves it if already queued.
+    pub(crate) fn set(&mut self, v: usize, key: f32) {
+        let old = self.key_of(v);
+        if let Some(k) = self.key.get_mut(v) {
+            *k = key;
+        } else {
+            return;
+        }
+        match self.slot_of(v) {
+            Some(slot) => {
+                if key.total_cmp(&old) == Ordering::Less {
+                    self.up(slot)
+                } else {
+                    self.down(slot)
+                }
+            }
+            None => {
+                if self.len >= self.heap.len() {
+                    return;
+                }
+                self.len += 1;
+                self.place(self.len - 1, v);
+                self.up(self.len - 1);
+            }
+        }
+    }
+
+    /// Removes `v` if queued.
+    pub(crate) fn remove(&mut self, v: usize) {
+        let Some(slot) = self.slot_of(v) else { return };
+        if let Some(p) = self.pos.get_mut(v) {
+            *p = L::NIL;
+        }
+        self.len = self.len.saturating_sub(1);
+        if slot == self.len {
+            return;
+        }
+        let last = self.at(self.len);
+        self.place(slot, last);
+        self.down(slot);
+        let moved = self.slot_of(last).unwrap_or(0);
+        self.up(moved);
+    }
+
+    /// The cheapest vertex and its key, without removing it.
+    pub(crate) fn peek(&self) -> Option<(usize, f32)> {
+        if self.len == 0 {
+            None
+        } else {
+            let v = self.at(0);
+            Some((v, self.key_of(v)))
+        }
+    }
+}

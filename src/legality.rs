@@ -1,0 +1,245 @@
+//! Which collapses keep the mesh valid, and what they cost.
+//!
+//! A half-edge collapse `a -> b` (a moves onto b, b stays where it is) is refused when any rule
+//! below fails. The rules, in the order they are checked (cheapest first):
+//!
+//! | rule       | refuses when                                                        | source |
+//! |------------|---------------------------------------------------------------------|--------|
+//! | `Locked`   | a or b is on a non-manifold edge, a pinched fan or an inconsistently wound edge | seed 001 §3 |
+//! | `Feature`  | a is a feature vertex; or b is, unless feature targets are allowed  | seed 004 §3.3 |
+//! | `Boundary` | a is on the boundary and a-b is not a boundary edge; or the boundary loop through a-b has only three edges | seed 000 §3.2 |
+//! | `Link`     | a vertex adjacent to both a and b is not opposite a-b (the surface would pinch) | seed 000 §3.1 |
+//! | `Duplicate`| a triangle of a would become a copy of one of b's                    | |
+//! | `Sliver`   | a surviving triangle gets zero area, or a quality below the limit that is also worse than before | |
+//! | `NormalTurn` | a surviving triangle's normal turns by more than the limit       | seed 000 §3.2 |
+//! | `Fold`     | a surviving triangle and a neighbour across any of its edges end up with nearly opposite normals | |
+//!
+//! Interior vertices may move onto boundary vertices (the boundary does not change), never the
+//! reverse. Together with the link condition this keeps a closed manifold closed, keeps the
+//! Euler characteristic and the number of boundary loops, and never creates a non-manifold edge.
+
+use crate::cost::{Cost, EdgeChange, TriangleChange};
+use crate::index::Index;
+use crate::math;
+use crate::mesh::{flag, is_dead, Mesh, NIL};
+use crate::report::Reject;
+use crate::Config;
+
+/// Two adjacent triangles whose unit normals have a dot product below this are folded onto
+/// each other (more than about 154° apart).
+pub(crate) const FOLD_DOT: f32 = -0.9;
+
+/// The geometric limits of a [`Config`], precomputed.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Rules {
+    cos_turn: f32,
+    /// `min_quality² / 12`, compared with `|n|² / (Σ edge²)²`.
+    min_ratio: f32,
+    feature_targets: bool,
+}
+
+impl Rules {
+    pub(crate) fn new(config: &Config) -> Self {
+        let q = config.min_quality;
+        Rules {
+            cos_turn: math::cos(config.max_normal_turn_deg * (core::f32::consts::PI / 180.0)),
+            min_ratio: q * q / 12.0,
+            feature_targets: config.feature_targets,
+        }
+    }
+}
+
+/// `tri` after moving `a` onto `b`, or `None` if it contains both and vanishes.
+#[inline]
+fn moved(tri: [usize; 3], a: usize, b: usize) -> Option<[usize; 3]> {
+    if tri.contains(&a) && tri.contains(&b) {
+        return None;
+    }
+    Some(tri.map(|v| if v == a { b } else { v }))
+}
+
+/// `|n|² / (Σ edge²)²`: quality² / 12, where quality is `4√3·area / Σ edge²`.
+fn quality_ratio<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, tri: [usize; 3], n2: f32) -> f32 {
+    let [p0, p1, p2] = tri.map(|v| mesh.p(v));
+    let e = |u, w| {
+        let d = math::sub(u, w);
+        math::dot(d, d)
+    };
+    let s = e(p0, p1) + e(p1, p2) + e(p2, p0);
+    if s > 0.0 {
+        n2 / (s * s)
+    } else {
+        0.0
+    }
+}
+
+/// Checks every rule for `a -> b` and returns its cost.
+pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    cost: &C,
+    a: usize,
+    b: usize,
+) -> Result<f32, Reject> {
+    let (fa, fb) = (mesh.flags(a), mesh.flags(b));
+    if fa & fb & flag::USED == 0 || (fa | fb) & flag::LOCKED != 0 {
+        return Err(Reject::Locked);
+    }
+    if fa & flag::FEATURE != 0 || (fb & flag::FEATURE != 0 && !rules.feature_targets) {
+        return Err(Reject::Feature);
+    }
+
+    // The triangles on edge a-b, and the vertices opposite it.
+    let mut opp = [NIL; 2];
+    let mut n_ab = 0;
+    for (t, _) in mesh.corners(a) {
+        let tri = mesh.tri(t);
+        if tri.contains(&b) {
+            if n_ab >= 2 {
+                return Err(Reject::Locked);
+            }
+            opp[n_ab] = tri.iter().copied().find(|&x| x != a && x != b).unwrap_or(NIL);
+            n_ab += 1;
+        }
+    }
+    if n_ab == 0 {
+        return Err(Reject::Link);
+    }
+
+    // Boundary: a boundary vertex only slides along its own boundary edge.
+    let mut retreat2 = 0.0;
+    if fa & flag::BOUNDARY != 0 {
+        if n_ab != 1 {
+            return Err(Reject::Boundary);
+        }
+        let x = mesh.boundary_neighbour(a, b);
+        let y = mesh.boundary_neighbour(b, a);
+        if x == y {
+            // A loop of three edges would close up (or a lone triangle vanish).
+            return Err(Reject::Boundary);
+        }
+        if x != NIL {
+            retreat2 = math::segment_distance2(mesh.p(a), mesh.p(x), mesh.p(b));
+        }
+    }
+
+    // Link condition and duplicates.
+    for (t, _) in mesh.corners(a) {
+        let tri = mesh.tri(t);
+        if tri.contains(&b) {
+            continue;
+        }
+        let mut both_opposite = true;
+        for &x in &tri {
+            if x == a {
+                continue;
+            }
+            if opp[..n_ab].contains(&x) {
+                continue;
+            }
+            both_opposite = false;
+            if mesh.adjacent(b, x) {
+                return Err(Reject::Link);
+            }
+        }
+        if both_opposite {
+            // a's triangle (a, c, d) with c and d both opposite a-b becomes (b, c, d): refuse if
+            // b already has it.
+            let others = tri.map(|v| if v == a { b } else { v });
+            if mesh
+                .corners(b)
+                .any(|(u, _)| others.iter().all(|v| mesh.tri(u).contains(v)))
+            {
+                return Err(Reject::Duplicate);
+            }
+        }
+    }
+
+    // Geometry of every surviving triangle, and the cost.
+    let pa = mesh.p(a);
+    let pb = mesh.p(b);
+    let shift = math::sub(pb, pa);
+    let mut sum = 0.0f32;
+    for (t, _) in mesh.corners(a) {
+        let old = mesh.tri(t);
+        let Some(new) = moved(old, a, b) else {
+            continue;
+        };
+        let n0 = mesh.normal_of(old);
+        let n1 = mesh.normal_of(new);
+        let l0 = math::dot(n0, n0);
+        let l1 = math::dot(n1, n1);
+        if !(l1 > 0.0) {
+            return Err(Reject::Sliver);
+        }
+        let r1 = quality_ratio(mesh, new, l1);
+        if r1 < rules.min_ratio && r1 < quality_ratio(mesh, old, l0) {
+            return Err(Reject::Sliver);
+        }
+        if math::dot(n0, n1) < rules.cos_turn * math::sqrt(l0 * l1) {
+            return Err(Reject::NormalTurn);
+        }
+        let u1 = math::unit(n1);
+        if folds(mesh, t, new, u1, a, b) {
+            return Err(Reject::Fold);
+        }
+        sum += cost.triangle(&TriangleChange {
+            old_normal: math::unit(n0),
+            new_normal: u1,
+            old_area2: math::sqrt(l0),
+            moved: shift,
+        });
+    }
+    let total = cost.total(
+        sum,
+        &EdgeChange {
+            length2: math::dot(shift, shift),
+            boundary_retreat2: retreat2,
+        },
+    );
+    if total.is_nan() || total == f32::INFINITY {
+        return Err(Reject::Sliver);
+    }
+    Ok(if total > 0.0 { total } else { 0.0 })
+}
+
+/// Whether the moved triangle `t` (now `new`, unit normal `u1`) would be folded onto any of its
+/// neighbours after the collapse `a -> b`.
+fn folds<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    t: usize,
+    new: [usize; 3],
+    u1: [f32; 3],
+    a: usize,
+    b: usize,
+) -> bool {
+    for k in 0..3 {
+        let (p, q) = (new[k], new[(k + 1) % 3]);
+        // After the collapse, b's triangles are a's and b's together.
+        let lists = if p == b || q == b { [a, b] } else { [p, NIL] };
+        for owner in lists {
+            if owner == NIL {
+                continue;
+            }
+            for (s, _) in mesh.corners(owner) {
+                if s == t {
+                    continue;
+                }
+                let tri = mesh.tri(s);
+                if is_dead(tri) {
+                    continue;
+                }
+                let Some(post) = moved(tri, a, b) else {
+                    continue;
+                };
+                if post.contains(&p) && post.contains(&q) {
+                    let us = math::unit(mesh.normal_of(post));
+                    if math::dot(u1, us) < FOLD_DOT {
+                        return true;
+                    }
+                }
+            }
+        }
+    }
+    false
+}

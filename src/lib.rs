@@ -1,0 +1,151 @@
+//! # tinydecimate
+//!
+//! A triangle mesh simplifier for microcontrollers: no heap, no `unsafe`, no panics, and every
+//! byte of working memory fixed at compile time.
+//!
+//! It follows the mobile-terminal method of Lin Mouguang (seed 004, "A Geometry Compression
+//! Method for Mobile Computing Terminal", 2007): edge collapse where the vertex whose removal
+//! turns its triangles' unit normals least moves onto its neighbour (eq. 1-2, Algorithm 1),
+//! and *feature vertices*, whose triangles' normals differ most from each other (eq. 3-5),
+//! are never collapsed. Collapses keep one endpoint (subset placement, §2), so the positions
+//! are only ever read and may stay in flash; RAM holds indices and working state. Legality
+//! follows Hoppe's progressive meshes and Garland-Heckbert (seeds 000, 001): link condition,
+//! boundary preservation, no flipped, folded, sliver or duplicate triangles.
+//!
+//! Data flows one way:
+//!
+//! ```text
+//! positions (read-only) + caller's triangles
+//!   -> mesh      validate, drop degenerate/duplicate triangles, build adjacency, lock non-manifold vertices
+//!   -> feature   feature flags (eq. 3-5)
+//!   -> cost      normal variation W (eq. 1-2), or any other `Cost`
+//!   -> collapse  schedule (greedy heap or the paper's passes), legality, apply
+//!   -> the compacted triangles in the caller's buffer, and a `Report`
+//! ```
+//!
+//! ```
+//! use tinydecimate::{Config, Schedule, Workspace};
+//!
+//! // A 4x4 grid of quads on the plane z = 0: 32 triangles.
+//! let mut positions = [[0.0f32; 3]; 25];
+//! for (i, p) in positions.iter_mut().enumerate() {
+//!     *p = [(i % 5) as f32, (i / 5) as f32, 0.0];
+//! }
+//! let mut triangles = [[0u16; 3]; 32];
+//! for y in 0..4u16 {
+//!     for x in 0..4u16 {
+//!         let v = y * 5 + x;
+//!         let q = usize::from(y * 4 + x) * 2;
+//!         triangles[q] = [v, v + 1, v + 6];
+//!         triangles[q + 1] = [v, v + 6, v + 5];
+//!     }
+//! }
+//! // 64 vertices and 64 triangles of capacity, u16 links. `new` is const: on a device this
+//! // can be a `static`.
+//! let mut ws = Workspace::<u16, 64, 64>::new();
+//! let config = Config::new().with_ratio(0.25).with_schedule(Schedule::Greedy);
+//! let report = ws.simplify(&positions, &mut triangles, &config).unwrap();
+//! let simplified = &triangles[..report.triangles_out];
+//! assert!(report.triangles_out < 32);
+//! assert_eq!(simplified.len(), report.triangles_out);
+//! ```
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+mod collapse;
+mod config;
+pub mod cost;
+mod feature;
+mod heap;
+mod index;
+mod legality;
+mod math;
+mod mesh;
+mod report;
+mod workspace;
+
+pub use collapse::Simplifier;
+pub use config::{Config, FeatureMode, Schedule};
+pub use index::Index;
+pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
+pub use workspace::Workspace;
+
+/// Which capacity an input exceeded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Capacity {
+    /// More positions than the workspace (or its link type) can number.
+    Vertices,
+    /// More triangles than the workspace (or its link type) can number.
+    Triangles,
+}
+
+/// Which configuration field is out of range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
+pub enum ConfigField {
+    TargetRatio,
+    MaxCost,
+    MaxPasses,
+    Lambda,
+    MaxNormalTurn,
+    MinQuality,
+    BoundaryWeight,
+}
+
+/// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
+/// is modified.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Error {
+    /// The mesh does not fit the workspace.
+    Capacity {
+        /// Vertices or triangles.
+        what: Capacity,
+        /// How many the mesh has.
+        needed: usize,
+        /// How many the workspace takes.
+        available: usize,
+    },
+    /// A triangle refers to a vertex past the end of `positions`.
+    IndexOutOfRange {
+        /// The triangle.
+        triangle: usize,
+        /// The offending index.
+        index: usize,
+    },
+    /// A vertex used by a triangle has a NaN or infinite coordinate.
+    NonFinitePosition {
+        /// The vertex.
+        vertex: usize,
+    },
+    /// A configuration value is out of range.
+    InvalidConfig {
+        /// The field.
+        field: ConfigField,
+    },
+}
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Error::Capacity {
+                what,
+                needed,
+                available,
+            } => write!(
+                f,
+                "mesh has {needed} {what:?} but the workspace holds {available}"
+            ),
+            Error::IndexOutOfRange { triangle, index } => {
+                write!(f, "triangle {triangle} refers to missing vertex {index}")
+            }
+            Error::NonFinitePosition { vertex } => {
+                write!(f, "vertex {vertex} has a non-finite coordinate")
+            }
+            Error::InvalidConfig { field } => write!(f, "configuration field {field:?} is out of range"),
+        }
+    }
+}

@@ -1,0 +1,157 @@
+//! The fixed-capacity working memory, sized at compile time.
+
+use crate::collapse::Simplifier;
+use crate::cost::{Cost, NormalVariation};
+use crate::index::Index;
+use crate::mesh::Mesh;
+use crate::{Config, Error, Report, Schedule};
+
+/// All working state of the simplifier, with capacity fixed by const generics.
+///
+/// * `L`: link type (`u16` or `u32`) for vertex and corner numbers inside the workspace. With
+///   `u16` a mesh may have at most 65 534 vertices and 21 844 triangles.
+/// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
+///
+/// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a
+/// heap slot, a 4-byte key and a flag byte; per triangle three corner links. With `u16` links
+/// and the usual `V ≈ T/2` that is 11.5 bytes per triangle. [`Workspace::new`] is a `const fn`,
+/// so a workspace can be a `static` in `.bss` instead of living on the stack.
+///
+/// The positions are never copied: they stay wherever the caller keeps them (flash included).
+pub struct Workspace<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> {
+    /// First corner of each vertex's corner list (NIL: none).
+    pub(crate) head: [L; MAX_VERTICES],
+    /// For corner `3t + k`, the next corner around the same vertex.
+    pub(crate) next: [[L; 3]; MAX_TRIANGLES],
+    /// Per-vertex flags, see `mesh::flag`.
+    pub(crate) flags: [u8; MAX_VERTICES],
+    /// Greedy schedule: binary heap of vertices ...
+    pub(crate) heap: [L; MAX_VERTICES],
+    /// ... each vertex's slot in it (NIL: not queued) ...
+    pub(crate) heap_pos: [L; MAX_VERTICES],
+    /// ... and its key, the cost of its cheapest legal collapse.
+    pub(crate) key: [f32; MAX_VERTICES],
+}
+
+impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
+    Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
+{
+    /// Size of the workspace in bytes: all of the simplifier's RAM apart from the caller's
+    /// triangle buffer, positions and a bounded stack frame.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// An empty workspace. `const`, so it can initialise a `static`.
+    pub const fn new() -> Self {
+        Workspace {
+            head: [L::NIL; MAX_VERTICES],
+            next: [[L::NIL; 3]; MAX_TRIANGLES],
+            flags: [0; MAX_VERTICES],
+            heap: [L::NIL; MAX_VERTICES],
+            heap_pos: [L::NIL; MAX_VERTICES],
+            key: [0.0; MAX_VERTICES],
+        }
+    }
+
+    /// Simplifies `triangles` in place, in one call.
+    ///
+    /// `positions` are only read. On success the first `report.triangles_out` entries of
+    /// `triangles` hold the result, referring to the original vertex indices; the rest of the
+    /// buffer is left over and meaningless. On error nothing has been written.
+    pub fn simplify<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        let mut s = self.start(positions, triangles, config)?;
+        while !s.step(u32::MAX) {}
+        Ok(s.finish())
+    }
+
+    /// Validates the input, builds adjacency and returns a [`Simplifier`] to drive step by step
+    /// (for watchdogs and frame deadlines). Steps of any size give exactly the result of
+    /// [`Workspace::simplify`].
+    ///
+    /// Errors, all returned before the triangle buffer is touched:
+    /// [`Error::Capacity`], [`Error::IndexOutOfRange`], [`Error::NonFinitePosition`],
+    /// [`Error::InvalidConfig`].
+    pub fn start<'a, I: Index>(
+        &'a mut self,
+        positions: &'a [[f32; 3]],
+        triangles: &'a mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Simplifier<'a, L, I, NormalVariation>, Error> {
+        let cost = match config.schedule {
+            Schedule::Greedy => NormalVariation::greedy(config.boundary_weight),
+            Schedule::Passes => NormalVariation::paper(config.boundary_weight),
+        };
+        self.start_with_cost(positions, triangles, config, cost)
+    }
+
+    /// Like [`Workspace::start`], with another [`Cost`].
+    pub fn start_with_cost<'a, I: Index, C: Cost>(
+        &'a mut self,
+        positions: &'a [[f32; 3]],
+        triangles: &'a mut [[I; 3]],
+        config: &Config,
+        cost: C,
+    ) -> Result<Simplifier<'a, L, I, C>, Error> {
+        config.validate()?;
+        if positions.len() > MAX_VERTICES || positions.len() > L::COUNT {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Vertices,
+                needed: positions.len(),
+                available: if MAX_VERTICES < L::COUNT {
+                    MAX_VERTICES
+                } else {
+                    L::COUNT
+                },
+            });
+        }
+        let corner_cap = L::COUNT / 3;
+        if triangles.len() > MAX_TRIANGLES || triangles.len() > corner_cap {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Triangles,
+                needed: triangles.len(),
+                available: if MAX_TRIANGLES < corner_cap {
+                    MAX_TRIANGLES
+                } else {
+                    corner_cap
+                },
+            });
+        }
+        let nv = positions.len();
+        let nt = triangles.len();
+        // `get_mut` with lengths just checked against the capacities: cannot fail, but costs
+        // nothing and keeps every path panic-free.
+        let (Some(head), Some(next), Some(flags), Some(heap), Some(heap_pos), Some(key)) = (
+            self.head.get_mut(..nv),
+            self.next.get_mut(..nt),
+            self.flags.get_mut(..nv),
+            self.heap.get_mut(..nv),
+            self.heap_pos.get_mut(..nv),
+            self.key.get_mut(..nv),
+        ) else {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Vertices,
+                needed: nv,
+                available: MAX_VERTICES,
+            });
+        };
+        let mesh = Mesh::build(positions, triangles, head, next, flags)?;
+        Ok(Simplifier::new(
+            mesh,
+            crate::heap::Heap::new(heap, heap_pos, key),
+            *config,
+            cost,
+        ))
+    }
+}
+
+impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> Default
+    for Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}

@@ -1,0 +1,384 @@
+//! Test support: an OBJ reader for the shared meshes, mesh generators, and an invariant checker
+//! written independently of the library (plain std collections, f64 math).
+#![allow(dead_code)]
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use tinydecimate::{Config, Report, Workspace};
+
+pub type Tri = [u32; 3];
+
+#[derive(Clone, Debug, Default)]
+pub struct MeshData {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<Tri>,
+}
+
+/// `../shared/meshes` beside the checkout.
+pub fn shared_meshes() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join("shared")
+        .join("meshes")
+}
+
+/// Minimal reader for the shared meshes (only `v x y z` and `f a b c`, 1-based).
+pub fn load_obj(name: &str) -> MeshData {
+    let path = shared_meshes().join(name);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    parse_obj(&text)
+}
+
+pub fn parse_obj(text: &str) -> MeshData {
+    let mut m = MeshData::default();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let p: Vec<f32> = it.take(3).map(|x| x.parse().unwrap()).collect();
+                m.positions.push([p[0], p[1], p[2]]);
+            }
+            Some("f") => {
+                let f: Vec<u32> = it
+                    .map(|x| x.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                    .collect();
+                assert_eq!(f.len(), 3, "triangles only");
+                m.triangles.push([f[0], f[1], f[2]]);
+            }
+            _ => {}
+        }
+    }
+    m
+}
+
+/// Workspace big enough for every shared mesh, as a static (it is several megabytes).
+pub static BIG: Mutex<Workspace<u32, 65_536, 131_072>> = Mutex::new(Workspace::new());
+
+/// Runs the library on a copy of the mesh with the big workspace.
+pub fn simplify(m: &MeshData, config: &Config) -> (MeshData, Report) {
+    let mut tris = m.triangles.clone();
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let report = ws
+        .simplify(&m.positions, &mut tris, config)
+        .expect("simplify");
+    tris.truncate(report.triangles_out);
+    (
+        MeshData {
+            positions: m.positions.clone(),
+            triangles: tris,
+        },
+        report,
+    )
+}
+
+// ---- generators ------------------------------------------------------------------------
+
+/// Icosahedron subdivided `n` times, projected to the unit sphere.
+pub fn icosphere(n: u32) -> MeshData {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut p: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut f: Vec<Tri> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..n {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut nf = Vec::new();
+        for tri in &f {
+            let mut m = [0u32; 3];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let key = (a.min(b), a.max(b));
+                m[k] = *mid.entry(key).or_insert_with(|| {
+                    let (pa, pb) = (p[a as usize], p[b as usize]);
+                    p.push([
+                        (pa[0] + pb[0]) / 2.0,
+                        (pa[1] + pb[1]) / 2.0,
+                        (pa[2] + pb[2]) / 2.0,
+                    ]);
+                    (p.len() - 1) as u32
+                });
+            }
+            nf.push([tri[0], m[0], m[2]]);
+            nf.push([tri[1], m[1], m[0]]);
+            nf.push([tri[2], m[2], m[1]]);
+            nf.push([m[0], m[1], m[2]]);
+        }
+        f = nf;
+    }
+    let positions = p
+        .iter()
+        .map(|q| {
+            let l = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
+            [(q[0] / l) as f32, (q[1] / l) as f32, (q[2] / l) as f32]
+        })
+        .collect();
+    MeshData {
+        positions,
+        triangles: f,
+    }
+}
+
+/// An open `n` x `m` grid of quads on a wavy height field (boundary: one loop).
+pub fn grid(n: u32, m: u32, wave: f32) -> MeshData {
+    let mut positions = Vec::new();
+    for j in 0..=m {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32, j as f32 / m as f32);
+            let z = wave * ((x * 6.0).sin() * (y * 4.0).cos());
+            positions.push([x, y, z]);
+        }
+    }
+    let mut triangles = Vec::new();
+    let w = n + 1;
+    for j in 0..m {
+        for i in 0..n {
+            let v = j * w + i;
+            if (i + j) % 2 == 0 {
+                triangles.push([v, v + 1, v + w + 1]);
+                triangles.push([v, v + w + 1, v + w]);
+            } else {
+                triangles.push([v, v + 1, v + w]);
+                triangles.push([v + 1, v + w + 1, v + w]);
+            }
+        }
+    }
+    MeshData {
+        positions,
+        triangles,
+    }
+}
+
+/// A cube with `n` x `n` quads per face, welded, sharp creases at the edges.
+pub fn cube(n: u32) -> MeshData {
+    let mut positions: Vec<[f32; 3]> = Vec::new();
+    let mut index: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut triangles = Vec::new();
+    let mut vid = |p: [f32; 3], positions: &mut Vec<[f32; 3]>| -> u32 {
+        let key = p.map(|x| (x as f64 * 1e6).round() as i64);
+        *index.entry(key).or_insert_with(|| {
+            positions.push(p);
+            (positions.len() - 1) as u32
+        })
+    };
+    // Each face: origin, u axis, v axis (u x v points outwards).
+    let faces: [([f32; 3], [f32; 3], [f32; 3]); 6] = [
+        ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]), // z = 0, normal -z
+        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]), // z = 1, +z
+        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), // y = 0, -y
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]), // y = 1, +y
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]), // x = 0, -x
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]), // x = 1, +x
+    ];
+    for (o, u, v) in faces {
+        let at = |i: u32, j: u32| {
+            let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+            [
+                o[0] + u[0] * s + v[0] * t,
+                o[1] + u[1] * s + v[1] * t,
+                o[2] + u[2] * s + v[2] * t,
+            ]
+        };
+        for j in 0..n {
+            for i in 0..n {
+                let a = vid(at(i, j), &mut positions);
+                let b = vid(at(i + 1, j), &mut positions);
+                let c = vid(at(i + 1, j + 1), &mut positions);
+                let d = vid(at(i, j + 1), &mut positions);
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            }
+        }
+    }
+    MeshData {
+        positions,
+        triangles,
+    }
+}
+
+// ---- invariants ------------------------------------------------------------------------
+
+/// Unit normals of adjacent triangles with a dot product below this are "folded".
+pub const FOLD_DOT: f64 = -0.9;
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Topology {
+    pub vertices: usize,
+    pub edges: usize,
+    pub faces: usize,
+    pub boundary_edges: usize,
+    pub boundary_loops: usize,
+    pub non_manifold_edges: usize,
+    pub degenerate: usize,
+    pub duplicates: usize,
+    pub out_of_range: usize,
+    /// Folded adjacent pairs, as sorted pairs of sorted vertex triples.
+    pub folded: BTreeSet<([u32; 3], [u32; 3])>,
+}
+
+impl Topology {
+    pub fn euler(&self) -> i64 {
+        self.vertices as i64 - self.edges as i64 + self.faces as i64
+    }
+}
+
+fn normal(m: &MeshData, t: Tri) -> [f64; 3] {
+    let p = |i: u32| m.positions[i as usize].map(|x| x as f64);
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 {
+        n.map(|x| x / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
+fn sorted(t: Tri) -> [u32; 3] {
+    let mut s = t;
+    s.sort();
+    s
+}
+
+pub fn analyse(m: &MeshData) -> Topology {
+    let mut edges: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
+    let mut verts = BTreeSet::new();
+    let mut seen = BTreeSet::new();
+    let (mut degenerate, mut duplicates, mut out_of_range) = (0, 0, 0);
+    for (i, &t) in m.triangles.iter().enumerate() {
+        if t.iter().any(|&v| v as usize >= m.positions.len()) {
+            out_of_range += 1;
+            continue;
+        }
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            degenerate += 1;
+            continue;
+        }
+        if !seen.insert(sorted(t)) {
+            duplicates += 1;
+        }
+        for k in 0..3 {
+            verts.insert(t[k]);
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.entry((a.min(b), a.max(b))).or_default().push(i);
+        }
+    }
+    let boundary: Vec<(u32, u32)> = edges
+        .iter()
+        .filter(|(_, f)| f.len() == 1)
+        .map(|(e, _)| *e)
+        .collect();
+    // Boundary loops: connected components of the boundary-edge graph.
+    let mut parent: HashMap<u32, u32> = HashMap::new();
+    fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
+        let mut r = x;
+        while let Some(&q) = p.get(&r) {
+            if q == r {
+                break;
+            }
+            r = q;
+        }
+        p.insert(x, r);
+        r
+    }
+    for &(a, b) in &boundary {
+        parent.entry(a).or_insert(a);
+        parent.entry(b).or_insert(b);
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent.insert(ra, rb);
+        }
+    }
+    let keys: Vec<u32> = parent.keys().copied().collect();
+    let roots: BTreeSet<u32> = keys.into_iter().map(|k| find(&mut parent, k)).collect();
+    let mut folded = BTreeSet::new();
+    for f in edges.values() {
+        if f.len() == 2 {
+            let (t, u) = (m.triangles[f[0]], m.triangles[f[1]]);
+            let (a, b) = (normal(m, t), normal(m, u));
+            if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < FOLD_DOT {
+                let (x, y) = (sorted(t), sorted(u));
+                folded.insert((x.min(y), x.max(y)));
+            }
+        }
+    }
+    Topology {
+        vertices: verts.len(),
+        edges: edges.len(),
+        faces: m.triangles.len() - degenerate - out_of_range,
+        boundary_edges: boundary.len(),
+        boundary_loops: roots.len(),
+        non_manifold_edges: edges.values().filter(|f| f.len() > 2).count(),
+        degenerate,
+        duplicates,
+        out_of_range,
+        folded,
+    }
+}
+
+/// Asserts that `output` is a valid simplification of `input`, with the library's report.
+pub fn assert_valid(name: &str, input: &MeshData, output: &MeshData, report: &Report) {
+    let a = analyse(input);
+    let b = analyse(output);
+    assert_eq!(report.triangles_out, output.triangles.len(), "{name}: count");
+    assert_eq!(b.out_of_range, 0, "{name}: index out of range");
+    assert_eq!(b.degenerate, 0, "{name}: degenerate triangle");
+    assert_eq!(b.duplicates, 0, "{name}: duplicate triangle");
+    assert!(
+        b.non_manifold_edges <= a.non_manifold_edges,
+        "{name}: new non-manifold edges {} > {}",
+        b.non_manifold_edges,
+        a.non_manifold_edges
+    );
+    let new_folds: Vec<_> = b.folded.difference(&a.folded).collect();
+    assert!(new_folds.is_empty(), "{name}: new folded pairs {new_folds:?}");
+    if a.non_manifold_edges == 0 && a.duplicates == 0 && a.degenerate == 0 {
+        assert_eq!(b.boundary_loops, a.boundary_loops, "{name}: boundary loops");
+        if a.boundary_edges == 0 {
+            assert_eq!(b.boundary_edges, 0, "{name}: closed stays closed");
+        }
+        // Euler characteristic, unless vertices were pinched (then V counts differ only by
+        // the locked pinch points, which never collapse).
+        assert_eq!(b.euler(), a.euler(), "{name}: Euler characteristic");
+    }
+}
