@@ -132,6 +132,22 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         self.mesh.tris.iter().copied().filter(|t| t[0] != t[1])
     }
 
+    /// The caller's buffer as it is now: live triangles in their original slots, removed ones
+    /// written as `[i, i, i]`.
+    pub fn buffer(&self) -> &[[I; 3]] {
+        self.mesh.tris
+    }
+
+    /// Whether vertex `v` is currently a feature vertex (never removed while it is one).
+    pub fn is_feature(&self, v: usize) -> bool {
+        self.mesh.has(v, flag::FEATURE)
+    }
+
+    /// Whether vertex `v` currently has triangles.
+    pub fn is_used(&self, v: usize) -> bool {
+        self.mesh.first(v) != NIL
+    }
+
     /// The report so far (`stop` is [`Stop::Running`] until the run is finished).
     pub fn report(&self) -> Report {
         let stop = match self.phase {
@@ -179,7 +195,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     }
 
     fn done(&mut self, stop: Stop) {
-        if self.config.schedule == Schedule::Greedy || self.pass_collapses > 0 {
+        if self.pass_collapses > 0 || self.pass_triangles.is_empty() {
             self.log_pass();
         }
         self.phase = Phase::Done(stop);
@@ -218,7 +234,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             Phase::Flags => {
                 if self.v < nv {
                     let v = self.v;
-                    let is = self.is_feature(v);
+                    let is = self.classify(v);
                     self.mesh.set_flag(v, flag::FEATURE, is);
                     self.mesh.set_flag(v, flag::DONE, false);
                     self.features += is as usize;
@@ -246,7 +262,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
     }
 
-    fn is_feature(&self, v: usize) -> bool {
+    fn classify(&self, v: usize) -> bool {
         self.config.features
             && feature::variation(&self.mesh, v, self.config.feature_mode)
                 .is_some_and(|d| d > self.threshold)
@@ -260,7 +276,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             return None;
         }
         let mut best: Option<(f32, usize)> = None;
-        let (mesh, rules, cost, rejected) = (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
+        let (mesh, rules, cost, rejected) =
+            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
         mesh.for_each_neighbour(from, |to| {
             match legality::evaluate(mesh, rules, cost, from, to) {
                 Ok(c) => {
@@ -288,7 +305,15 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             return self.done(Stop::Target);
         }
         let Some((v, key)) = self.heap.peek() else {
-            return self.done(Stop::NoLegalCollapse);
+            // Flags far from recent collapses are stale: refresh everything once more (a new
+            // round) and stop only when a round finds nothing to collapse.
+            if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
+                return self.done(Stop::NoLegalCollapse);
+            }
+            self.log_pass();
+            self.phase = Phase::Mean;
+            self.v = 0;
+            return;
         };
         if key > self.config.max_cost {
             return self.done(Stop::MaxCost);
@@ -300,6 +325,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             Some((_, to)) => {
                 self.heap.remove(v);
                 self.collapse_greedy(v, to);
+                self.pass_collapses += 1;
             }
         }
     }
@@ -329,10 +355,10 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             mean.add(feature::variation(mesh, b, mode));
             mesh.for_each_neighbour(b, |x| mean.add(feature::variation(mesh, x, mode)));
             self.threshold = self.mean.threshold(self.config.lambda);
-            let is = self.is_feature(b);
+            let is = self.classify(b);
             self.mesh.set_flag(b, flag::FEATURE, is);
             self.for_neighbours(b, |s, x| {
-                let is = s.is_feature(x);
+                let is = s.classify(x);
                 s.mesh.set_flag(x, flag::FEATURE, is);
             });
         }
@@ -403,7 +429,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         // Cheapest legal collapse between v and an unpaired neighbour, in either direction:
         // Algorithm 1 moves the endpoint whose W is smaller.
         let mut best: Option<(f32, usize, usize)> = None;
-        let (mesh, rules, cost, rejected) = (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
+        let (mesh, rules, cost, rejected) =
+            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
         mesh.for_each_neighbour(v, |y| {
             if mesh.has(y, flag::DONE) {
                 return;

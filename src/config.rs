@@ -38,7 +38,7 @@ pub struct Config {
     pub target_ratio: f32,
     /// Never perform a collapse whose cost exceeds this (in the schedule's cost units).
     pub max_cost: f32,
-    /// Stop after this many passes ([`Schedule::Passes`] only); at least 1.
+    /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue); at least 1.
     pub max_passes: u32,
     /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1. Negative or
     /// non-finite values are rejected; `f32::INFINITY` is not allowed either (use

@@ -98,7 +98,11 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
             if n_ab >= 2 {
                 return Err(Reject::Locked);
             }
-            opp[n_ab] = tri.iter().copied().find(|&x| x != a && x != b).unwrap_or(NIL);
+            opp[n_ab] = tri
+                .iter()
+                .copied()
+                .find(|&x| x != a && x != b)
+                .unwrap_or(NIL);
             n_ab += 1;
         }
     }

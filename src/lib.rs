@@ -145,7 +145,9 @@ impl core::fmt::Display for Error {
             Error::NonFinitePosition { vertex } => {
                 write!(f, "vertex {vertex} has a non-finite coordinate")
             }
-            Error::InvalidConfig { field } => write!(f, "configuration field {field:?} is out of range"),
+            Error::InvalidConfig { field } => {
+                write!(f, "configuration field {field:?} is out of range")
+            }
         }
     }
 }

@@ -116,9 +116,11 @@ pub struct Report {
     pub vertices_removed: usize,
     /// Vertices locked because the mesh is not a manifold around them.
     pub locked_vertices: usize,
-    /// Feature vertices: at the start for `Greedy`; in the last pass for `Passes`.
+    /// Feature vertices found by the last global classification (the start of the last pass
+    /// or round).
     pub feature_vertices: usize,
-    /// Passes run (`Greedy` counts as one).
+    /// Passes run. For `Greedy`, rounds: the queue is refilled with fresh feature flags each
+    /// time it runs empty, until a round collapses nothing.
     pub passes: u32,
     /// Triangles after each pass (the first [`PASS_LOG`] passes).
     pub pass_triangles: heapless::Vec<u32, PASS_LOG>,

@@ -9,7 +9,8 @@ use crate::{Config, Error, Report, Schedule};
 /// All working state of the simplifier, with capacity fixed by const generics.
 ///
 /// * `L`: link type (`u16` or `u32`) for vertex and corner numbers inside the workspace. With
-///   `u16` a mesh may have at most 65 534 vertices and 21 844 triangles.
+///   `u16` a mesh may have at most 65 535 vertices and 21 845 triangles (the largest value is
+///   reserved as "none", and each triangle has three corners).
 /// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
 ///
 /// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a

@@ -33,8 +33,16 @@ fn run(schedule: Schedule) {
                 report.pass_triangles,
                 report.feature_vertices,
             );
-            assert_valid(&format!("{name} {schedule:?} {ratio}"), &input, &output, &report);
-            assert!(report.triangles_out < report.triangles_in, "{name}: nothing removed");
+            assert_valid(
+                &format!("{name} {schedule:?} {ratio}"),
+                &input,
+                &output,
+                &report,
+            );
+            assert!(
+                report.triangles_out < report.triangles_in,
+                "{name}: nothing removed"
+            );
             if report.stop != Stop::Target {
                 assert!(!report.target_reached);
             }

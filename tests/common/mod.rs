@@ -360,7 +360,11 @@ pub fn analyse(m: &MeshData) -> Topology {
 pub fn assert_valid(name: &str, input: &MeshData, output: &MeshData, report: &Report) {
     let a = analyse(input);
     let b = analyse(output);
-    assert_eq!(report.triangles_out, output.triangles.len(), "{name}: count");
+    assert_eq!(
+        report.triangles_out,
+        output.triangles.len(),
+        "{name}: count"
+    );
     assert_eq!(b.out_of_range, 0, "{name}: index out of range");
     assert_eq!(b.degenerate, 0, "{name}: degenerate triangle");
     assert_eq!(b.duplicates, 0, "{name}: duplicate triangle");
@@ -371,7 +375,10 @@ pub fn assert_valid(name: &str, input: &MeshData, output: &MeshData, report: &Re
         a.non_manifold_edges
     );
     let new_folds: Vec<_> = b.folded.difference(&a.folded).collect();
-    assert!(new_folds.is_empty(), "{name}: new folded pairs {new_folds:?}");
+    assert!(
+        new_folds.is_empty(),
+        "{name}: new folded pairs {new_folds:?}"
+    );
     if a.non_manifold_edges == 0 && a.duplicates == 0 && a.degenerate == 0 {
         assert_eq!(b.boundary_loops, a.boundary_loops, "{name}: boundary loops");
         if a.boundary_edges == 0 {

@@ -1,0 +1,276 @@
+//! Bad input gets a typed error before the caller's buffer is touched, or a documented
+//! behaviour (dropped and counted, or locked and simplified around).
+
+mod common;
+use common::*;
+use tinydecimate::{Capacity, Config, ConfigField, Error, Schedule, Stop, Workspace};
+
+fn sphere() -> MeshData {
+    icosphere(2) // 162 vertices, 320 triangles
+}
+
+#[test]
+fn too_many_vertices_or_triangles_is_a_capacity_error() {
+    let m = sphere();
+    let mut tris = m.triangles.clone();
+    let mut small = Workspace::<u32, 100, 400>::new();
+    let e = small.simplify(&m.positions, &mut tris, &Config::new());
+    assert_eq!(
+        e,
+        Err(Error::Capacity {
+            what: Capacity::Vertices,
+            needed: 162,
+            available: 100
+        })
+    );
+    let mut small = Workspace::<u32, 200, 300>::new();
+    let e = small.simplify(&m.positions, &mut tris, &Config::new());
+    assert!(matches!(
+        e,
+        Err(Error::Capacity {
+            what: Capacity::Triangles,
+            needed: 320,
+            ..
+        })
+    ));
+    assert_eq!(tris, m.triangles, "buffer untouched");
+}
+
+#[test]
+fn u16_links_cap_the_triangle_count() {
+    // 21 846 triangles need corner numbers up to 65 537, past what u16 links leave below NIL
+    // (65 535); 21 845 still fit.
+    let positions = vec![[0.0f32; 3]; 3];
+    let mut tris = vec![[0u32, 1, 2]; 21_846];
+    let mut ws = Box::new(Workspace::<u16, 4, 30_000>::new());
+    let e = ws.simplify(&positions, &mut tris, &Config::new());
+    assert_eq!(tris[0], [0, 1, 2]);
+    assert_eq!(
+        e,
+        Err(Error::Capacity {
+            what: Capacity::Triangles,
+            needed: 21_846,
+            available: 21_845
+        })
+    );
+}
+
+#[test]
+fn index_out_of_range_names_the_triangle() {
+    let m = sphere();
+    let mut tris = m.triangles.clone();
+    tris[17][2] = 162;
+    let before = tris.clone();
+    let mut ws = Workspace::<u32, 256, 512>::new();
+    let e = ws.simplify(&m.positions, &mut tris, &Config::new());
+    assert_eq!(
+        e,
+        Err(Error::IndexOutOfRange {
+            triangle: 17,
+            index: 162
+        })
+    );
+    assert_eq!(tris, before);
+}
+
+#[test]
+fn non_finite_positions_name_the_vertex() {
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let mut m = sphere();
+        m.positions[40][1] = bad;
+        let mut tris = m.triangles.clone();
+        let mut ws = Workspace::<u32, 256, 512>::new();
+        let e = ws.simplify(&m.positions, &mut tris, &Config::new());
+        assert_eq!(e, Err(Error::NonFinitePosition { vertex: 40 }));
+        assert_eq!(tris, m.triangles);
+    }
+    // An unused vertex may be anything.
+    let mut m = sphere();
+    m.positions.push([f32::NAN; 3]);
+    let (out, report) = simplify(&m, &Config::new().with_ratio(0.5));
+    assert_valid("unused NaN", &m, &out, &report);
+}
+
+#[test]
+fn bad_configuration_is_refused() {
+    let m = sphere();
+    let mut ws = Workspace::<u32, 256, 512>::new();
+    let cases: [(Config, ConfigField); 6] = [
+        (Config::new().with_ratio(1.5), ConfigField::TargetRatio),
+        (Config::new().with_ratio(f32::NAN), ConfigField::TargetRatio),
+        (Config::new().with_lambda(-1.0), ConfigField::Lambda),
+        (Config::new().with_max_passes(0), ConfigField::MaxPasses),
+        (Config::new().with_max_cost(f32::NAN), ConfigField::MaxCost),
+        (
+            Config {
+                max_normal_turn_deg: 0.0,
+                ..Config::new()
+            },
+            ConfigField::MaxNormalTurn,
+        ),
+    ];
+    for (config, field) in cases {
+        let mut tris = m.triangles.clone();
+        let e = ws.simplify(&m.positions, &mut tris, &config);
+        assert_eq!(e, Err(Error::InvalidConfig { field }));
+        assert_eq!(tris, m.triangles);
+    }
+}
+
+#[test]
+fn degenerate_and_duplicate_triangles_are_dropped_and_counted() {
+    let mut m = sphere();
+    m.triangles.push([3, 3, 4]); // repeated index
+    m.triangles.push([5, 6, 5]);
+    let t = m.triangles[10];
+    m.triangles.push(t); // exact duplicate
+    m.triangles.push([t[1], t[0], t[2]]); // same vertices, other winding
+    let (out, report) = simplify(&m, &Config::new().with_ratio(1.0));
+    assert_eq!(report.degenerate_dropped, 2);
+    assert_eq!(report.duplicates_dropped, 2);
+    assert_eq!(report.triangles_out, 320, "ratio 1: only the bad ones go");
+    let clean = sphere();
+    assert_eq!(
+        out.triangles, clean.triangles,
+        "the first copy is kept, in order"
+    );
+}
+
+#[test]
+fn empty_and_tiny_meshes() {
+    let mut ws = Workspace::<u16, 8, 8>::new();
+    let mut none: [[u16; 3]; 0] = [];
+    let r = ws.simplify(&[], &mut none, &Config::new()).unwrap();
+    assert_eq!((r.triangles_out, r.stop), (0, Stop::Target));
+
+    let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let mut one = [[0u16, 1, 2]];
+    let r = ws
+        .simplify(&p, &mut one, &Config::new().with_ratio(0.0))
+        .unwrap();
+    assert_eq!(
+        r.triangles_out, 1,
+        "a lone triangle cannot lose its boundary loop"
+    );
+    assert_eq!(r.stop, Stop::NoLegalCollapse);
+    assert!(!r.target_reached);
+    assert_eq!(one, [[0, 1, 2]]);
+
+    // A tetrahedron is the smallest closed surface: nothing can go.
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let mut tet = [[0u16, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+    for schedule in [Schedule::Greedy, Schedule::Passes] {
+        let c = Config::new().with_ratio(0.0).with_schedule(schedule);
+        let r = ws.simplify(&p, &mut tet, &c).unwrap();
+        assert_eq!(r.triangles_out, 4);
+        assert_eq!(r.stop, Stop::NoLegalCollapse);
+    }
+}
+
+#[test]
+fn all_zero_area_triangles_only_lose_whole_triangles() {
+    // Collinear points: every triangle has zero area. A collapse may still delete triangles
+    // outright (the end of the strip), but never move a vertex of a surviving one, which would
+    // need a new zero-area triangle.
+    let m = MeshData {
+        positions: (0..6).map(|i| [i as f32, 0.0, 0.0]).collect(),
+        triangles: vec![[0, 1, 2], [1, 3, 2], [2, 3, 4], [3, 5, 4]],
+    };
+    let (out, r) = simplify(&m, &Config::new().with_ratio(0.0));
+    assert_eq!(r.stop, Stop::NoLegalCollapse);
+    assert!(r.triangles_out >= 1);
+    assert!(
+        out.triangles.iter().all(|t| m.triangles.contains(t)),
+        "{out:?}"
+    );
+    assert_valid("collinear", &m, &out, &r);
+}
+
+#[test]
+fn coordinates_near_f32_limits_simplify_like_small_ones() {
+    let m = icosphere(3);
+    let huge = MeshData {
+        positions: m.positions.iter().map(|p| p.map(|x| x * 3.0e38)).collect(),
+        triangles: m.triangles.clone(),
+    };
+    let tiny = MeshData {
+        positions: m.positions.iter().map(|p| p.map(|x| x * 1.0e-36)).collect(),
+        triangles: m.triangles.clone(),
+    };
+    let c = Config::new().with_ratio(0.2);
+    let (a, ra) = simplify(&m, &c);
+    let (b, rb) = simplify(&huge, &c);
+    let (t, rt) = simplify(&tiny, &c);
+    assert!(ra.target_reached && rb.target_reached && rt.target_reached);
+    assert_valid("huge", &huge, &b, &rb);
+    assert_valid("tiny", &tiny, &t, &rt);
+    // Power-of-two-free scales round differently, so only sizes are compared.
+    assert_eq!(a.triangles.len(), b.triangles.len());
+}
+
+#[test]
+fn non_manifold_input_is_simplified_around_locked_vertices() {
+    let mut m = grid(8, 8, 0.1);
+    let [a, b, _] = m.triangles[64];
+    m.positions.push([0.5, 0.5, 1.0]);
+    let top = (m.positions.len() - 1) as u32;
+    m.triangles.push([a, b, top]); // third triangle on edge a-b
+    let (out, report) = simplify(&m, &Config::new().with_ratio(0.2));
+    assert!(report.locked_vertices >= 2, "{report:?}");
+    assert!(report.triangles_out < m.triangles.len() / 2);
+    assert_valid("fin", &m, &out, &report);
+    let e = analyse(&out);
+    assert_eq!(e.non_manifold_edges, 1, "the fin edge stays, untouched");
+    assert!(out.triangles.contains(&[a, b, top]));
+}
+
+#[test]
+fn inconsistent_winding_is_locked_not_rejected() {
+    let mut m = grid(6, 6, 0.0);
+    m.triangles[20].swap(0, 1);
+    let (out, report) = simplify(&m, &Config::new().with_ratio(0.3));
+    assert!(report.locked_vertices >= 3);
+    assert!(out.triangles.len() < m.triangles.len());
+    let t = m.triangles[20];
+    assert!(out.triangles.contains(&t), "the flipped triangle is kept");
+}
+
+#[test]
+fn target_of_zero_or_above_input() {
+    let m = sphere();
+    let (out, r) = simplify(&m, &Config::new().with_ratio(1.0));
+    assert_eq!(
+        (r.triangles_out, r.collapses, r.stop),
+        (320, 0, Stop::Target)
+    );
+    assert_eq!(out.triangles, m.triangles);
+    let (_, r) = simplify(
+        &m,
+        &Config::new().with_target_triangles(10_000).with_ratio(0.0),
+    );
+    assert_eq!((r.triangles_out, r.stop), (320, Stop::Target));
+    let (out, r) = simplify(&m, &Config::new().with_ratio(0.0));
+    assert!(!r.target_reached);
+    assert_ne!(r.stop, Stop::Target);
+    assert_valid("zero", &m, &out, &r);
+}
+
+#[test]
+fn max_cost_and_max_passes_stop_the_run() {
+    let m = icosphere(3);
+    let (_, r) = simplify(&m, &Config::new().with_ratio(0.0).with_max_cost(0.0));
+    assert_eq!((r.stop, r.collapses), (Stop::MaxCost, 0));
+    let c = Config::new()
+        .with_ratio(0.0)
+        .with_schedule(Schedule::Passes)
+        .with_max_passes(2);
+    let (_, r) = simplify(&m, &c);
+    assert_eq!((r.stop, r.passes), (Stop::MaxPasses, 2));
+    assert_eq!(r.pass_triangles.len(), 2);
+    assert_eq!(r.pass_triangles[1] as usize, r.triangles_out);
+}

@@ -1,0 +1,183 @@
+//! Property tests on generated meshes: after every run (and, where it matters, after every
+//! single operation) the mesh is valid, closed stays closed, topology is kept, features stay.
+
+mod common;
+use common::*;
+use proptest::prelude::*;
+use tinydecimate::{Config, FeatureMode, Schedule, Workspace};
+
+#[derive(Clone, Debug)]
+enum Kind {
+    Sphere(u32),
+    Grid(u32, u32),
+    Cube(u32),
+    /// A grid with a fin: a third triangle on one interior edge (non-manifold edge), and a cone
+    /// touching it at one vertex (pinched vertex).
+    NonManifold(u32),
+}
+
+fn build(kind: &Kind, jitter: u64) -> MeshData {
+    let mut m = match *kind {
+        Kind::Sphere(n) => icosphere(n),
+        Kind::Grid(n, k) => grid(n, k, 0.15),
+        Kind::Cube(n) => cube(n),
+        Kind::NonManifold(n) => {
+            let mut m = grid(n, n, 0.1);
+            // Fin on the edge of the first triangle.
+            let [a, b, _] = m.triangles[m.triangles.len() / 2];
+            m.positions.push([0.5, 0.5, 1.0]);
+            let top = (m.positions.len() - 1) as u32;
+            m.triangles.push([a, b, top]);
+            // A small cone pinched onto a grid corner vertex 0.
+            let base = m.positions.len() as u32;
+            for i in 0..5 {
+                let t = i as f32 / 5.0 * std::f32::consts::TAU;
+                m.positions
+                    .push([-0.2 + 0.1 * t.cos(), -0.2 + 0.1 * t.sin(), -0.3]);
+            }
+            for i in 0..5 {
+                m.triangles.push([0, base + (i + 1) % 5, base + i]);
+            }
+            m
+        }
+    };
+    // Deterministic jitter so that ties and symmetric cases vary.
+    let mut s = jitter | 1;
+    for p in &mut m.positions {
+        for x in p.iter_mut() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            *x += ((s % 1000) as f32 / 1000.0 - 0.5) * 1e-3;
+        }
+    }
+    m
+}
+
+fn kind() -> impl Strategy<Value = Kind> {
+    prop_oneof![
+        (1u32..4).prop_map(Kind::Sphere),
+        (2u32..14, 2u32..14).prop_map(|(a, b)| Kind::Grid(a, b)),
+        (1u32..7).prop_map(Kind::Cube),
+        (3u32..9).prop_map(Kind::NonManifold),
+    ]
+}
+
+fn config() -> impl Strategy<Value = Config> {
+    (
+        prop_oneof![Just(Schedule::Greedy), Just(Schedule::Passes)],
+        0.0f32..0.9,
+        prop_oneof![Just(0.0f32), Just(0.5), Just(1.0), Just(2.0)],
+        any::<bool>(),
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(|(schedule, ratio, lambda, valence, targets, loose)| {
+            let mut c = Config::new()
+                .with_schedule(schedule)
+                .with_ratio(ratio)
+                .with_lambda(lambda)
+                .with_feature_mode(if valence {
+                    FeatureMode::ValenceNormalized
+                } else {
+                    FeatureMode::Paper
+                });
+            c.feature_targets = targets;
+            if loose {
+                // Geometry barely constrains: the topological rules must hold on their own.
+                c.max_normal_turn_deg = 179.0;
+                c.min_quality = 0.0;
+            }
+            c
+        })
+}
+
+fn angle_deg(m: &MeshData, a: [u32; 3], b: [u32; 3]) -> f64 {
+    let n = |t: [u32; 3]| {
+        let p = |i: u32| m.positions[i as usize].map(|x| x as f64);
+        let (x, y, z) = (p(t[0]), p(t[1]), p(t[2]));
+        let u = [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+        let v = [z[0] - x[0], z[1] - x[1], z[2] - x[2]];
+        [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ]
+    };
+    let (p, q) = (n(a), n(b));
+    let d = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+    let l = ((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]))
+        .sqrt();
+    if l == 0.0 {
+        return 0.0;
+    }
+    (d / l).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// One-shot runs: the output is a valid simplification of the input.
+    #[test]
+    fn output_is_valid(kind in kind(), jitter in any::<u64>(), config in config()) {
+        let input = build(&kind, jitter);
+        let (output, report) = simplify(&input, &config);
+        assert_valid(&format!("{kind:?}"), &input, &output, &report);
+        prop_assert!(report.triangles_out <= input.triangles.len());
+        prop_assert_eq!(report.target_reached, report.triangles_out <= report.target_triangles);
+    }
+
+    /// Operation by operation: no triangle turns beyond the limit in one collapse, and a vertex
+    /// that is a feature before an operation survives it.
+    #[test]
+    fn every_operation_respects_limits(kind in kind(), jitter in any::<u64>(), config in config()) {
+        let input = build(&kind, jitter);
+        let mut tris = input.triangles.clone();
+        let mut ws = Workspace::<u16, 2048, 2048>::new();
+        let mut s = ws.start(&input.positions, &mut tris, &config).unwrap();
+        let mut guard = 0;
+        loop {
+            let before: Vec<[u32; 3]> = s.buffer().to_vec();
+            let features: Vec<usize> = (0..input.positions.len())
+                .filter(|&v| s.is_feature(v) && s.is_used(v))
+                .collect();
+            let finished = s.step(1);
+            for &v in &features {
+                prop_assert!(s.is_used(v), "feature vertex {} removed", v);
+            }
+            for (t, (old, new)) in before.iter().zip(s.buffer()).enumerate() {
+                if new[0] != new[1] && old != new {
+                    let a = angle_deg(&input, *old, *new);
+                    prop_assert!(a <= config.max_normal_turn_deg as f64 + 0.5,
+                        "triangle {} turned {:.1} degrees", t, a);
+                }
+            }
+            guard += 1;
+            prop_assert!(guard < 100_000, "no termination");
+            if finished { break; }
+        }
+        let report = s.finish();
+        tris.truncate(report.triangles_out);
+        let output = MeshData { positions: input.positions.clone(), triangles: tris };
+        assert_valid(&format!("{kind:?}"), &input, &output, &report);
+    }
+
+    /// Stepping with any budgets gives exactly the one-shot bytes and report.
+    #[test]
+    fn stepping_equals_one_shot(kind in kind(), jitter in any::<u64>(), config in config(),
+                                budgets in proptest::collection::vec(1u32..50, 1..8)) {
+        let input = build(&kind, jitter);
+        let mut one = input.triangles.clone();
+        let mut ws = Workspace::<u32, 2048, 2048>::new();
+        let r1 = ws.simplify(&input.positions, &mut one, &config).unwrap();
+        let mut stepped = input.triangles.clone();
+        let mut s = ws.start(&input.positions, &mut stepped, &config).unwrap();
+        let mut i = 0;
+        while !s.step(budgets[i % budgets.len()]) {
+            i += 1;
+        }
+        let r2 = s.finish();
+        prop_assert_eq!(&r1, &r2);
+        prop_assert_eq!(&one[..r1.triangles_out], &stepped[..r2.triangles_out]);
+    }
+}
