@@ -270,25 +270,66 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
 
     /// The cheapest legal collapse of `from` onto one of its neighbours: `(cost, to)`.
     /// Ties go to the lower vertex number.
+    ///
+    /// Every neighbour is priced first (cheap rules and cost); the connectivity rules then run
+    /// on the candidates in cost order only until one passes. Up to `CANDIDATES` candidates are
+    /// kept on the stack; any beyond (valence > 32) are checked in full on the spot. Either way
+    /// the answer is the minimum over the legal candidates.
     fn best(&mut self, from: usize) -> Option<(f32, usize)> {
+        const CANDIDATES: usize = 32;
         let f = self.mesh.flags(from);
         if f & flag::USED == 0 || f & (flag::LOCKED | flag::FEATURE) != 0 {
             return None;
         }
-        let mut best: Option<(f32, usize)> = None;
+        let mut cand = [(f32::INFINITY, NIL); CANDIDATES];
+        let mut n = 0;
+        let mut overflow: Option<(f32, usize)> = None;
         let (mesh, rules, cost, rejected) =
             (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
         mesh.for_each_neighbour(from, |to| {
-            match legality::evaluate(mesh, rules, cost, from, to) {
+            match legality::price(mesh, rules, cost, from, to) {
                 Ok(c) => {
-                    if best.is_none_or(|(bc, bt)| c < bc || (c == bc && to < bt)) {
-                        best = Some((c, to));
+                    if let Some(slot) = cand.get_mut(n) {
+                        *slot = (c, to);
+                        n += 1;
+                    } else {
+                        match legality::connectivity(mesh, from, to) {
+                            Ok(()) => {
+                                if overflow.is_none_or(|o| less((c, to), o)) {
+                                    overflow = Some((c, to));
+                                }
+                            }
+                            Err(r) => rejected.count(r),
+                        }
                     }
                 }
                 Err(r) => rejected.count(r),
             }
         });
-        best
+        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        loop {
+            let mut min: Option<(usize, (f32, usize))> = None;
+            for (i, &c) in cand.iter().enumerate() {
+                if c.1 != NIL && min.is_none_or(|(_, m)| less(c, m)) {
+                    min = Some((i, c));
+                }
+            }
+            let Some((i, c)) = min else {
+                return overflow;
+            };
+            if overflow.is_some_and(|o| less(o, c)) {
+                return overflow;
+            }
+            match legality::connectivity(mesh, from, c.1) {
+                Ok(()) => return Some(c),
+                Err(r) => {
+                    rejected.count(r);
+                    if let Some(slot) = cand.get_mut(i) {
+                        slot.1 = NIL;
+                    }
+                }
+            }
+        }
     }
 
     /// Greedy: recompute `v`'s key.
@@ -366,25 +407,19 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         self.for_neighbours(b, |s, x| s.rekey(x));
     }
 
-    /// Calls `f(self, x)` for each neighbour `x` of `v`, re-walking the list so that `f` may
-    /// change flags and keys (never adjacency).
+    /// Calls `f(self, x)` once for each neighbour `x` of `v`; `f` may change flags and keys,
+    /// never adjacency, so the walk can hold a corner number across the call.
     fn for_neighbours(&mut self, v: usize, mut f: impl FnMut(&mut Self, usize)) {
-        let mut i = 0;
-        loop {
-            // The i-th distinct neighbour; adjacency does not change inside `f`.
-            let mut n = 0;
-            let mut found = NIL;
-            self.mesh.for_each_neighbour(v, |x| {
-                if n == i {
-                    found = x;
+        let mut c = self.mesh.first(v);
+        while c != NIL {
+            let tri = self.mesh.tri(c / 3);
+            let k = c % 3;
+            for x in [tri[(k + 1) % 3], tri[(k + 2) % 3]] {
+                if !self.mesh.seen_before(v, c, x) {
+                    f(self, x);
                 }
-                n += 1;
-            });
-            if found == NIL {
-                break;
             }
-            f(self, found);
-            i += 1;
+            c = self.mesh.after(c);
         }
     }
 
@@ -460,4 +495,10 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             self.pass_collapses += 1;
         }
     }
+}
+
+/// `(cost, vertex)` order: cheaper first, then the lower vertex number.
+#[inline]
+fn less(a: (f32, usize), b: (f32, usize)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
 }

@@ -81,6 +81,21 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
     a: usize,
     b: usize,
 ) -> Result<f32, Reject> {
+    let c = price(mesh, rules, cost, a, b)?;
+    connectivity(mesh, a, b)?;
+    Ok(c)
+}
+
+/// The cheap rules (flags, boundary, each surviving triangle's own shape and turn) and the
+/// cost. The schedules call this for every candidate and [`connectivity`] only for the
+/// cheapest ones, in cost order, until one passes.
+pub(crate) fn price<L: Index, I: Index, C: Cost>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    cost: &C,
+    a: usize,
+    b: usize,
+) -> Result<f32, Reject> {
     let (fa, fb) = (mesh.flags(a), mesh.flags(b));
     if fa & fb & flag::USED == 0 || (fa | fb) & flag::LOCKED != 0 {
         return Err(Reject::Locked);
@@ -89,25 +104,18 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
         return Err(Reject::Feature);
     }
 
-    // The triangles on edge a-b, and the vertices opposite it.
-    let mut opp = [NIL; 2];
+    // The number of triangles on edge a-b.
     let mut n_ab = 0;
     for (t, _) in mesh.corners(a) {
-        let tri = mesh.tri(t);
-        if tri.contains(&b) {
-            if n_ab >= 2 {
-                return Err(Reject::Locked);
-            }
-            opp[n_ab] = tri
-                .iter()
-                .copied()
-                .find(|&x| x != a && x != b)
-                .unwrap_or(NIL);
+        if mesh.tri(t).contains(&b) {
             n_ab += 1;
         }
     }
     if n_ab == 0 {
         return Err(Reject::Link);
+    }
+    if n_ab > 2 {
+        return Err(Reject::Locked);
     }
 
     // Boundary: a boundary vertex only slides along its own boundary edge.
@@ -127,7 +135,75 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
         }
     }
 
-    // Link condition and duplicates.
+    // Each surviving triangle's shape and turn, and the cost.
+    let pa = mesh.p(a);
+    let pb = mesh.p(b);
+    let shift = math::sub(pb, pa);
+    let mut sum = 0.0f32;
+    for (t, _) in mesh.corners(a) {
+        let old = mesh.tri(t);
+        let Some(new) = moved(old, a, b) else {
+            continue;
+        };
+        let n0 = mesh.normal_of(old);
+        let n1 = mesh.normal_of(new);
+        let l0 = math::dot(n0, n0);
+        let l1 = math::dot(n1, n1);
+        // Zero or NaN: no area left.
+        if l1.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            return Err(Reject::Sliver);
+        }
+        let r1 = quality_ratio(mesh, new, l1);
+        if r1 < rules.min_ratio && r1 < quality_ratio(mesh, old, l0) {
+            return Err(Reject::Sliver);
+        }
+        if math::dot(n0, n1) < rules.cos_turn * math::sqrt(l0 * l1) {
+            return Err(Reject::NormalTurn);
+        }
+        sum += cost.triangle(&TriangleChange {
+            old_normal: math::unit(n0),
+            new_normal: math::unit(n1),
+            old_area2: math::sqrt(l0),
+            moved: shift,
+        });
+    }
+    let total = cost.total(
+        sum,
+        &EdgeChange {
+            length2: math::dot(shift, shift),
+            boundary_retreat2: retreat2,
+        },
+    );
+    if total.is_nan() || total == f32::INFINITY {
+        return Err(Reject::Sliver);
+    }
+    Ok(if total > 0.0 { total } else { 0.0 })
+}
+
+/// The rules that look past `a`'s own triangles: link condition, duplicates, folds.
+pub(crate) fn connectivity<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    a: usize,
+    b: usize,
+) -> Result<(), Reject> {
+    // The vertices opposite edge a-b (at most two: `price` refused more).
+    let mut opp = [NIL; 2];
+    let mut n_ab = 0;
+    for (t, _) in mesh.corners(a) {
+        let tri = mesh.tri(t);
+        if tri.contains(&b) {
+            if let Some(slot) = opp.get_mut(n_ab) {
+                *slot = tri
+                    .iter()
+                    .copied()
+                    .find(|&x| x != a && x != b)
+                    .unwrap_or(NIL);
+            }
+            n_ab += 1;
+        }
+    }
+    let opp = &opp[..n_ab.min(2)];
+
     for (t, _) in mesh.corners(a) {
         let tri = mesh.tri(t);
         if tri.contains(&b) {
@@ -135,13 +211,12 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
         }
         let mut both_opposite = true;
         for &x in &tri {
-            if x == a {
-                continue;
-            }
-            if opp[..n_ab].contains(&x) {
+            if x == a || opp.contains(&x) {
                 continue;
             }
             both_opposite = false;
+            // Link condition: x is a neighbour of a but not opposite a-b, so it must not be a
+            // neighbour of b too.
             if mesh.adjacent(b, x) {
                 return Err(Reject::Link);
             }
@@ -159,52 +234,16 @@ pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
         }
     }
 
-    // Geometry of every surviving triangle, and the cost.
-    let pa = mesh.p(a);
-    let pb = mesh.p(b);
-    let shift = math::sub(pb, pa);
-    let mut sum = 0.0f32;
     for (t, _) in mesh.corners(a) {
-        let old = mesh.tri(t);
-        let Some(new) = moved(old, a, b) else {
+        let Some(new) = moved(mesh.tri(t), a, b) else {
             continue;
         };
-        let n0 = mesh.normal_of(old);
-        let n1 = mesh.normal_of(new);
-        let l0 = math::dot(n0, n0);
-        let l1 = math::dot(n1, n1);
-        if !(l1 > 0.0) {
-            return Err(Reject::Sliver);
-        }
-        let r1 = quality_ratio(mesh, new, l1);
-        if r1 < rules.min_ratio && r1 < quality_ratio(mesh, old, l0) {
-            return Err(Reject::Sliver);
-        }
-        if math::dot(n0, n1) < rules.cos_turn * math::sqrt(l0 * l1) {
-            return Err(Reject::NormalTurn);
-        }
-        let u1 = math::unit(n1);
+        let u1 = math::unit(mesh.normal_of(new));
         if folds(mesh, t, new, u1, a, b) {
             return Err(Reject::Fold);
         }
-        sum += cost.triangle(&TriangleChange {
-            old_normal: math::unit(n0),
-            new_normal: u1,
-            old_area2: math::sqrt(l0),
-            moved: shift,
-        });
     }
-    let total = cost.total(
-        sum,
-        &EdgeChange {
-            length2: math::dot(shift, shift),
-            boundary_retreat2: retreat2,
-        },
-    );
-    if total.is_nan() || total == f32::INFINITY {
-        return Err(Reject::Sliver);
-    }
-    Ok(if total > 0.0 { total } else { 0.0 })
+    Ok(())
 }
 
 /// Whether the moved triangle `t` (now `new`, unit normal `u1`) would be folded onto any of its

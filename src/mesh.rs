@@ -318,22 +318,26 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             let tri = self.tri(t);
             let k = c % 3;
             for x in [tri[(k + 1) % 3], tri[(k + 2) % 3]] {
-                // Seen in an earlier corner? O(valence²), and valences are small.
-                let mut seen = false;
-                let mut e = self.first(v);
-                while e != c && e != NIL {
-                    if self.tri(e / 3).contains(&x) {
-                        seen = true;
-                        break;
-                    }
-                    e = self.after(e);
-                }
-                if !seen {
+                if !self.seen_before(v, c, x) {
                     f(x);
                 }
             }
             c = self.after(c);
         }
+    }
+
+    /// Whether `x` is in a triangle of `v`'s list before corner `c`: O(valence), so a walk
+    /// over distinct neighbours is O(valence²), and valences are small.
+    #[inline]
+    pub(crate) fn seen_before(&self, v: usize, c: usize, x: usize) -> bool {
+        let mut e = self.first(v);
+        while e != c && e != NIL {
+            if self.tri(e / 3).contains(&x) {
+                return true;
+            }
+            e = self.after(e);
+        }
+        false
     }
 
     /// The other end of `v`'s boundary edges, except `not`; `NIL` if none.

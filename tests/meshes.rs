@@ -25,13 +25,14 @@ fn run(schedule: Schedule) {
             let (output, report) = simplify(&input, &config);
             let dt = t0.elapsed();
             eprintln!(
-                "{name} {schedule:?} {ratio}: {} -> {} (target {}, {:?}, passes {:?}) features {} in {dt:.2?}",
+                "{name} {schedule:?} {ratio}: {} -> {} (target {}, {:?}, passes {:?}) features {} in {dt:.2?} digest {:016x}",
                 report.triangles_in,
                 report.triangles_out,
                 report.target_triangles,
                 report.stop,
                 report.pass_triangles,
                 report.feature_vertices,
+                digest(&output.triangles),
             );
             assert_valid(
                 &format!("{name} {schedule:?} {ratio}"),

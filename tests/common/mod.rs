@@ -74,6 +74,16 @@ pub fn simplify(m: &MeshData, config: &Config) -> (MeshData, Report) {
     )
 }
 
+/// FNV-1a over the triangles' little-endian bytes: a short fingerprint of an output.
+pub fn digest(tris: &[Tri]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for b in tris.iter().flatten().flat_map(|i| i.to_le_bytes()) {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h
+}
+
 // ---- generators ------------------------------------------------------------------------
 
 /// Icosahedron subdivided `n` times, projected to the unit sphere.
