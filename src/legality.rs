@@ -23,7 +23,7 @@ use crate::index::Index;
 use crate::math;
 use crate::mesh::{flag, is_dead, Mesh, NIL};
 use crate::report::Reject;
-use crate::Config;
+use crate::{Config, Schedule};
 
 /// Two adjacent triangles whose unit normals have a dot product below this are folded onto
 /// each other (more than about 154° apart).
@@ -44,7 +44,8 @@ impl Rules {
         Rules {
             cos_turn: math::cos(config.max_normal_turn_deg * (core::f32::consts::PI / 180.0)),
             min_ratio: q * q / 12.0,
-            feature_targets: config.feature_targets,
+            // The paper's schedule keeps the paper's rule.
+            feature_targets: config.feature_targets && config.schedule == Schedule::Greedy,
         }
     }
 }
