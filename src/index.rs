@@ -5,7 +5,7 @@
 ///
 /// Implemented for `u16` and `u32` only. The largest value, [`Index::NIL`], is reserved as
 /// "no link" inside the workspace, so a workspace with `u16` links addresses at most 65 535
-/// vertices and 21 845 triangles (three corners each).
+/// vertices and 65 535 triangles.
 pub trait Index: Copy + Eq + Ord + core::fmt::Debug + sealed::Sealed {
     /// Zero.
     const ZERO: Self;

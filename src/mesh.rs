@@ -4,9 +4,11 @@
 //! Adjacency is a *corner list*: corner `3t + k` is slot `k` of triangle `t`, and every vertex
 //! owns a singly linked list of its corners (`head[v]`, then `next[corner]`). That is one link
 //! per vertex and three per triangle, the least that still lets a collapse re-home a vertex's
-//! triangles in O(valence). Removed triangles are written as `[b, b, b]` in the caller's buffer
-//! (a degenerate triangle, which renders as nothing) and unlinked from every list, so lists only
-//! ever hold live corners.
+//! triangles in O(valence). A link stores only the next *triangle*: the slot is found again by
+//! looking for the vertex among the triangle's three (live triangles never repeat a vertex), so
+//! `u16` links reach 65 535 triangles instead of the 21 845 that corner numbers would allow.
+//! Removed triangles are unlinked from every list, then written as `[b, b, b]` in the caller's
+//! buffer (a degenerate triangle, which renders as nothing), so lists only hold live corners.
 //!
 //! Every access goes through `get`, so a broken invariant shows up as a refused collapse, never
 //! as a panic.
@@ -214,11 +216,20 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
+    /// The corner of `v` in triangle `t`, or `NIL` if `t` does not hold `v`.
+    #[inline]
+    fn corner_of(&self, t: usize, v: usize) -> usize {
+        match self.tri(t).iter().position(|&x| x == v) {
+            Some(k) => 3 * t + k,
+            None => NIL,
+        }
+    }
+
     /// First corner of `v`'s list.
     #[inline]
     pub(crate) fn first(&self, v: usize) -> usize {
         match self.head.get(v) {
-            Some(&c) if c != L::NIL => c.to_usize(),
+            Some(&t) if t != L::NIL => self.corner_of(t.to_usize(), v),
             _ => NIL,
         }
     }
@@ -226,15 +237,17 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     #[inline]
     fn set_first(&mut self, v: usize, c: usize) {
         if let Some(h) = self.head.get_mut(v) {
-            *h = if c == NIL { L::NIL } else { L::narrow(c) };
+            *h = if c == NIL { L::NIL } else { L::narrow(c / 3) };
         }
     }
 
-    /// The corner after `c` in its vertex's list.
+    /// The corner after `c` in its vertex's list (`c`'s triangle must still hold the vertex in
+    /// slot `c % 3`).
     #[inline]
     pub(crate) fn after(&self, c: usize) -> usize {
+        let v = self.tri(c / 3).get(c % 3).copied().unwrap_or(NIL);
         match self.next.get(c / 3).and_then(|n| n.get(c % 3)) {
-            Some(&n) if n != L::NIL => n.to_usize(),
+            Some(&t) if t != L::NIL => self.corner_of(t.to_usize(), v),
             _ => NIL,
         }
     }
@@ -242,7 +255,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     #[inline]
     fn set_after(&mut self, c: usize, n: usize) {
         if let Some(x) = self.next.get_mut(c / 3).and_then(|t| t.get_mut(c % 3)) {
-            *x = if n == NIL { L::NIL } else { L::narrow(n) };
+            *x = if n == NIL { L::NIL } else { L::narrow(n / 3) };
         }
     }
 
@@ -427,23 +440,24 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     // ---- changes ------------------------------------------------------------------------
 
-    /// Removes from `v`'s list every corner whose triangle is dead.
-    fn prune(&mut self, v: usize) {
+    /// Removes triangle `t` (still intact) from `v`'s list; a vertex left without triangles
+    /// loses its flags.
+    fn unlink(&mut self, v: usize, t: usize) {
         let mut prev = NIL;
         let mut c = self.first(v);
-        let mut guard = 3 * self.tris.len() + 1;
+        let mut guard = self.tris.len() + 1;
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            if is_dead(self.tri(c / 3)) {
+            if c / 3 == t {
                 if prev == NIL {
                     self.set_first(v, n);
                 } else {
                     self.set_after(prev, n);
                 }
-            } else {
-                prev = c;
+                break;
             }
+            prev = c;
             c = n;
         }
         if self.first(v) == NIL {
@@ -458,21 +472,21 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut removed = 0;
         let mut keep = NIL;
         let mut c = self.first(a);
-        let mut guard = 3 * self.tris.len() + 1;
+        let mut guard = self.tris.len() + 1;
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
             let t = c / 3;
             let tri = self.tri(t);
             if tri.contains(&b) {
-                // Dies: unlink it from the third vertex now, from b below.
-                self.kill(t);
-                removed += 1;
+                // Dies: out of b's and the third vertex's lists while it is intact, then gone.
                 for &x in &tri {
-                    if x != a && x != b {
-                        self.prune(x);
+                    if x != a {
+                        self.unlink(x, t);
                     }
                 }
+                self.kill(t);
+                removed += 1;
             } else {
                 self.set_corner(c, b);
                 self.set_after(c, keep);
@@ -482,7 +496,6 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
         self.set_first(a, NIL);
         self.set_flags(a, 0);
-        self.prune(b);
         // Splice a's surviving corners in front of b's list.
         let mut c = keep;
         let mut guard = 3 * self.tris.len() + 1;

@@ -9,8 +9,8 @@ use crate::{Config, Error, Report, Schedule};
 /// All working state of the simplifier, with capacity fixed by const generics.
 ///
 /// * `L`: link type (`u16` or `u32`) for vertex and corner numbers inside the workspace. With
-///   `u16` a mesh may have at most 65 535 vertices and 21 845 triangles (the largest value is
-///   reserved as "none", and each triangle has three corners).
+///   `u16` a mesh may have at most 65 535 vertices and 65 535 triangles (the largest value is
+///   reserved as "none").
 /// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
 ///
 /// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a
@@ -20,9 +20,9 @@ use crate::{Config, Error, Report, Schedule};
 ///
 /// The positions are never copied: they stay wherever the caller keeps them (flash included).
 pub struct Workspace<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> {
-    /// First corner of each vertex's corner list (NIL: none).
+    /// Triangle of the first corner of each vertex's corner list (NIL: none).
     pub(crate) head: [L; MAX_VERTICES],
-    /// For corner `3t + k`, the next corner around the same vertex.
+    /// For corner `3t + k`, the triangle of the next corner around the same vertex.
     pub(crate) next: [[L; 3]; MAX_TRIANGLES],
     /// Per-vertex flags, see `mesh::flag`.
     pub(crate) flags: [u8; MAX_VERTICES],
@@ -109,7 +109,8 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
                 },
             });
         }
-        let corner_cap = L::COUNT / 3;
+        // Links number triangles (not corners), so the link type caps triangles at its COUNT.
+        let corner_cap = L::COUNT;
         if triangles.len() > MAX_TRIANGLES || triangles.len() > corner_cap {
             return Err(Error::Capacity {
                 what: crate::Capacity::Triangles,

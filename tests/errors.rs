@@ -38,19 +38,18 @@ fn too_many_vertices_or_triangles_is_a_capacity_error() {
 
 #[test]
 fn u16_links_cap_the_triangle_count() {
-    // 21 846 triangles need corner numbers up to 65 537, past what u16 links leave below NIL
-    // (65 535); 21 845 still fit.
+    // u16 links number triangles below NIL (65 535): 65 536 triangles do not fit.
     let positions = vec![[0.0f32; 3]; 3];
-    let mut tris = vec![[0u32, 1, 2]; 21_846];
-    let mut ws = Box::new(Workspace::<u16, 4, 30_000>::new());
+    let mut tris = vec![[0u32, 1, 2]; 65_536];
+    let mut ws = Box::new(Workspace::<u16, 4, 70_000>::new());
     let e = ws.simplify(&positions, &mut tris, &Config::new());
     assert_eq!(tris[0], [0, 1, 2]);
     assert_eq!(
         e,
         Err(Error::Capacity {
             what: Capacity::Triangles,
-            needed: 21_846,
-            available: 21_845
+            needed: 65_536,
+            available: 65_535
         })
     );
 }
