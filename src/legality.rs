@@ -59,19 +59,14 @@ fn moved(tri: [usize; 3], a: usize, b: usize) -> Option<[usize; 3]> {
     Some(tri.map(|v| if v == a { b } else { v }))
 }
 
-/// `|n|² / (Σ edge²)²`: quality² / 12, where quality is `4√3·area / Σ edge²`.
-fn quality_ratio<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, tri: [usize; 3], n2: f32) -> f32 {
-    let [p0, p1, p2] = tri.map(|v| mesh.p(v));
-    let e = |u, w| {
-        let d = math::sub(u, w);
-        math::dot(d, d)
-    };
-    let s = e(p0, p1) + e(p1, p2) + e(p2, p0);
-    if s > 0.0 {
-        n2 / (s * s)
-    } else {
-        0.0
-    }
+/// Area normal (twice the area vector) and sum of squared edge lengths of a triangle.
+#[inline]
+fn shape(p: [[f32; 3]; 3]) -> ([f32; 3], f32) {
+    let e0 = math::sub(p[1], p[0]);
+    let e1 = math::sub(p[2], p[1]);
+    let e2 = math::sub(p[0], p[2]);
+    let n = math::cross(e0, math::sub(p[2], p[0]));
+    (n, math::dot(e0, e0) + math::dot(e1, e1) + math::dot(e2, e2))
 }
 
 /// Checks every rule for `a -> b` and returns its cost.
@@ -136,35 +131,47 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
         }
     }
 
-    // Each surviving triangle's shape and turn, and the cost.
+    // Each surviving triangle's shape and turn, and the cost. Positions are read once per
+    // triangle; the moved one differs from the old one in a's corner only.
     let pa = mesh.p(a);
     let pb = mesh.p(b);
     let shift = math::sub(pb, pa);
     let mut sum = 0.0f32;
-    for (t, _) in mesh.corners(a) {
+    for (t, k) in mesh.corners(a) {
         let old = mesh.tri(t);
-        let Some(new) = moved(old, a, b) else {
+        if old.contains(&b) {
             continue;
-        };
-        let n0 = mesh.normal_of(old);
-        let n1 = mesh.normal_of(new);
+        }
+        let q = old.map(|v| mesh.p(v));
+        let mut r = q;
+        if let Some(x) = r.get_mut(k) {
+            *x = pb;
+        }
+        let (n0, s0) = shape(q);
+        let (n1, s1) = shape(r);
         let l0 = math::dot(n0, n0);
         let l1 = math::dot(n1, n1);
         // Zero or NaN: no area left.
         if l1.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return Err(Reject::Sliver);
         }
-        let r1 = quality_ratio(mesh, new, l1);
-        if r1 < rules.min_ratio && r1 < quality_ratio(mesh, old, l0) {
+        // quality² / 12 = |n|² / (Σ edge²)²; compared without dividing.
+        if l1 < rules.min_ratio * s1 * s1 && l1 * s0 * s0 < l0 * s1 * s1 {
             return Err(Reject::Sliver);
         }
-        if math::dot(n0, n1) < rules.cos_turn * math::sqrt(l0 * l1) {
+        let (len0, len1) = (math::sqrt(l0), math::sqrt(l1));
+        if math::dot(n0, n1) < rules.cos_turn * (len0 * len1) {
             return Err(Reject::NormalTurn);
         }
+        let u0 = if len0 > 0.0 {
+            math::scale(n0, 1.0 / len0)
+        } else {
+            [0.0; 3]
+        };
         sum += cost.triangle(&TriangleChange {
-            old_normal: math::unit(n0),
-            new_normal: math::unit(n1),
-            old_area2: math::sqrt(l0),
+            old_normal: u0,
+            new_normal: math::scale(n1, 1.0 / len1),
+            old_area2: len0,
             moved: shift,
         });
     }
@@ -205,6 +212,31 @@ pub(crate) fn connectivity<L: Index, I: Index>(
     }
     let opp = &opp[..n_ab.min(2)];
 
+    // Link condition: a neighbour x of a that is not opposite a-b must not be a neighbour of
+    // b too. b's neighbours are marked first, so the check is O(valence), not O(valence²).
+    mesh.mark_fan(b, true);
+    let link = link_and_duplicates(mesh, a, b, opp);
+    mesh.mark_fan(b, false);
+    link?;
+
+    for (t, _) in mesh.corners(a) {
+        let Some(new) = moved(mesh.tri(t), a, b) else {
+            continue;
+        };
+        let u1 = math::unit(mesh.normal_of(new));
+        if folds(mesh, t, new, u1, a, b) {
+            return Err(Reject::Fold);
+        }
+    }
+    Ok(())
+}
+
+fn link_and_duplicates<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    a: usize,
+    b: usize,
+    opp: &[usize],
+) -> Result<(), Reject> {
     for (t, _) in mesh.corners(a) {
         let tri = mesh.tri(t);
         if tri.contains(&b) {
@@ -216,9 +248,7 @@ pub(crate) fn connectivity<L: Index, I: Index>(
                 continue;
             }
             both_opposite = false;
-            // Link condition: x is a neighbour of a but not opposite a-b, so it must not be a
-            // neighbour of b too.
-            if mesh.adjacent(b, x) {
+            if mesh.has(x, flag::MARK) {
                 return Err(Reject::Link);
             }
         }
@@ -232,16 +262,6 @@ pub(crate) fn connectivity<L: Index, I: Index>(
             {
                 return Err(Reject::Duplicate);
             }
-        }
-    }
-
-    for (t, _) in mesh.corners(a) {
-        let Some(new) = moved(mesh.tri(t), a, b) else {
-            continue;
-        };
-        let u1 = math::unit(mesh.normal_of(new));
-        if folds(mesh, t, new, u1, a, b) {
-            return Err(Reject::Fold);
         }
     }
     Ok(())

@@ -13,6 +13,8 @@
 //! Every access goes through `get`, so a broken invariant shows up as a refused collapse, never
 //! as a panic.
 
+use core::cell::Cell;
+
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::Error;
@@ -29,6 +31,8 @@ pub(crate) mod flag {
     pub const FEATURE: u8 = 8;
     /// Already paired in the current pass (Passes schedule).
     pub const DONE: u8 = 16;
+    /// Scratch mark for one legality check (neighbours of the kept vertex); always cleared.
+    pub const MARK: u8 = 32;
 }
 
 /// Marks the end of a corner list.
@@ -40,7 +44,9 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     pub(crate) tris: &'a mut [[I; 3]],
     head: &'a mut [L],
     next: &'a mut [[L; 3]],
-    pub(crate) flags: &'a mut [u8],
+    /// Flags behind `Cell`s, so that a legality check (which only reads the mesh) can mark
+    /// and unmark vertices: the safe `Cell::as_slice_of_cells` view of the workspace's bytes.
+    flags: &'a [Cell<u8>],
     /// Positions are read through this affine map into roughly `[-1, 1]³`, so that squared
     /// lengths and cross products can neither overflow nor underflow whatever the input's scale
     /// (coordinates near `f32::MAX` included). Every cost and test is scale-free or uses these
@@ -100,7 +106,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             tris,
             head,
             next,
-            flags,
+            flags: Cell::from_mut(flags).as_slice_of_cells(),
             centre,
             inv_half,
             live: 0,
@@ -261,7 +267,22 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     #[inline]
     pub(crate) fn flags(&self, v: usize) -> u8 {
-        self.flags.get(v).copied().unwrap_or(flag::LOCKED)
+        self.flags.get(v).map_or(flag::LOCKED, Cell::get)
+    }
+
+    /// Sets or clears [`flag::MARK`] on every vertex of `v`'s triangles (`v` included).
+    pub(crate) fn mark_fan(&self, v: usize, on: bool) {
+        for (t, _) in self.corners(v) {
+            for x in self.tri(t) {
+                if let Some(f) = self.flags.get(x) {
+                    f.set(if on {
+                        f.get() | flag::MARK
+                    } else {
+                        f.get() & !flag::MARK
+                    });
+                }
+            }
+        }
     }
 
     #[inline]
@@ -271,19 +292,15 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     #[inline]
     pub(crate) fn set_flags(&mut self, v: usize, f: u8) {
-        if let Some(x) = self.flags.get_mut(v) {
-            *x = f;
+        if let Some(x) = self.flags.get(v) {
+            x.set(f);
         }
     }
 
     #[inline]
     pub(crate) fn set_flag(&mut self, v: usize, f: u8, on: bool) {
-        if let Some(x) = self.flags.get_mut(v) {
-            if on {
-                *x |= f;
-            } else {
-                *x &= !f;
-            }
+        if let Some(x) = self.flags.get(v) {
+            x.set(if on { x.get() | f } else { x.get() & !f });
         }
     }
 
