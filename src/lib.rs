@@ -71,6 +71,11 @@ pub use index::Index;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
 pub use workspace::Workspace;
 
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 /// Which capacity an input exceeded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
