@@ -332,10 +332,30 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
     }
 
-    /// Greedy: recompute `v`'s key.
+    /// Greedy: recompute `v`'s key, a lower bound of its cheapest legal collapse: the
+    /// cheapest candidate that passes the cheap rules. The connectivity rules wait until the
+    /// vertex reaches the top of the queue (`pop` re-checks everything and re-queues it at its
+    /// true cost if the bound was not legal), so they run about once per collapse instead of
+    /// once per re-keyed vertex. The order of collapses is the same: a popped vertex whose
+    /// true cost equals its bound is cheaper than every other vertex's bound.
     fn rekey(&mut self, v: usize) {
-        match self.best(v) {
-            Some((c, _)) => self.heap.set(v, c),
+        let f = self.mesh.flags(v);
+        if f & flag::USED == 0 || f & (flag::LOCKED | flag::FEATURE) != 0 {
+            return self.heap.remove(v);
+        }
+        let mut key: Option<f32> = None;
+        let (mesh, rules, cost, rejected) =
+            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
+        mesh.for_each_neighbour(v, |to| match legality::price(mesh, rules, cost, v, to) {
+            Ok(c) => {
+                if key.is_none_or(|k| c < k) {
+                    key = Some(c);
+                }
+            }
+            Err(r) => rejected.count(r),
+        });
+        match key {
+            Some(c) => self.heap.set(v, c),
             None => self.heap.remove(v),
         }
     }
@@ -372,21 +392,22 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     }
 
     /// Greedy: collapse `a -> b`, then refresh feature flags (seed 004 eq. 5 with a running
-    /// mean) and queue keys around `b`.
+    /// mean) and queue keys where the surface changed.
+    ///
+    /// Only the fans of `a`'s neighbours change (`b` is one of them): they are marked before
+    /// the collapse, their old D taken out of the mean and their new D put back, and they are
+    /// re-keyed. All of `b`'s neighbours are re-classified against the new mean (it rises as
+    /// the mesh coarsens, and stale flags would pin vertices that are no longer features);
+    /// an unmarked one is re-keyed only if its flag changed.
     fn collapse_greedy(&mut self, a: usize, b: usize) {
         let mode = self.config.feature_mode;
         let features = self.config.features;
+        self.mesh.mark_fan(a, true);
         if features {
-            // D changes for a, b and every vertex of a's triangles; take the old values out.
             let mean = &mut self.mean;
             let mesh = &self.mesh;
             mean.sub(feature::variation(mesh, a, mode));
             mesh.for_each_neighbour(a, |x| mean.sub(feature::variation(mesh, x, mode)));
-            mesh.for_each_neighbour(b, |x| {
-                if x != a && !mesh.adjacent(a, x) {
-                    mean.sub(feature::variation(mesh, x, mode))
-                }
-            });
         }
         self.mesh.collapse(a, b);
         self.collapses += 1;
@@ -394,17 +415,32 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             let mean = &mut self.mean;
             let mesh = &self.mesh;
             mean.add(feature::variation(mesh, b, mode));
-            mesh.for_each_neighbour(b, |x| mean.add(feature::variation(mesh, x, mode)));
-            self.threshold = self.mean.threshold(self.config.lambda);
-            let is = self.classify(b);
-            self.mesh.set_flag(b, flag::FEATURE, is);
-            self.for_neighbours(b, |s, x| {
-                let is = s.classify(x);
-                s.mesh.set_flag(x, flag::FEATURE, is);
+            mesh.for_each_neighbour(b, |x| {
+                if mesh.has(x, flag::MARK) {
+                    mean.add(feature::variation(mesh, x, mode))
+                }
             });
+            self.threshold = self.mean.threshold(self.config.lambda);
         }
-        self.rekey(b);
-        self.for_neighbours(b, |s, x| s.rekey(x));
+        // b and the marked neighbours: new flag, new key, mark cleared. (a lost its flags in
+        // the collapse, and so did any vertex left without triangles.)
+        self.refresh(b);
+        self.for_neighbours(b, |s, x| s.refresh(x));
+    }
+
+    /// Greedy: re-classify `v`, and re-key it if its fan changed (marked) or its flag did;
+    /// clear its mark.
+    fn refresh(&mut self, v: usize) {
+        let mut changed = self.mesh.has(v, flag::MARK);
+        self.mesh.set_flag(v, flag::MARK, false);
+        if self.config.features {
+            let is = self.classify(v);
+            changed |= is != self.mesh.has(v, flag::FEATURE);
+            self.mesh.set_flag(v, flag::FEATURE, is);
+        }
+        if changed {
+            self.rekey(v);
+        }
     }
 
     /// Calls `f(self, x)` once for each neighbour `x` of `v`; `f` may change flags and keys,

@@ -335,11 +335,6 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Whether `u` and `w` share an edge.
-    pub(crate) fn adjacent(&self, u: usize, w: usize) -> bool {
-        self.corners(u).any(|(t, _)| self.tri(t).contains(&w))
-    }
-
     /// Calls `f` once for each distinct neighbour of `v`, in corner-list order.
     pub(crate) fn for_each_neighbour(&self, v: usize, mut f: impl FnMut(usize)) {
         let mut c = self.first(v);

@@ -41,14 +41,16 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
     /// triangle buffer, positions and a bounded stack frame.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
-    /// An empty workspace. `const`, so it can initialise a `static`.
+    /// An empty workspace. `const`, so it can initialise a `static`; and all zero bits, so
+    /// such a `static` goes to `.bss` (zeroed at boot) instead of taking its size again in
+    /// flash as `.data`. Nothing here is read before [`Workspace::start`] writes it.
     pub const fn new() -> Self {
         Workspace {
-            head: [L::NIL; MAX_VERTICES],
-            next: [[L::NIL; 3]; MAX_TRIANGLES],
+            head: [L::ZERO; MAX_VERTICES],
+            next: [[L::ZERO; 3]; MAX_TRIANGLES],
             flags: [0; MAX_VERTICES],
-            heap: [L::NIL; MAX_VERTICES],
-            heap_pos: [L::NIL; MAX_VERTICES],
+            heap: [L::ZERO; MAX_VERTICES],
+            heap_pos: [L::ZERO; MAX_VERTICES],
             key: [0.0; MAX_VERTICES],
         }
     }
