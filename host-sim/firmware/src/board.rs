@@ -1,0 +1,78 @@
+//! What each board holds. All buffers are statics in `.bss`; their sizes are chosen so that
+//! buffers + workspace + the measured stack fit the board's RAM (see README.md for the budget).
+//!
+//! The case file's positions and triangles are read straight into these buffers, in the file's
+//! index type: the triangle buffer is raw bytes viewed as `[[u16; 3]]` or `[[u32; 3]]`.
+
+#![allow(dead_code)]
+
+use meshfmt::{Board, IndexType};
+
+#[cfg(feature = "board-microbit")]
+mod sel {
+    pub const BOARD: super::Board = super::Board::Microbit;
+    pub const NAME: &str = "microbit";
+    /// 16 KB of RAM: positions 2 880 B, triangles 2 640 B, workspace 5 280 B; ~5.2 KB of
+    /// stack, of which the firmware needs ~3.5 KB at its deepest (measured).
+    pub const MAX_VERTICES: usize = 240;
+    pub const MAX_TRIANGLES: usize = 440;
+    pub type Link = u16;
+}
+
+#[cfg(feature = "board-lm3s6965evb")]
+mod sel {
+    pub const BOARD: super::Board = super::Board::Lm3s6965evb;
+    pub const NAME: &str = "lm3s6965evb";
+    /// 64 KB of RAM: positions 15 000 B, triangles 14 400 B, workspace ≈ 28 100 B.
+    pub const MAX_VERTICES: usize = 1_250;
+    pub const MAX_TRIANGLES: usize = 2_400;
+    pub type Link = u16;
+}
+
+#[cfg(any(
+    feature = "board-mps2-an386",
+    feature = "board-mps2-an500",
+    feature = "board-mps2-an505"
+))]
+mod sel {
+    #[cfg(feature = "board-mps2-an386")]
+    pub const BOARD: super::Board = super::Board::Mps2An386;
+    #[cfg(feature = "board-mps2-an386")]
+    pub const NAME: &str = "mps2-an386";
+    #[cfg(feature = "board-mps2-an500")]
+    pub const BOARD: super::Board = super::Board::Mps2An500;
+    #[cfg(feature = "board-mps2-an500")]
+    pub const NAME: &str = "mps2-an500";
+    #[cfg(feature = "board-mps2-an505")]
+    pub const BOARD: super::Board = super::Board::Mps2An505;
+    #[cfg(feature = "board-mps2-an505")]
+    pub const NAME: &str = "mps2-an505";
+    /// 4 MB of RAM, u32 links (a u16 workspace stops at 21 844 triangles): positions
+    /// 636 000 B, triangles 1 272 000 B, workspace 2 173 000 B; ~110 KB left for the stack.
+    pub const MAX_VERTICES: usize = 53_000;
+    pub const MAX_TRIANGLES: usize = 106_000;
+    pub type Link = u32;
+}
+
+pub use sel::*;
+
+/// Bytes of the triangle buffer: `MAX_TRIANGLES` triangles of the widest index type this board
+/// takes (`u16` boards read `u32` files too, with half as many triangles).
+pub const TRIANGLE_BYTES: usize = MAX_TRIANGLES * 3 * core::mem::size_of::<Link>();
+
+/// How many triangles of `it` fit the triangle buffer.
+pub const fn triangle_capacity(it: IndexType) -> usize {
+    let by_buffer = TRIANGLE_BYTES / it.triangle_bytes();
+    if by_buffer < MAX_TRIANGLES {
+        by_buffer
+    } else {
+        MAX_TRIANGLES
+    }
+}
+
+/// The triangle buffer: raw bytes, 4-aligned so they can be viewed as `u16` or `u32` triples.
+#[repr(C, align(4))]
+pub struct TriangleBytes(pub [u8; TRIANGLE_BYTES]);
+
+#[cfg(feature = "lib")]
+pub type Workspace = tinydecimate::Workspace<Link, MAX_VERTICES, MAX_TRIANGLES>;

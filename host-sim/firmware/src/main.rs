@@ -1,0 +1,403 @@
+//! tinydecimate on an emulated Cortex-M.
+//!
+//! The host (`host-sim qemu`) starts QEMU with three semihosting arguments,
+//! `<program> <case file> <result file>`: the firmware reads the case (mesh + configuration,
+//! format in host-sim/meshfmt) through semihosting file I/O into static buffers sized per board
+//! (src/board.rs), simplifies it, and writes the result file. One image per board serves every
+//! case. Without arguments it simplifies a built-in grid (self-test, e.g. under `cargo run`).
+//!
+//! Logs are defmt frames on semihosting stdout (defmt-semihosting), decoded by the host with
+//! the image's ELF. Nothing else writes to stdout. Exit status through SYS_EXIT_EXTENDED:
+//! 0 done (the result file says how the case went), 2 host file I/O failed, 101 panic,
+//! 102 HardFault or unexpected exception.
+
+#![no_std]
+#![no_main]
+
+mod board;
+mod hostio;
+mod measure;
+
+use core::sync::atomic::{AtomicBool, Ordering};
+
+use cortex_m::peripheral::SYST;
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use defmt_semihosting as _;
+use meshfmt::{CaseHeader, IndexType, ResultHeader, Status, CASE_HEADER_LEN};
+use static_cell::ConstStaticCell;
+
+use hostio::IoError;
+
+#[cfg(target_endian = "big")]
+compile_error!("the case file is read straight into memory: little-endian only");
+
+const EXIT_IO: i32 = 2;
+const EXIT_PANIC: i32 = 101;
+const EXIT_FAULT: i32 = 102;
+
+/// Positions of the current case (all zero: in .bss).
+static POSITIONS: ConstStaticCell<[[f32; 3]; board::MAX_VERTICES]> =
+    ConstStaticCell::new([[0.0; 3]; board::MAX_VERTICES]);
+/// The result header (a static rather than a local: ~300 bytes off the stack while the
+/// library runs).
+static RESULT: ConstStaticCell<ResultHeader> = ConstStaticCell::new(ResultHeader::empty(
+    IndexType::U16,
+    Status::Ok,
+    board::BOARD,
+));
+/// Triangles of the current case, in the file's index type.
+static TRIANGLES: ConstStaticCell<board::TriangleBytes> =
+    ConstStaticCell::new(board::TriangleBytes([0; board::TRIANGLE_BYTES]));
+
+#[entry]
+fn main() -> ! {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        semihosting::process::exit(EXIT_FAULT)
+    };
+    let args = hostio::args();
+    defmt::info!(
+        "{=str}: capacity {=usize} vertices, {=usize} u16 / {=usize} u32 triangles; stack {=usize} B",
+        board::NAME,
+        board::MAX_VERTICES,
+        board::triangle_capacity(IndexType::U16),
+        board::triangle_capacity(IndexType::U32),
+        measure::stack_size()
+    );
+    let positions = POSITIONS.take();
+    let triangles = &mut TRIANGLES.take().0;
+    let result = RESULT.take();
+    let code = match (args.get(1), args.get(2)) {
+        (Some("calibrate"), Some(out)) => match calibrate(&mut cp.SYST, out) {
+            Ok(()) => 0,
+            Err(e) => {
+                defmt::error!("host file I/O failed: {}", e);
+                EXIT_IO
+            }
+        },
+        (Some(case), Some(out)) => {
+            match run_case(&mut cp.SYST, case, out, positions, triangles, result) {
+                Ok(()) => 0,
+                Err(e) => {
+                    defmt::error!("host file I/O failed: {}", e);
+                    EXIT_IO
+                }
+            }
+        }
+        // Checks that a panic and a fault end QEMU with a failure status.
+        (Some("panic"), _) => defmt::panic!("panic requested"),
+        // A permanently undefined instruction: UsageFault escalated to HardFault (M3 and up),
+        // HardFault directly on the M0. (Loads from unmapped addresses do not fault on every
+        // QEMU machine.)
+        (Some("fault"), _) => cortex_m::asm::udf(),
+        _ => selftest(&mut cp.SYST, positions, triangles, result),
+    };
+    semihosting::process::exit(code)
+}
+
+/// Reads the case, simplifies, writes the result.
+///
+/// Reading and writing happen in their own (never inlined) functions, so their buffers (the
+/// header, the NUL-terminated paths, the encoded result header) are off the stack while the
+/// library runs: on the micro:bit every byte of stack is mesh capacity.
+fn run_case(
+    syst: &mut SYST,
+    case_path: &str,
+    out_path: &str,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [u8],
+    result: &mut ResultHeader,
+) -> Result<(), IoError> {
+    if let Some(h) = read_case(case_path, positions, triangles, result)? {
+        simplify(
+            syst,
+            &h,
+            &positions[..h.vertices as usize],
+            &mut triangles[..h.triangles_len()],
+            result,
+        );
+    }
+    result.capacity_vertices = board::MAX_VERTICES as u32;
+    result.capacity_triangles = board::triangle_capacity(result.index_type) as u32;
+    let out_bytes = result.triangles_len();
+    write_result(out_path, result, &triangles[..out_bytes])
+}
+
+/// Reads the case file into the buffers. `Ok(None)`: the case is rejected (not a case file,
+/// or too big for this board) and `result` says so.
+#[inline(never)]
+fn read_case(
+    case_path: &str,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [u8],
+    result: &mut ResultHeader,
+) -> Result<Option<CaseHeader>, IoError> {
+    let mut file = hostio::open(case_path)?;
+    let mut head = [0u8; CASE_HEADER_LEN];
+    hostio::read_exact(&mut file, &mut head)?;
+    let h = match CaseHeader::from_bytes(&head) {
+        Ok(h) => h,
+        Err(e) => {
+            defmt::error!(
+                "{=str}: not a case file ({})",
+                case_path,
+                defmt::Debug2Format(&e)
+            );
+            *result = ResultHeader::empty(IndexType::U16, Status::BadCase, board::BOARD);
+            return Ok(None);
+        }
+    };
+    let nv = h.vertices as usize;
+    let nt = h.triangles as usize;
+    defmt::info!(
+        "case {=str}: {=usize} vertices, {=usize} triangles (u{=usize})",
+        case_path,
+        nv,
+        nt,
+        h.index_type.bytes() * 8
+    );
+    if nv > board::MAX_VERTICES || nt > board::triangle_capacity(h.index_type) {
+        defmt::warn!("the mesh does not fit this board");
+        *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
+        result.error_a = h.vertices;
+        result.error_b = h.triangles;
+        return Ok(None);
+    }
+    hostio::read_exact(&mut file, bytemuck::cast_slice_mut(&mut positions[..nv]))?;
+    hostio::read_exact(&mut file, &mut triangles[..h.triangles_len()])?;
+    Ok(Some(h))
+}
+
+/// Writes the result file: header, then the triangles (already in the file's byte order).
+#[inline(never)]
+fn write_result(out_path: &str, result: &ResultHeader, triangles: &[u8]) -> Result<(), IoError> {
+    let mut out = hostio::create(out_path)?;
+    hostio::write_all(&mut out, &result.to_bytes())?;
+    hostio::write_all(&mut out, triangles)?;
+    defmt::info!("wrote {=str}", out_path);
+    Ok(())
+}
+
+/// Instructions in [`calibrate`]'s loop: `cortex_m::asm::delay(n)` runs `subs; bne` n + 1 times.
+const CALIBRATION_LOOPS: u32 = 5_000_000;
+
+/// Times a loop of 2 × (CALIBRATION_LOOPS + 1) instructions, so the host can check how many
+/// instructions one timer tick is on this board. Writes a result file with only the ticks.
+fn calibrate(syst: &mut SYST, out_path: &str) -> Result<(), IoError> {
+    measure::start(syst);
+    cortex_m::asm::delay(CALIBRATION_LOOPS);
+    let ticks = measure::stop(syst);
+    defmt::info!(
+        "calibration: {=u32} instructions in {=u64} ticks",
+        2 * (CALIBRATION_LOOPS + 1),
+        ticks
+    );
+    let mut r = ResultHeader::empty(IndexType::U16, Status::Ok, board::BOARD);
+    r.ticks = ticks;
+    r.error_a = 2 * (CALIBRATION_LOOPS + 1);
+    let mut out = hostio::create(out_path)?;
+    hostio::write_all(&mut out, &r.to_bytes())
+}
+
+/// Simplifies the mesh in the buffers, measuring instructions and stack.
+#[cfg(feature = "lib")]
+fn simplify(
+    syst: &mut SYST,
+    h: &CaseHeader,
+    pos: &[[f32; 3]],
+    tri: &mut [u8],
+    r: &mut ResultHeader,
+) {
+    // `Workspace::new` is const, so the workspace is initialised at compile time. (Building it
+    // at run time, `StaticCell::uninit().write(Workspace::new())`, assembles it on the stack
+    // first: a 1.6 MB frame on the 4 MB boards.)
+    static WORKSPACE: ConstStaticCell<board::Workspace> =
+        ConstStaticCell::new(board::Workspace::new());
+    let ws = WORKSPACE.take();
+    let config = meshfmt::lib::config(h);
+
+    let sp = measure::paint();
+    measure::start(syst);
+    let outcome = match h.index_type {
+        IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(tri) {
+            Ok(t) => run_library(ws, pos, t, &config),
+            Err(_) => {
+                *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
+                return;
+            }
+        },
+        IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(tri) {
+            Ok(t) => run_library(ws, pos, t, &config),
+            Err(_) => {
+                *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
+                return;
+            }
+        },
+    };
+    let ticks = measure::stop(syst);
+    let low = measure::lowest_touched();
+
+    *r = meshfmt::lib::result_header(h.index_type, &outcome, board::BOARD);
+    r.ticks = ticks;
+    r.stack_bytes = sp.saturating_sub(low) as u32;
+    r.stack_high_water = measure::depth(low) as u32;
+    r.workspace_bytes = board::Workspace::BYTES as u32;
+    match &outcome {
+        Ok(report) => defmt::info!("{}", report),
+        Err(e) => defmt::warn!("simplify failed: {}", e),
+    }
+    defmt::info!(
+        "{=u64} SysTick ticks; stack {=u32} B in simplify, high-water {=u32} of {=usize} B; workspace {=u32} B",
+        ticks,
+        r.stack_bytes,
+        r.stack_high_water,
+        measure::stack_size(),
+        r.workspace_bytes
+    );
+    if measure::overflowed(low) {
+        // The stack ran down into .bss: the buffers may be corrupt, so is the result.
+        defmt::panic!("stack overflow: no painted word left below the library's frames");
+    }
+}
+
+/// The library call, never inlined: its whole frame then lies below the stack pointer at which
+/// [`measure::paint`] stopped, so the painted stack measures all of it.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_library<I: tinydecimate::Index>(
+    ws: &mut board::Workspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    ws.simplify(positions, triangles, config)
+}
+
+/// Without the library: the output is the input (boot + semihosting + defmt smoke test).
+#[cfg(not(feature = "lib"))]
+fn simplify(
+    syst: &mut SYST,
+    h: &CaseHeader,
+    _pos: &[[f32; 3]],
+    _tri: &mut [u8],
+    r: &mut ResultHeader,
+) {
+    let sp = measure::paint();
+    measure::start(syst);
+    let ticks = measure::stop(syst);
+    let low = measure::lowest_touched();
+    *r = ResultHeader::empty(h.index_type, Status::Ok, board::BOARD);
+    r.triangles_in = h.triangles;
+    r.triangles_out = h.triangles;
+    r.target_triangles = h.triangles;
+    r.ticks = ticks;
+    r.stack_bytes = sp.saturating_sub(low) as u32;
+    r.stack_high_water = measure::depth(low) as u32;
+    defmt::info!("no library linked: echoing {=u32} triangles", h.triangles);
+}
+
+/// No case given: simplify a bumpy grid of (n × n) quads that fits the board.
+fn selftest(
+    syst: &mut SYST,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [u8],
+    r: &mut ResultHeader,
+) -> i32 {
+    let mut n = 2usize;
+    while (n + 2) * (n + 2) <= board::MAX_VERTICES
+        && 2 * (n + 1) * (n + 1) <= board::triangle_capacity(IndexType::U16)
+        && n < 24
+    {
+        n += 1;
+    }
+    let nv = (n + 1) * (n + 1);
+    for (i, p) in positions[..nv].iter_mut().enumerate() {
+        let (x, y) = (i % (n + 1), i / (n + 1));
+        *p = [x as f32, y as f32, ((x * 7 + y * 3) % 5) as f32 * 0.1];
+    }
+    let mut nt = 0;
+    for y in 0..n {
+        for x in 0..n {
+            let v = (y * (n + 1) + x) as u16;
+            let w = (n + 1) as u16;
+            for t in [[v, v + 1, v + w + 1], [v, v + w + 1, v + w]] {
+                for (k, i) in t.iter().enumerate() {
+                    let at = (nt * 3 + k) * 2;
+                    triangles[at..at + 2].copy_from_slice(&i.to_le_bytes());
+                }
+                nt += 1;
+            }
+        }
+    }
+    defmt::info!(
+        "self-test: {=usize}x{=usize} grid, {=usize} triangles",
+        n,
+        n,
+        nt
+    );
+    // Greedy, 25 %, λ = 1, the library's defaults otherwise.
+    let h = CaseHeader {
+        index_type: IndexType::U16,
+        schedule: meshfmt::ScheduleCode::Greedy,
+        vertices: nv as u32,
+        triangles: nt as u32,
+        target_ratio: 0.25,
+        target_triangles: 0,
+        lambda: 1.0,
+        feature_mode: meshfmt::FeatureCode::Paper,
+        feature_targets: false,
+        max_passes: 32,
+        max_cost: f32::INFINITY,
+        max_normal_turn_deg: 60.0,
+        min_quality: 0.05,
+        boundary_weight: 1.0,
+    };
+    simplify(syst, &h, &positions[..nv], &mut triangles[..nt * 6], r);
+    if r.status == Status::Ok && r.triangles_out > 0 && r.triangles_out <= r.triangles_in {
+        defmt::info!(
+            "self-test passed: {=u32} -> {=u32} triangles",
+            r.triangles_in,
+            r.triangles_out
+        );
+        0
+    } else {
+        defmt::error!("self-test failed");
+        1
+    }
+}
+
+static PANICKED: AtomicBool = AtomicBool::new(false);
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    // Log once: a panic inside the logger must not recurse.
+    if !PANICKED.load(Ordering::Relaxed) {
+        PANICKED.store(true, Ordering::Relaxed);
+        defmt::error!("panic: {}", defmt::Display2Format(info));
+    }
+    semihosting::process::exit(EXIT_PANIC)
+}
+
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    semihosting::process::exit(EXIT_PANIC)
+}
+
+#[exception]
+unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
+    if !PANICKED.load(Ordering::Relaxed) {
+        PANICKED.store(true, Ordering::Relaxed);
+        defmt::error!(
+            "HardFault: pc={=u32:#010x} lr={=u32:#010x} xpsr={=u32:#010x}",
+            ef.pc(),
+            ef.lr(),
+            ef.xpsr()
+        );
+    }
+    semihosting::process::exit(EXIT_FAULT)
+}
+
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    defmt::error!("unexpected exception {=i16}", irqn);
+    semihosting::process::exit(EXIT_FAULT)
+}

@@ -1,0 +1,48 @@
+//! `host-sim`: command-line front end of the harness. Each subcommand's arguments and code live
+//! in its module (`Args` + `run`); this file only dispatches. Exit codes: 0 success, 1 the
+//! result is not a valid simplification (`check`, `simplify`), 2 error (bad file, bad input).
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use host_sim::{bench, check, metro, qemu, render, simplify};
+
+#[derive(Parser)]
+#[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simplify a mesh file with tinydecimate, then check and measure the result.
+    Simplify(simplify::Args),
+    /// Metro surface distance between an original and a simplified mesh.
+    Metro(metro::Args),
+    /// Topology of both meshes and whether the second is a valid simplification of the first.
+    Check(check::Args),
+    /// Flat-shaded PNG of a mesh, or a side-by-side comparison with an error heatmap.
+    Render(render::Args),
+    /// tinydecimate (both schedules) against meshoptimizer: time, memory, error, validity.
+    Bench(bench::Args),
+    /// The library on QEMU-emulated Cortex-M0/M3/M4F/M7/M33 boards, compared with the host;
+    /// --measure for instructions, stack, image sizes and the largest mesh per board.
+    Qemu(qemu::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Simplify(a) => simplify::run(a),
+        Command::Metro(a) => metro::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Qemu(a) => qemu::run(a),
+    };
+    result.unwrap_or_else(|e| {
+        eprintln!("error: {e:#}");
+        ExitCode::from(2)
+    })
+}

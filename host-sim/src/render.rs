@@ -1,0 +1,405 @@
+//! Flat-shaded pictures of meshes, for eyeballing simplifications.
+//!
+//! **Viewpoint** (fixed, so pictures of different runs compare): orthographic camera looking at
+//! the centre of the mesh's bounding box (referenced vertices) along the direction
+//! `-(1.0, 0.7, 1.5)` (normalised), i.e. from the +X, +Y, +Z octant, with +Y up on screen. The
+//! image is [`SIZE`]×[`SIZE`] pixels; the projection of the 8 bounding-box corners fills 92 % of
+//! it, so the mesh never touches the border. In `--compare` mode all three panels use the view
+//! of the ORIGINAL mesh, so they line up pixel for pixel.
+//!
+//! **Shading**: a z-buffer rasteriser of our own writes into an `image::RgbImage` (encoded to PNG
+//! by the `image` crate). Each triangle is flat shaded with `ambient + diffuse·|n·l|` for a light
+//! coming from over the viewer's right shoulder. Both sides are drawn: front faces (counter-
+//! clockwise on screen) in grey-blue, back faces in orange, so flipped triangles and holes show.
+//! Background is white.
+//!
+//! **Heatmap** (third `--compare` panel): every visible point of the simplified surface (one per
+//! pixel) is coloured by its exact distance to the original surface, mapped linearly from 0
+//! (blue) through cyan, green and yellow to the largest distance in the picture (red), see
+//! [`heat_colour`]; a colour bar along the bottom of the panel shows the scale, whose top value
+//! the command prints. (Colouring by per-vertex error would show nothing: tinydecimate keeps
+//! original vertices, so every output vertex lies on the original surface.)
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use image::{ImageFormat, Rgb, RgbImage};
+
+use crate::io::MeshData;
+
+/// Width and height of one picture, in pixels.
+pub const SIZE: u32 = 512;
+/// Direction from the scene towards the camera (before normalisation).
+pub const EYE_DIRECTION: [f64; 3] = [1.0, 0.7, 1.5];
+/// Background colour.
+pub const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);
+const FRONT: [f64; 3] = [190.0, 200.0, 220.0];
+const BACK: [f64; 3] = [235.0, 150.0, 90.0];
+const FILL: f64 = 0.92;
+
+type V3 = [f64; 3];
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn normalize(a: V3) -> V3 {
+    let l = dot(a, a).sqrt();
+    if l > 0.0 {
+        a.map(|c| c / l)
+    } else {
+        a
+    }
+}
+
+/// An orthographic camera.
+#[derive(Clone, Copy, Debug)]
+pub struct View {
+    centre: V3,
+    right: V3,
+    up: V3,
+    /// Viewing direction (from the camera into the scene).
+    forward: V3,
+    /// Pixels per model unit.
+    scale: f64,
+    light: V3,
+}
+
+impl View {
+    /// The fixed view of `mesh`: see the module documentation.
+    pub fn fit(mesh: &MeshData) -> View {
+        let (lo, hi) = mesh.bbox().unwrap_or(([-1.0; 3], [1.0; 3]));
+        let centre = [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0);
+        let forward = normalize(EYE_DIRECTION.map(|c| -c));
+        let right = normalize(cross(forward, [0.0, 1.0, 0.0]));
+        let up = cross(right, forward);
+        let mut extent: f64 = 0.0;
+        for corner in 0..8 {
+            let p = [0, 1, 2].map(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+            let d = [0, 1, 2].map(|k| p[k] - centre[k]);
+            extent = extent.max(dot(d, right).abs()).max(dot(d, up).abs());
+        }
+        let scale = if extent > 0.0 {
+            f64::from(SIZE) / 2.0 * FILL / extent
+        } else {
+            1.0
+        };
+        // Light from over the viewer's right shoulder.
+        let light = normalize([0, 1, 2].map(|k| -forward[k] + 0.4 * right[k] + 0.6 * up[k]));
+        View {
+            centre,
+            right,
+            up,
+            forward,
+            scale,
+            light,
+        }
+    }
+
+    /// Pixel coordinates (x right, y down) and depth (larger is farther) of a point.
+    fn project(&self, p: V3) -> V3 {
+        let d = [0, 1, 2].map(|k| p[k] - self.centre[k]);
+        let half = f64::from(SIZE) / 2.0;
+        [
+            half + dot(d, self.right) * self.scale,
+            half - dot(d, self.up) * self.scale,
+            dot(d, self.forward),
+        ]
+    }
+}
+
+/// Heatmap colour of `t` in `[0, 1]` (clamped): blue, cyan, green, yellow, red at 0, ¼, ½, ¾, 1.
+pub fn heat_colour(t: f64) -> [f64; 3] {
+    const STOPS: [[f64; 3]; 5] = [
+        [0.0, 0.0, 255.0],
+        [0.0, 255.0, 255.0],
+        [0.0, 255.0, 0.0],
+        [255.0, 255.0, 0.0],
+        [255.0, 0.0, 0.0],
+    ];
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        1.0
+    } * 4.0;
+    let i = (t.floor() as usize).min(3);
+    let f = t - i as f64;
+    [0, 1, 2].map(|k| STOPS[i][k] + (STOPS[i + 1][k] - STOPS[i][k]) * f)
+}
+
+/// What the z-buffer keeps for a covered pixel.
+#[derive(Clone, Copy, Debug)]
+struct Hit {
+    /// The surface point seen (model space).
+    point: V3,
+    /// `|n·l|` of its triangle.
+    lambert: f64,
+    /// Whether its triangle faces the camera.
+    front: bool,
+}
+
+/// Z-buffer rasterisation of `mesh`: the nearest surface point per pixel (row-major), sampled
+/// at pixel centres.
+fn rasterise(mesh: &MeshData, view: &View) -> Vec<Option<Hit>> {
+    let (w, h) = (SIZE as usize, SIZE as usize);
+    let mut depth = vec![f64::INFINITY; w * h];
+    let mut hits: Vec<Option<Hit>> = vec![None; w * h];
+    let n = mesh.positions.len();
+    for t in &mesh.triangles {
+        if t.iter().any(|&i| i as usize >= n) {
+            continue;
+        }
+        let p = t.map(|i| mesh.positions[i as usize].map(f64::from));
+        let normal = normalize(cross(
+            [0, 1, 2].map(|k| p[1][k] - p[0][k]),
+            [0, 1, 2].map(|k| p[2][k] - p[0][k]),
+        ));
+        let front = dot(normal, view.forward) < 0.0;
+        let lambert = dot(normal, view.light).abs();
+        let s = p.map(|q| view.project(q));
+        let area =
+            (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
+        if area == 0.0 || !area.is_finite() {
+            continue;
+        }
+        let min = |k: usize| s.iter().map(|v| v[k]).fold(f64::INFINITY, f64::min);
+        let max = |k: usize| s.iter().map(|v| v[k]).fold(f64::NEG_INFINITY, f64::max);
+        let (x0, x1) = (min(0).floor().max(0.0), max(0).ceil().min(w as f64 - 1.0));
+        let (y0, y1) = (min(1).floor().max(0.0), max(1).ceil().min(h as f64 - 1.0));
+        if x1 < x0 || y1 < y0 {
+            continue;
+        }
+        for y in y0 as usize..=y1 as usize {
+            for x in x0 as usize..=x1 as usize {
+                let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+                let e = |a: V3, b: V3| (b[0] - a[0]) * (py - a[1]) - (px - a[0]) * (b[1] - a[1]);
+                let w0 = e(s[1], s[2]) / area;
+                let w1 = e(s[2], s[0]) / area;
+                let w2 = 1.0 - w0 - w1;
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let z = w0 * s[0][2] + w1 * s[1][2] + w2 * s[2][2];
+                let slot = &mut depth[y * w + x];
+                if z >= *slot {
+                    continue;
+                }
+                *slot = z;
+                let point = [0, 1, 2].map(|k| w0 * p[0][k] + w1 * p[1][k] + w2 * p[2][k]);
+                hits[y * w + x] = Some(Hit {
+                    point,
+                    lambert,
+                    front,
+                });
+            }
+        }
+    }
+    hits
+}
+
+fn shaded(base: [f64; 3], shade: f64) -> Rgb<u8> {
+    Rgb(base.map(|c| (c * shade).round().clamp(0.0, 255.0) as u8))
+}
+
+fn image_of(hits: &[Option<Hit>], colour: impl Fn(usize, &Hit) -> Rgb<u8>) -> RgbImage {
+    let mut img = RgbImage::from_pixel(SIZE, SIZE, BACKGROUND);
+    for (i, hit) in hits.iter().enumerate() {
+        if let Some(h) = hit {
+            img.put_pixel(i as u32 % SIZE, i as u32 / SIZE, colour(i, h));
+        }
+    }
+    img
+}
+
+/// Draws `mesh` from `view`, flat shaded, into a new [`SIZE`]² image.
+pub fn render(mesh: &MeshData, view: &View) -> RgbImage {
+    image_of(&rasterise(mesh, view), |_, h| {
+        shaded(if h.front { FRONT } else { BACK }, 0.25 + 0.75 * h.lambert)
+    })
+}
+
+/// Draws `mesh` from `view` coloured by the distance of each visible surface point (one per
+/// pixel) to the surface of `reference`, scaled so that red is the largest distance seen.
+/// Returns the image and that largest distance.
+pub fn render_heat(mesh: &MeshData, view: &View, reference: &MeshData) -> (RgbImage, f64) {
+    use rayon::prelude::*;
+    let hits = rasterise(mesh, view);
+    let bvh = crate::metro::Bvh::new(reference);
+    let dist: Vec<f64> = hits
+        .par_iter()
+        .map(|h| h.map_or(0.0, |h| bvh.closest(h.point, usize::MAX).0.sqrt()))
+        .collect();
+    let top = dist
+        .iter()
+        .copied()
+        .filter(|d| d.is_finite())
+        .fold(0.0, f64::max);
+    let img = image_of(&hits, |i, h| {
+        let t = if top > 0.0 { dist[i] / top } else { 0.0 };
+        shaded(heat_colour(t), 0.45 + 0.55 * h.lambert)
+    });
+    (img, top)
+}
+
+/// The three `--compare` panels side by side: original | simplified | simplified coloured by
+/// its distance to the original (per pixel, see [`render_heat`]), all from the original's view.
+/// Returns the image and the distance that red stands for.
+pub fn render_compare(original: &MeshData, simplified: &MeshData) -> (RgbImage, f64) {
+    let view = View::fit(original);
+    let (heat, top) = render_heat(simplified, &view, original);
+    let panels = [render(original, &view), render(simplified, &view), heat];
+    let mut out = RgbImage::from_pixel(3 * SIZE, SIZE, BACKGROUND);
+    for (k, panel) in panels.iter().enumerate() {
+        image::imageops::replace(&mut out, panel, i64::from(k as u32 * SIZE), 0);
+    }
+    // Colour bar under the heatmap, and thin separators between panels.
+    let (bx0, bx1, by0, by1) = (2 * SIZE + 16, 3 * SIZE - 16, SIZE - 14, SIZE - 6);
+    for x in bx0..bx1 {
+        let c = heat_colour(f64::from(x - bx0) / f64::from(bx1 - 1 - bx0));
+        for y in by0..by1 {
+            out.put_pixel(x, y, Rgb(c.map(|v| v as u8)));
+        }
+    }
+    for x in [SIZE, 2 * SIZE] {
+        for y in 0..SIZE {
+            out.put_pixel(x, y, Rgb([160, 160, 160]));
+        }
+    }
+    (out, top)
+}
+
+/// `host-sim render MESH OUT.png [--compare ORIGINAL]`
+#[derive(Clone, Debug, clap::Args)]
+pub struct Args {
+    /// The mesh to draw.
+    pub mesh: std::path::PathBuf,
+    /// Output PNG.
+    pub out: std::path::PathBuf,
+    /// Draw original | MESH | MESH coloured by its distance to ORIGINAL, side by side.
+    #[arg(long, value_name = "ORIGINAL")]
+    pub compare: Option<std::path::PathBuf>,
+}
+
+/// `host-sim render`.
+pub fn run(args: &Args) -> Result<std::process::ExitCode> {
+    draw(&args.mesh, &args.out, args.compare.as_deref())?;
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// Draws `mesh` (or the comparison with `compare`) into the PNG file `out`.
+pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
+    let m = crate::io::load(mesh)?;
+    let img = match compare {
+        None => render(&m, &View::fit(&m)),
+        Some(orig) => {
+            let o = crate::io::load(orig)?;
+            let (img, top) = render_compare(&o, &m);
+            let diag = o.bbox_diagonal();
+            let pct = if diag > 0.0 { 100.0 * top / diag } else { 0.0 };
+            println!(
+                "panels: original | simplified | error heatmap (blue = 0, red = {top:.6e} = {pct:.4} % of the original's bbox diagonal)"
+            );
+            img
+        }
+    };
+    img.save_with_format(out, ImageFormat::Png)
+        .with_context(|| format!("{}: cannot write PNG", out.display()))?;
+    println!("wrote {} ({}x{})", out.display(), img.width(), img.height());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> MeshData {
+        let mut positions = Vec::new();
+        for i in 0..8 {
+            positions.push([(i & 1) as f32, (i >> 1 & 1) as f32, (i >> 2 & 1) as f32]);
+        }
+        // Outward-facing (counter-clockwise seen from outside).
+        let triangles = vec![
+            [0, 2, 3],
+            [0, 3, 1], // z = 0
+            [4, 5, 7],
+            [4, 7, 6], // z = 1
+            [0, 1, 5],
+            [0, 5, 4], // y = 0
+            [2, 6, 7],
+            [2, 7, 3], // y = 1
+            [0, 4, 6],
+            [0, 6, 2], // x = 0
+            [1, 3, 7],
+            [1, 7, 5], // x = 1
+        ];
+        MeshData {
+            positions,
+            triangles,
+        }
+    }
+
+    fn colours(img: &RgbImage) -> std::collections::HashSet<[u8; 3]> {
+        img.pixels()
+            .filter(|p| **p != BACKGROUND)
+            .map(|p| p.0)
+            .collect()
+    }
+
+    #[test]
+    fn cube_png_has_expected_size_and_three_front_faces() {
+        let dir = tempfile::tempdir().unwrap();
+        let obj = dir.path().join("cube.obj");
+        let png = dir.path().join("cube.png");
+        crate::io::save(&obj, &cube()).unwrap();
+        draw(&obj, &png, None).unwrap();
+        let img = image::open(&png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (SIZE, SIZE));
+        let drawn = img.pixels().filter(|p| **p != BACKGROUND).count();
+        assert!(drawn > (SIZE * SIZE / 5) as usize, "{drawn}");
+        // Three visible faces, three shades, all front-facing (no orange).
+        let c = colours(&img);
+        assert_eq!(c.len(), 3, "{c:?}");
+        assert!(c.iter().all(|p| p[2] > p[0]));
+        // Corners stay background (the fit leaves a margin).
+        assert_eq!(*img.get_pixel(0, 0), BACKGROUND);
+        assert_eq!(*img.get_pixel(SIZE - 1, SIZE - 1), BACKGROUND);
+    }
+
+    #[test]
+    fn inside_out_cube_is_orange_and_compare_has_three_panels() {
+        let mut flipped = cube();
+        for t in &mut flipped.triangles {
+            t.swap(1, 2);
+        }
+        let img = render(&flipped, &View::fit(&flipped));
+        assert!(colours(&img).iter().all(|p| p[0] > p[2]));
+
+        let mut bumped = cube();
+        bumped.positions[7] = [1.2, 1.2, 1.2];
+        let (img, top) = render_compare(&cube(), &bumped);
+        assert_eq!(img.dimensions(), (3 * SIZE, SIZE));
+        assert!(top > 0.1 && top <= 0.2 * 3f64.sqrt() + 1e-9, "{top}");
+        // The heatmap panel has red near the bumped corner and blue elsewhere.
+        let heat: Vec<[u8; 3]> = (2 * SIZE + 1..3 * SIZE)
+            .flat_map(|x| (0..SIZE - 20).map(move |y| (x, y)))
+            .map(|(x, y)| img.get_pixel(x, y).0)
+            .collect();
+        assert!(heat.iter().any(|p| p[0] > 150 && p[1] < 80 && p[2] < 80));
+        assert!(heat.iter().any(|p| p[2] > 150 && p[0] < 80));
+    }
+
+    #[test]
+    fn heat_colour_stops() {
+        assert_eq!(heat_colour(0.0), [0.0, 0.0, 255.0]);
+        assert_eq!(heat_colour(0.5), [0.0, 255.0, 0.0]);
+        assert_eq!(heat_colour(1.0), [255.0, 0.0, 0.0]);
+        assert_eq!(heat_colour(7.0), [255.0, 0.0, 0.0]);
+        assert_eq!(heat_colour(f64::NAN), [255.0, 0.0, 0.0]);
+    }
+}
