@@ -273,3 +273,37 @@ fn max_cost_and_max_passes_stop_the_run() {
     assert_eq!(r.pass_triangles.len(), 2);
     assert_eq!(r.pass_triangles[1] as usize, r.triangles_out);
 }
+
+#[test]
+fn pinched_vertex_is_locked_and_kept() {
+    // Two closed cones (tips up and down) sharing only their apex: two fans touch at one
+    // vertex, like the cow's vertex 254.
+    let mut m = MeshData::default();
+    m.positions.push([0.0, 0.0, 0.0]); // shared apex
+    for (z, flip) in [(1.0f32, false), (-1.0, true)] {
+        let base = m.positions.len() as u32;
+        for i in 0..12 {
+            let t = i as f32 / 12.0 * std::f32::consts::TAU;
+            m.positions.push([t.cos(), t.sin(), z]);
+        }
+        let centre = m.positions.len() as u32;
+        m.positions.push([0.0, 0.0, z * 1.2]);
+        for i in 0..12 {
+            let (a, b) = (base + i, base + (i + 1) % 12);
+            let (side, cap) = ([0, a, b], [centre, b, a]);
+            let flipped = |t: [u32; 3]| if flip { [t[0], t[2], t[1]] } else { t };
+            m.triangles.push(flipped(side));
+            m.triangles.push(flipped(cap));
+        }
+    }
+    let before = analyse(&m);
+    assert_eq!(before.non_manifold_edges, 0);
+    let (out, report) = simplify(&m, &Config::new().with_ratio(0.2));
+    assert!(report.locked_vertices >= 1, "{report:?}");
+    assert_valid("pinch", &m, &out, &report);
+    assert!(
+        out.triangles.iter().any(|t| t.contains(&0)),
+        "the apex stays"
+    );
+    assert!(out.triangles.len() < m.triangles.len());
+}

@@ -1,0 +1,87 @@
+//! Deterministic termination, measured: the number of operations `step` performs is bounded by
+//! the mesh size.
+//!
+//! Proof sketch (also in `src/collapse.rs`). Every collapse removes a vertex, so there are at
+//! most V collapses. Sweeps (feature mean, flags, keys, pairing) visit each vertex once per
+//! pass or round, and a pass or round without a collapse ends the run, so there are at most
+//! min(max_passes, collapses + 1) of them. A queue pop either collapses, drops the vertex, or
+//! re-queues it at its exact current cost, which the next pop of that vertex accepts unless a
+//! collapse intervened; so between two collapses each queued vertex is popped at most twice.
+
+mod common;
+use common::*;
+use tinydecimate::{Config, Schedule, Workspace};
+
+fn operations(m: &MeshData, config: &Config) -> (u64, usize, u32) {
+    let mut tris = m.triangles.clone();
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut s = ws.start(&m.positions, &mut tris, config).unwrap();
+    let mut ops = 0u64;
+    while !s.step(1) {
+        ops += 1;
+    }
+    let r = s.finish();
+    (ops, r.collapses, r.passes)
+}
+
+#[test]
+fn operations_are_bounded_by_the_mesh_size() {
+    for (name, m) in [
+        ("cow", load_obj("cow.obj")),
+        ("camelhead", load_obj("camelhead.obj")),
+        ("sphere", icosphere(4)),
+        ("grid", grid(40, 30, 0.2)),
+    ] {
+        let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
+        for config in [
+            Config::new().with_ratio(0.0),
+            Config::paper().with_ratio(0.0),
+        ] {
+            let (ops, collapses, passes) = operations(&m, &config);
+            // Sweeps: 3 per pass/round over V vertices; queue: pops per collapse.
+            let sweeps = 3 * v * passes as u64;
+            let per_collapse = (ops - sweeps.min(ops)) as f64 / collapses.max(1) as f64;
+            eprintln!(
+                "{name} {:?}: V {v} T {t}: {ops} operations, {collapses} collapses, {passes} passes; {per_collapse:.2} non-sweep operations per collapse",
+                config.schedule
+            );
+            assert!(
+                (collapses as u64) < v,
+                "{name}: a collapse removes a vertex"
+            );
+            assert!(passes <= config.max_passes);
+            // The proof's bound is far looser (O(V) pops between collapses); in practice the
+            // queue needs a few pops per collapse. 8 leaves room and still fails a regression
+            // that loses track of its keys.
+            match config.schedule {
+                Schedule::Greedy => assert!(
+                    ops <= sweeps + 8 * (collapses as u64 + 1) + v,
+                    "{name}: {ops} operations"
+                ),
+                Schedule::Passes => assert!(ops <= (v + 1) * 3 * passes as u64 + 1),
+            }
+            assert!(ops <= 3 * v * config.max_passes as u64 + 8 * t);
+        }
+    }
+}
+
+#[test]
+fn a_workspace_is_reusable_and_runs_are_repeatable() {
+    let m = load_obj("cow.obj");
+    let mut ws = Workspace::<u16, 4096, 8192>::new();
+    let mut first = m.triangles.clone();
+    let r1 = ws
+        .simplify(&m.positions, &mut first, &Config::new())
+        .unwrap();
+    // Something else in between, with other sizes.
+    let s = icosphere(2);
+    let mut other = s.triangles.clone();
+    ws.simplify(&s.positions, &mut other, &Config::paper().with_ratio(0.3))
+        .unwrap();
+    let mut second = m.triangles.clone();
+    let r2 = ws
+        .simplify(&m.positions, &mut second, &Config::new())
+        .unwrap();
+    assert_eq!(r1, r2);
+    assert_eq!(first[..r1.triangles_out], second[..r2.triangles_out]);
+}
