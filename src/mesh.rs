@@ -126,7 +126,9 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         mesh.link_all();
 
         // 3. Drop exact duplicates (same vertex set, any order or winding): keep the first.
-        // A later copy shows up in the corner list of its first vertex.
+        // A later copy shows up in the corner list of its first vertex. A copy leaves all
+        // three lists while it is intact (a list walk finds its slot by its vertex), and only
+        // then is written as removed, so no walk ever meets it.
         for t in 0..mesh.tris.len() {
             let tri = mesh.tri(t);
             if is_dead(tri) {
@@ -143,12 +145,13 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
                 c = mesh.after(c);
             }
             if dup {
+                for &x in &tri {
+                    mesh.unlink(x, t);
+                }
                 mesh.kill(t);
                 mesh.duplicates += 1;
+                mesh.live = mesh.live.saturating_sub(1);
             }
-        }
-        if mesh.duplicates > 0 {
-            mesh.link_all();
         }
         mesh.valid_in = mesh.live;
 
@@ -553,8 +556,9 @@ pub(crate) fn is_dead(t: [usize; 3]) -> bool {
     t[0] == t[1]
 }
 
+/// Same three vertices. Both directions, so a removed `[x, x, x]` never matches.
 fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
-    a.iter().all(|x| b.contains(x))
+    a.iter().all(|x| b.contains(x)) && b.iter().all(|x| a.contains(x))
 }
 
 /// Iterator over a vertex's corners.
