@@ -1,7 +1,35 @@
 #!/usr/bin/env bash
-# The whole test suite, as README.md and CI run it.
+# The whole test suite, as README.md and CI run it:
+#   1. library and harness tests on the host (property tests, real meshes, bad input, ...);
+#   2. golden outputs on the host, with both math backends (libm, micromath);
+#   3. the same golden files under QEMU on five Cortex-M cores, both backends: the same bytes
+#      on every core and on the host;
+#   4. the link-time proof that no panic path is left in the library.
+# It installs the rustup targets it needs; QEMU comes from `apt-get install qemu-system-arm`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# Library and harness tests on the host (release: the real-mesh tests simplify 86k triangles).
+need_targets="thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf thumbv8m.main-none-eabihf"
+installed=$(rustup target list --installed)
+for t in $need_targets; do
+  grep -qx "$t" <<<"$installed" || rustup target add "$t"
+done
+if ! command -v qemu-system-arm >/dev/null; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm
+  else
+    echo "scripts/test.sh needs QEMU for the Cortex-M golden checks: sudo apt-get install qemu-system-arm" >&2
+    exit 2
+  fi
+fi
+
+echo "== host tests"
 cargo test --workspace --release
+
+echo "== golden outputs on the host (libm, micromath)"
+cargo run -q -p host-sim --release -- golden --check --backend libm
+cargo run -q -p host-sim --release -- golden --check --backend micromath
+
+echo "== golden outputs under QEMU: Cortex-M0, M3, M4F, M7, M33 (libm, micromath)"
+cargo run -q -p host-sim --release -- qemu --check --backend libm
+cargo run -q -p host-sim --release -- qemu --check --backend micromath

@@ -1,25 +1,271 @@
-//! Golden results: the library run on the host is the reference every emulated board must
-//! reproduce bit for bit (same report counts, same triangles in the same order).
+//! Golden results: the exact output of every case in `tests/golden/cases.toml`, per math
+//! backend, checked on the host (`host-sim golden --check`) and on every emulated board
+//! (`host-sim qemu --check`).
 //!
-//! A [`Case`] is a mesh plus a configuration; it travels to the firmware as a case file and
-//! comes back as a result file (both in `meshfmt`, shared with the firmware). [`reference()`]
-//! runs the same case through the library on the host and produces the same result format, so
-//! [`compare`] can check a board's output against it, ignoring the per-board measurement block
-//! (ticks, stack, capacity). Goldens can also be stored as files ([`save`], [`load_dir`]) to
-//! notice when the library's output changes between versions.
+//! Layout of `tests/golden/`:
+//!
+//! * `cases.toml`: the cases, written by hand. Each names a mesh (a generator of
+//!   [`meshfmt::golden`], e.g. `grid 12`, or a file under `tests/`, optionally cut to a box and
+//!   with extra positions/triangles appended), the configuration (`Config::new()` or
+//!   `Config::paper()` with schedule, ratio, target, λ and feature mode spelled out) and the
+//!   index type of the triangles.
+//! * `<backend>/<case>.bin`: the expected output triangles, exactly as the library leaves them
+//!   in the caller's buffer: `triangles_out × 3` indices of the case's index type,
+//!   little-endian (the bytes the firmware writes after its result header).
+//! * `<backend>/<case>.txt`: readable and TOML: the case, the hash of its input, every count of
+//!   the library's report and the SHA-256 of the `.bin`. Regenerated from a run and compared as
+//!   text, so any change in a count shows as a changed line.
+//!
+//! `<backend>` is `libm` or `micromath`, the library's two math backends (a compile-time
+//! feature: host-sim's `micromath` feature forwards to `tinydecimate/micromath`).
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::file::{decode_result, encode_case, encode_result};
-use meshfmt::{Board, IndexType, ResultHeader, Status};
+use meshfmt::{Board, ErrorKind, IndexType, ResultHeader, Status};
+use serde::Deserialize;
+use sha2::{Digest, Sha256};
 use tinydecimate::{Config, FeatureMode, Schedule, Workspace};
+
+/// The case list inside the golden directory.
+pub const MANIFEST: &str = "cases.toml";
+
+/// The repository root (the parent of host-sim).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host-sim lives inside the repository")
+        .to_path_buf()
+}
+
+/// The golden directory: `tests/golden`.
+pub fn default_dir() -> PathBuf {
+    repo_root().join("tests").join("golden")
+}
+
+// ---------------------------------------------------------------------------------------------
+// Math backends
+
+/// The library's math backend (its `micromath` feature). Chosen when host-sim is compiled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    /// libm, the default: correctly rounded `sqrtf`.
+    Libm,
+    /// micromath: fast approximations.
+    Micromath,
+}
+
+impl Backend {
+    /// Both backends.
+    pub const ALL: [Backend; 2] = [Backend::Libm, Backend::Micromath];
+
+    /// The backend this host-sim binary was built with.
+    pub const fn compiled() -> Self {
+        if cfg!(feature = "micromath") {
+            Backend::Micromath
+        } else {
+            Backend::Libm
+        }
+    }
+
+    /// `libm` or `micromath`: the golden subdirectory and the cargo feature.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Backend::Libm => "libm",
+            Backend::Micromath => "micromath",
+        }
+    }
+}
+
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Set in the environment of a re-invoked host-sim, so it never re-invokes itself again.
+const REINVOKED: &str = "HOST_SIM_REINVOKED";
+
+/// Runs this same command line again through `cargo run -p host-sim`, built for `backend`
+/// (same profile; same target directory, so both builds stay cached side by side). The host
+/// side of a check must run the library with the backend being checked, and the backend is a
+/// compile-time feature. Returns the child's exit code.
+pub fn reinvoke(backend: Backend) -> Result<ExitCode> {
+    if std::env::var_os(REINVOKED).is_some() {
+        bail!(
+            "host-sim built with {} was asked for {backend} again after re-invoking itself",
+            Backend::compiled()
+        );
+    }
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = Command::new(cargo);
+    cmd.arg("run");
+    if !cfg!(debug_assertions) {
+        cmd.arg("--release");
+    }
+    cmd.args(["-p", "host-sim", "--manifest-path"])
+        .arg(repo_root().join("Cargo.toml"));
+    if backend == Backend::Micromath {
+        cmd.args(["--features", "micromath"]);
+    }
+    if std::env::var_os("CARGO_TARGET_DIR").is_none() {
+        // Run from its target directory by path: build the other variant next to it.
+        if let Some(dir) = std::env::current_exe()
+            .ok()
+            .and_then(|e| Some(e.parent()?.parent()?.to_path_buf()))
+            .filter(|d| d.join("CACHEDIR.TAG").exists())
+        {
+            cmd.arg("--target-dir").arg(dir);
+        }
+    }
+    cmd.arg("--").args(std::env::args_os().skip(1));
+    cmd.env(REINVOKED, "1");
+    eprintln!(
+        "host-sim: this binary runs the library with {}; re-running under `cargo run -p host-sim{}` for --backend {backend}",
+        Backend::compiled(),
+        if backend == Backend::Micromath {
+            " --features micromath"
+        } else {
+            ""
+        }
+    );
+    let status = cmd.status().context("re-running host-sim through cargo")?;
+    Ok(ExitCode::from(
+        status.code().map_or(2, |c| u8::try_from(c).unwrap_or(2)),
+    ))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cases
+
+/// The base configuration of a case.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Base {
+    /// `Config::new()`: the measured defaults.
+    New,
+    /// `Config::paper()`: the paper as written.
+    Paper,
+}
+
+/// Schedule as written in the manifest.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ScheduleName {
+    /// `Schedule::Greedy`.
+    Greedy,
+    /// `Schedule::Passes`.
+    Passes,
+}
+
+/// Feature mode as written in the manifest.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Features {
+    /// `features = false`.
+    Off,
+    /// `FeatureMode::Paper`.
+    Paper,
+    /// `FeatureMode::ValenceNormalized`.
+    Valence,
+}
+
+/// Index type as written in the manifest.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum IndexName {
+    /// `u16` triangles.
+    U16,
+    /// `u32` triangles.
+    U32,
+}
+
+/// One `[[case]]` of the manifest.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CaseSpec {
+    /// File name of the golden files (letters, digits, `-`).
+    pub name: String,
+    /// What the case checks (free text).
+    #[serde(default)]
+    pub about: String,
+    /// A generator spec (`grid 12`, see [`meshfmt::golden::GENERATORS`]) or a mesh file
+    /// relative to the repository root, under `tests/`.
+    pub mesh: String,
+    /// Keep only the triangles whose three vertices lie in this box
+    /// `[xmin, ymin, zmin, xmax, ymax, zmax]`; unused vertices are dropped.
+    #[serde(default)]
+    pub cut: Option<[f32; 6]>,
+    /// Positions appended after the (cut) mesh's.
+    #[serde(default)]
+    pub append_positions: Vec<[f32; 3]>,
+    /// Triangles appended after the (cut) mesh's (degenerate, duplicate, out-of-range ...).
+    #[serde(default)]
+    pub append_triangles: Vec<[u32; 3]>,
+    /// `new` (`Config::new()`) or `paper` (`Config::paper()`); the fields below override it.
+    pub config: Base,
+    /// `greedy` or `passes`.
+    pub schedule: ScheduleName,
+    /// Target ratio.
+    pub ratio: f32,
+    /// Target triangle count (0: ratio only).
+    #[serde(default)]
+    pub target_triangles: usize,
+    /// λ of the feature test.
+    pub lambda: f32,
+    /// `off`, `paper` or `valence`.
+    pub features: Features,
+    /// `u16` or `u32`.
+    pub index: IndexName,
+}
+
+impl CaseSpec {
+    /// The library configuration.
+    pub fn config(&self) -> Config {
+        let mut c = match self.config {
+            Base::New => Config::new(),
+            Base::Paper => Config::paper(),
+        }
+        .with_schedule(match self.schedule {
+            ScheduleName::Greedy => Schedule::Greedy,
+            ScheduleName::Passes => Schedule::Passes,
+        })
+        .with_ratio(self.ratio)
+        .with_target_triangles(self.target_triangles)
+        .with_lambda(self.lambda);
+        match self.features {
+            Features::Off => c.features = false,
+            Features::Paper => c = c.with_feature_mode(FeatureMode::Paper),
+            Features::Valence => c = c.with_feature_mode(FeatureMode::ValenceNormalized),
+        }
+        c
+    }
+
+    /// The index type.
+    pub fn index_type(&self) -> IndexType {
+        match self.index {
+            IndexName::U16 => IndexType::U16,
+            IndexName::U32 => IndexType::U32,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    case: Vec<CaseSpec>,
+}
 
 /// A mesh and how to simplify it.
 #[derive(Clone, Debug)]
 pub struct Case {
     /// File-name friendly name.
     pub name: String,
+    /// Where the mesh comes from (generator spec or file, with cut and appended parts).
+    pub mesh: String,
     /// Vertex positions.
     pub positions: Vec<[f32; 3]>,
     /// Triangles (written with `index_type`).
@@ -30,6 +276,115 @@ pub struct Case {
     pub config: Config,
 }
 
+impl Case {
+    /// Builds the case a manifest entry describes.
+    pub fn from_spec(spec: &CaseSpec) -> Result<Case> {
+        let name = &spec.name;
+        if name.is_empty()
+            || !name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        {
+            bail!("case name {name:?}: use letters, digits, '-' and '_'");
+        }
+        let mut mesh = match meshfmt::golden::generate(&spec.mesh) {
+            Some(m) => m.map_err(|e| anyhow!("case {name}: {e:?}"))?,
+            None => {
+                let rel = Path::new(&spec.mesh);
+                if rel.is_absolute() || !rel.starts_with("tests") {
+                    bail!(
+                        "case {name}: mesh {:?} is neither a generator ({}) nor a file under tests/",
+                        spec.mesh,
+                        meshfmt::golden::GENERATORS
+                            .iter()
+                            .map(|g| g.0)
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    );
+                }
+                let m = crate::io::load(repo_root().join(rel))
+                    .with_context(|| format!("case {name}"))?;
+                meshfmt::golden::Mesh {
+                    positions: m.positions,
+                    triangles: m.triangles,
+                }
+            }
+        };
+        let mut desc = spec.mesh.clone();
+        if let Some(b) = spec.cut {
+            let inside = |i: u32| {
+                mesh.positions
+                    .get(i as usize)
+                    .is_some_and(|p| (0..3).all(|k| p[k] >= b[k] && p[k] <= b[k + 3]))
+            };
+            let kept: Vec<_> = mesh
+                .triangles
+                .iter()
+                .copied()
+                .filter(|t| t.iter().all(|&i| inside(i)))
+                .collect();
+            mesh.triangles = kept;
+            meshfmt::golden::compact(&mut mesh);
+            let _ = write!(desc, ", cut to {b:?}");
+        }
+        mesh.positions.extend_from_slice(&spec.append_positions);
+        mesh.triangles.extend_from_slice(&spec.append_triangles);
+        if !spec.append_positions.is_empty() || !spec.append_triangles.is_empty() {
+            let _ = write!(
+                desc,
+                ", + {} positions, + {} triangles",
+                spec.append_positions.len(),
+                spec.append_triangles.len()
+            );
+        }
+        Ok(Case {
+            name: name.clone(),
+            mesh: desc,
+            positions: mesh.positions,
+            triangles: mesh.triangles,
+            index_type: spec.index_type(),
+            config: spec.config(),
+        })
+    }
+
+    /// The case file the firmware reads.
+    pub fn encode(&self) -> Result<Vec<u8>> {
+        let h = meshfmt::lib::case_header(&self.config, self.index_type);
+        encode_case(&h, &self.positions, &self.triangles)
+            .map_err(|e| anyhow!("case {}: {e:?}", self.name))
+    }
+
+    /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles).
+    pub fn buffer_bytes(&self) -> usize {
+        self.positions.len() * 12 + self.triangles.len() * self.index_type.triangle_bytes()
+    }
+}
+
+/// Reads the manifest `dir/cases.toml` and builds every case, in manifest order.
+pub fn load_cases(dir: &Path) -> Result<Vec<Case>> {
+    load_specs(dir)?.iter().map(Case::from_spec).collect()
+}
+
+/// Reads the manifest `dir/cases.toml`.
+pub fn load_specs(dir: &Path) -> Result<Vec<CaseSpec>> {
+    let path = dir.join(MANIFEST);
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let m: Manifest = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
+    for (i, c) in m.case.iter().enumerate() {
+        if m.case[..i].iter().any(|d| d.name == c.name) {
+            bail!("{}: case {:?} twice", path.display(), c.name);
+        }
+    }
+    if m.case.is_empty() {
+        bail!("{}: no cases", path.display());
+    }
+    Ok(m.case)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Outcomes and the host reference
+
 /// A simplification outcome, as the result file carries it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Outcome {
@@ -39,31 +394,17 @@ pub struct Outcome {
     pub triangles: Vec<[u32; 3]>,
 }
 
-impl Case {
-    /// The case file the firmware reads.
-    pub fn encode(&self) -> Result<Vec<u8>> {
-        let h = meshfmt::lib::case_header(&self.config, self.index_type);
-        encode_case(&h, &self.positions, &self.triangles)
-            .map_err(|e| anyhow::anyhow!("case {}: {e:?}", self.name))
-    }
-
-    /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles).
-    pub fn buffer_bytes(&self) -> usize {
-        self.positions.len() * 12 + self.triangles.len() * self.index_type.triangle_bytes()
-    }
-}
-
 impl Outcome {
     /// Decodes a result file.
     pub fn decode(bytes: &[u8]) -> Result<Self> {
         let (header, triangles) =
-            decode_result(bytes).map_err(|e| anyhow::anyhow!("result file: {e:?}"))?;
+            decode_result(bytes).map_err(|e| anyhow!("result file: {e:?}"))?;
         Ok(Outcome { header, triangles })
     }
 
     /// Encodes a result file.
     pub fn encode(&self) -> Result<Vec<u8>> {
-        encode_result(&self.header, &self.triangles).map_err(|e| anyhow::anyhow!("{e:?}"))
+        encode_result(&self.header, &self.triangles).map_err(|e| anyhow!("{e:?}"))
     }
 }
 
@@ -71,10 +412,12 @@ impl Outcome {
 pub const HOST_MAX_VERTICES: usize = 1 << 18;
 /// See [`HOST_MAX_VERTICES`].
 pub const HOST_MAX_TRIANGLES: usize = 1 << 19;
-type HostWorkspace = Workspace<u32, HOST_MAX_VERTICES, HOST_MAX_TRIANGLES>;
+/// The host reference run's workspace.
+pub type HostWorkspace = Workspace<u32, HOST_MAX_VERTICES, HOST_MAX_TRIANGLES>;
 
 /// Runs the case through the library on the host, exactly as the firmware does
-/// (`Workspace::simplify` with the case's index type).
+/// (`Workspace::simplify` with the case's index type and the configuration as the case file
+/// carries it).
 pub fn reference(case: &Case) -> Result<Outcome> {
     let case = case.clone();
     // The workspace is ~11 MB; build it on a thread with room for it even in debug builds,
@@ -86,7 +429,7 @@ pub fn reference(case: &Case) -> Result<Outcome> {
             reference_with(&mut ws, &case)
         })?
         .join()
-        .map_err(|_| anyhow::anyhow!("reference run panicked"))?
+        .map_err(|_| anyhow!("reference run panicked"))?
 }
 
 fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
@@ -96,8 +439,11 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
             let mut t: Vec<[u16; 3]> = case
                 .triangles
                 .iter()
-                .map(|t| t.map(|i| u16::try_from(i).unwrap_or(u16::MAX)))
-                .collect();
+                .map(|t| {
+                    t.map(|i| u16::try_from(i).map_err(|_| anyhow!("{}: index {i}", case.name)))
+                })
+                .map(|[a, b, c]| Ok([a?, b?, c?]))
+                .collect::<Result<_>>()?;
             let r = ws.simplify(&case.positions, &mut t, &config);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
@@ -117,426 +463,615 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
     })
 }
 
-/// How a board's outcome relates to the reference.
+// ---------------------------------------------------------------------------------------------
+// Golden files
+
+/// The golden files of one case: the readable `.txt` and the exact `.bin`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Golden {
+    /// `<case>.txt`.
+    pub txt: String,
+    /// `<case>.bin`: the output triangles, little-endian, in the case's index type.
+    pub bin: Vec<u8>,
+}
+
+/// Lower-case hex SHA-256.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .fold(String::with_capacity(64), |mut s, b| {
+            let _ = write!(s, "{b:02x}");
+            s
+        })
+}
+
+/// Triangles as the firmware and the library's caller hold them: little-endian indices of
+/// `it`.
+pub fn triangle_bytes(it: IndexType, triangles: &[[u32; 3]]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(triangles.len() * it.triangle_bytes());
+    for &i in triangles.iter().flatten() {
+        match it {
+            // Board outputs come from u16 buffers; host ones were checked on the way in.
+            IndexType::U16 => out.extend_from_slice(&(i as u16).to_le_bytes()),
+            IndexType::U32 => out.extend_from_slice(&i.to_le_bytes()),
+        }
+    }
+    out
+}
+
+fn triangles_of(it: IndexType, bytes: &[u8]) -> Vec<[u32; 3]> {
+    let w = it.bytes();
+    bytes
+        .chunks_exact(3 * w)
+        .map(|c| {
+            let f = |k: usize| match it {
+                IndexType::U16 => u32::from(u16::from_le_bytes([c[2 * k], c[2 * k + 1]])),
+                IndexType::U32 => {
+                    u32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])
+                }
+            };
+            [f(0), f(1), f(2)]
+        })
+        .collect()
+}
+
+fn config_line(c: &Config) -> String {
+    let features = match (c.features, c.feature_mode) {
+        (false, _) => "off",
+        (true, FeatureMode::Paper) => "paper",
+        (true, FeatureMode::ValenceNormalized) => "valence",
+    };
+    format!(
+        "schedule {}, ratio {}, target {}, lambda {}, features {features}, feature_targets {}, \
+         max_passes {}, max_cost {}, max_normal_turn_deg {}, min_quality {}, boundary_weight {}",
+        match c.schedule {
+            Schedule::Greedy => "greedy",
+            Schedule::Passes => "passes",
+        },
+        c.target_ratio,
+        c.target_triangles,
+        c.lambda,
+        c.feature_targets,
+        c.max_passes,
+        c.max_cost,
+        c.max_normal_turn_deg,
+        c.min_quality,
+        c.boundary_weight
+    )
+}
+
+fn error_text(h: &ResultHeader) -> String {
+    let (a, b) = (h.error_a, h.error_b);
+    match h.error_kind {
+        ErrorKind::None => String::new(),
+        ErrorKind::CapacityVertices => format!("capacity: {a} vertices needed, {b} available"),
+        ErrorKind::CapacityTriangles => format!("capacity: {a} triangles needed, {b} available"),
+        ErrorKind::IndexOutOfRange => format!("index out of range: triangle {a}, index {b}"),
+        ErrorKind::NonFinitePosition => format!("non-finite position: vertex {a}"),
+        ErrorKind::InvalidConfig => format!("invalid config: field {a}"),
+    }
+}
+
+impl Golden {
+    /// The golden files `outcome` gives for `case` under `backend`. The measurement block of a
+    /// board's result (ticks, stack, capacity) does not enter them.
+    pub fn of(case: &Case, backend: Backend, outcome: &Outcome) -> Result<Golden> {
+        let h = &outcome.header;
+        let bin = triangle_bytes(case.index_type, &outcome.triangles);
+        let it = match case.index_type {
+            IndexType::U16 => "u16",
+            IndexType::U32 => "u32",
+        };
+        let mut t = String::new();
+        let w = &mut t;
+        writeln!(
+            w,
+            "# Golden result of case {:?} with the {backend} backend: written by\n\
+             # `host-sim golden --bless`, checked by `host-sim golden --check` (host) and\n\
+             # `host-sim qemu --check` (every board). {}.bin holds the output triangles.",
+            case.name, case.name
+        )?;
+        writeln!(w, "case = {:?}", case.name)?;
+        writeln!(w, "backend = \"{backend}\"")?;
+        writeln!(w, "mesh = {:?}", case.mesh)?;
+        writeln!(w, "index = \"{it}\"")?;
+        writeln!(w, "config = {:?}", config_line(&case.config))?;
+        writeln!(w, "input_vertices = {}", case.positions.len())?;
+        writeln!(w, "input_triangles = {}", case.triangles.len())?;
+        writeln!(
+            w,
+            "input_sha256 = \"{}\"  # the case file: mesh and configuration",
+            sha256_hex(&case.encode()?)
+        )?;
+        writeln!(w)?;
+        let status = match h.status {
+            Status::Ok => "ok",
+            Status::LibraryError => "library error",
+            Status::BadCase => "bad case file",
+            Status::TooBig => "too big for the board",
+        };
+        writeln!(w, "status = {status:?}")?;
+        if h.status == Status::LibraryError {
+            writeln!(w, "error = {:?}", error_text(h))?;
+        }
+        writeln!(w, "triangles_in = {}", h.triangles_in)?;
+        writeln!(w, "degenerate_dropped = {}", h.degenerate_dropped)?;
+        writeln!(w, "duplicates_dropped = {}", h.duplicates_dropped)?;
+        writeln!(w, "triangles_out = {}", h.triangles_out)?;
+        writeln!(w, "target_triangles = {}", h.target_triangles)?;
+        writeln!(w, "target_reached = {}", h.target_reached)?;
+        let stop = match h.stop {
+            0 => "running",
+            1 => "target",
+            2 => "no legal collapse",
+            3 => "max cost",
+            4 => "max passes",
+            _ => "?",
+        };
+        writeln!(w, "stop = {stop:?}")?;
+        writeln!(w, "collapses = {}", h.collapses)?;
+        writeln!(w, "vertices_removed = {}", h.vertices_removed)?;
+        writeln!(w, "locked_vertices = {}", h.locked_vertices)?;
+        writeln!(w, "feature_vertices = {}", h.feature_vertices)?;
+        writeln!(w, "passes = {}", h.passes)?;
+        let r = &h.rejected;
+        writeln!(
+            w,
+            "rejected = {{ locked = {}, feature = {}, boundary = {}, link = {}, duplicate = {}, \
+             normal_turn = {}, sliver = {}, fold = {} }}",
+            r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]
+        )?;
+        writeln!(
+            w,
+            "pass_triangles = {:?}",
+            &h.pass_triangles[..usize::from(h.pass_log_len).min(h.pass_triangles.len())]
+        )?;
+        writeln!(w)?;
+        writeln!(
+            w,
+            "bin_bytes = {}  # triangles_out x 3 x {} bytes, little-endian",
+            bin.len(),
+            case.index_type.bytes()
+        )?;
+        writeln!(w, "bin_sha256 = \"{}\"", sha256_hex(&bin))?;
+        Ok(Golden { txt: t, bin })
+    }
+
+    fn paths(dir: &Path, backend: Backend, name: &str) -> (PathBuf, PathBuf) {
+        let d = dir.join(backend.name());
+        (d.join(format!("{name}.txt")), d.join(format!("{name}.bin")))
+    }
+
+    /// Reads `dir/<backend>/<name>.txt|.bin`; `None` if neither exists.
+    pub fn load(dir: &Path, backend: Backend, name: &str) -> Result<Option<Golden>> {
+        let (t, b) = Self::paths(dir, backend, name);
+        if !t.exists() && !b.exists() {
+            return Ok(None);
+        }
+        let txt = std::fs::read_to_string(&t).with_context(|| format!("{}", t.display()))?;
+        let bin = std::fs::read(&b).with_context(|| format!("{}", b.display()))?;
+        Ok(Some(Golden { txt, bin }))
+    }
+
+    /// Writes `dir/<backend>/<name>.txt|.bin`.
+    pub fn save(&self, dir: &Path, backend: Backend, name: &str) -> Result<()> {
+        let (t, b) = Self::paths(dir, backend, name);
+        std::fs::create_dir_all(t.parent().expect("has a parent"))?;
+        std::fs::write(&t, &self.txt).with_context(|| format!("{}", t.display()))?;
+        std::fs::write(&b, &self.bin).with_context(|| format!("{}", b.display()))?;
+        Ok(())
+    }
+
+    /// `sha256 <first 16 hex>, <triangles_out> triangles, <collapses> collapses`, from the text.
+    pub fn summary(&self) -> String {
+        let t: toml::Table = self.txt.parse().unwrap_or_default();
+        let get = |k: &str| t.get(k).map(|v| v.to_string()).unwrap_or("?".into());
+        let sha = sha256_hex(&self.bin);
+        format!(
+            "sha256 {}, {} triangles out, {} collapses, status {}",
+            &sha[..16],
+            get("triangles_out"),
+            get("collapses"),
+            get("status")
+        )
+    }
+}
+
+/// How an outcome relates to its golden.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Verdict {
-    /// Same status, report and triangles.
-    Match,
-    /// The board could not hold the mesh (not a failure of the library).
-    TooBig,
-    /// Differences, described.
-    Mismatch(Vec<String>),
+    /// Same bytes, same counts.
+    Identical,
+    /// The board cannot hold the mesh; the case is skipped there. Says why.
+    Skipped(String),
+    /// Differences, the first differing triangle first.
+    Diff(Vec<String>),
+    /// No outcome (crash, timeout, no golden file ...). Says why.
+    Failed(String),
 }
 
-/// Compares a board's outcome with the reference, ignoring the measurement block.
-pub fn compare(expected: &Outcome, actual: &Outcome) -> Verdict {
-    if actual.header.status == Status::TooBig {
-        return Verdict::TooBig;
-    }
-    let mut diffs = Vec::new();
-    let (e, a) = (&expected.header, &actual.header);
-    macro_rules! field {
-        ($($f:ident),*) => {$(
-            if e.$f != a.$f {
-                diffs.push(format!("{}: expected {:?}, got {:?}", stringify!($f), e.$f, a.$f));
-            }
-        )*};
-    }
-    field!(
-        index_type,
-        status,
-        error_kind,
-        error_a,
-        error_b,
-        triangles_in,
-        degenerate_dropped,
-        duplicates_dropped,
-        triangles_out,
-        target_triangles,
-        target_reached,
-        stop,
-        pass_log_len,
-        collapses,
-        vertices_removed,
-        locked_vertices,
-        feature_vertices,
-        passes,
-        rejected,
-        pass_triangles
-    );
-    debug_assert_eq!(diffs.is_empty(), e.same_outcome(a));
-    if expected.triangles.len() != actual.triangles.len() {
-        diffs.push(format!(
-            "triangle count: expected {}, got {}",
-            expected.triangles.len(),
-            actual.triangles.len()
-        ));
-    }
-    if let Some(i) = expected
-        .triangles
-        .iter()
-        .zip(&actual.triangles)
-        .position(|(x, y)| x != y)
-    {
-        diffs.push(format!(
-            "triangle {i}: expected {:?}, got {:?}",
-            expected.triangles[i], actual.triangles[i]
-        ));
-    }
-    if diffs.is_empty() {
-        Verdict::Match
-    } else {
-        Verdict::Mismatch(diffs)
-    }
-}
-
-/// Writes `<dir>/<name>.case` and `<dir>/<name>.golden` (the reference result).
-pub fn save(dir: &Path, case: &Case, golden: &Outcome) -> Result<()> {
-    std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join(format!("{}.case", case.name)), case.encode()?)?;
-    std::fs::write(dir.join(format!("{}.golden", case.name)), golden.encode()?)?;
-    Ok(())
-}
-
-/// A stored golden: the case file bytes and the expected outcome.
-pub struct Stored {
-    /// Case name (file stem).
-    pub name: String,
-    /// The `.case` file.
-    pub case_path: PathBuf,
-    /// Its bytes.
-    pub case_bytes: Vec<u8>,
-    /// The `.golden` result.
-    pub golden: Outcome,
-}
-
-impl Stored {
-    /// The case, decoded again (to rerun the reference on the host).
-    pub fn case(&self) -> Result<Case> {
-        let (h, positions, triangles) = meshfmt::file::decode_case(&self.case_bytes)
-            .map_err(|e| anyhow::anyhow!("{}: {e:?}", self.case_path.display()))?;
-        Ok(Case {
-            name: self.name.clone(),
-            positions,
-            triangles,
-            index_type: h.index_type,
-            config: meshfmt::lib::config(&h),
-        })
-    }
-}
-
-/// Reads every `<name>.case` with its `<name>.golden` from `dir`, sorted by name.
-pub fn load_dir(dir: &Path) -> Result<Vec<Stored>> {
-    let mut out = Vec::new();
-    for entry in std::fs::read_dir(dir).with_context(|| format!("{}", dir.display()))? {
-        let path = entry?.path();
-        if path.extension().and_then(|e| e.to_str()) != Some("case") {
-            continue;
+impl Verdict {
+    /// Table cell.
+    pub fn cell(&self) -> &'static str {
+        match self {
+            Verdict::Identical => "identical",
+            Verdict::Skipped(_) => "skipped",
+            Verdict::Diff(_) => "DIFF",
+            Verdict::Failed(_) => "FAILED",
         }
-        let name = path
-            .file_stem()
-            .unwrap_or_default()
-            .to_string_lossy()
-            .into_owned();
-        let golden_path = path.with_extension("golden");
-        let case_bytes = std::fs::read(&path)?;
-        let golden = Outcome::decode(
-            &std::fs::read(&golden_path).with_context(|| format!("{}", golden_path.display()))?,
-        )
-        .with_context(|| format!("{}", golden_path.display()))?;
-        out.push(Stored {
-            name,
-            case_path: path,
-            case_bytes,
-            golden,
-        });
     }
-    out.sort_by(|a, b| a.name.cmp(&b.name));
-    if out.is_empty() {
-        bail!("no .case files in {}", dir.display());
+
+    /// DIFF or FAILED.
+    pub fn is_failure(&self) -> bool {
+        matches!(self, Verdict::Diff(_) | Verdict::Failed(_))
+    }
+}
+
+/// Compares an outcome of `case` with the expected golden files.
+pub fn judge(
+    case: &Case,
+    backend: Backend,
+    expected: &Golden,
+    actual: &Outcome,
+) -> Result<Verdict> {
+    let h = &actual.header;
+    if h.status == Status::TooBig {
+        return Ok(Verdict::Skipped(format!(
+            "too big for this board: {} vertices, {} {} triangles; it holds {} vertices, {} triangles",
+            h.error_a,
+            h.error_b,
+            if case.index_type == IndexType::U16 { "u16" } else { "u32" },
+            h.capacity_vertices,
+            h.capacity_triangles
+        )));
+    }
+    let got = Golden::of(case, backend, actual)?;
+    Ok(diff(case.index_type, expected, &got))
+}
+
+/// The differences between two goldens of the same case: the first differing triangle, then
+/// the differing lines of the text.
+pub fn diff(it: IndexType, expected: &Golden, got: &Golden) -> Verdict {
+    let mut d = Vec::new();
+    if expected.bin != got.bin {
+        let (e, g) = (triangles_of(it, &expected.bin), triangles_of(it, &got.bin));
+        match e.iter().zip(&g).position(|(a, b)| a != b) {
+            Some(i) => d.push(format!(
+                "first differing triangle: #{i}: expected {:?}, got {:?} ({} vs {} triangles)",
+                e[i],
+                g[i],
+                e.len(),
+                g.len()
+            )),
+            None => d.push(format!(
+                "first differing triangle: #{}: expected {}, got {} (the first {} are equal)",
+                e.len().min(g.len()),
+                e.get(g.len()).map_or("none".into(), |t| format!("{t:?}")),
+                g.get(e.len()).map_or("none".into(), |t| format!("{t:?}")),
+                e.len().min(g.len())
+            )),
+        }
+    }
+    if expected.txt != got.txt {
+        let (el, gl): (Vec<_>, Vec<_>) =
+            (expected.txt.lines().collect(), got.txt.lines().collect());
+        for i in 0..el.len().max(gl.len()) {
+            let (a, b) = (el.get(i).copied(), gl.get(i).copied());
+            if a != b {
+                d.push(format!(
+                    "expected `{}`, got `{}`",
+                    a.unwrap_or("<end>"),
+                    b.unwrap_or("<end>")
+                ));
+            }
+            if d.len() >= 8 {
+                d.push("...".into());
+                break;
+            }
+        }
+    }
+    if d.is_empty() {
+        Verdict::Identical
+    } else {
+        Verdict::Diff(d)
+    }
+}
+
+/// Runs every case of `dir/cases.toml` on the host and compares with `dir/<backend>/`. The
+/// backend must be the one this binary was built with.
+pub fn check_host(dir: &Path, backend: Backend) -> Result<Vec<(Case, Verdict)>> {
+    if backend != Backend::compiled() {
+        bail!(
+            "this host-sim runs the library with {}, not {backend}",
+            Backend::compiled()
+        );
+    }
+    let mut out = Vec::new();
+    for case in load_cases(dir)? {
+        let now = reference(&case)?;
+        let v = match Golden::load(dir, backend, &case.name)? {
+            Some(g) => judge(&case, backend, &g, &now)?,
+            None => Verdict::Failed(format!(
+                "no golden files {}/{}/{}.txt|.bin (run `host-sim golden --bless --backend {backend}`)",
+                dir.display(),
+                backend,
+                case.name
+            )),
+        };
+        out.push((case, v));
     }
     Ok(out)
 }
 
-// ---------------------------------------------------------------------------------------------
-// Built-in meshes and cases: small enough for the 16 KB micro:bit (≤ 240 vertices and ≤ 440 u16
-// or 220 u32 triangles), chosen to exercise both schedules, both index types, both feature
-// modes, boundaries, dropped input triangles and a library error.
-
-/// A bumpy `n × n` grid of quads on z = height(x, y): `(n+1)²` vertices, `2n²` triangles, with
-/// a boundary. Coordinates are small multiples of 1/8, exact in `f32`.
-pub fn bumpy_grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-    let w = n + 1;
-    let mut p = Vec::new();
-    for y in 0..w {
-        for x in 0..w {
-            let h = ((x * 7 + y * 3) % 5) as f32 * 0.125 + if x > n / 2 { 1.0 } else { 0.0 };
-            p.push([x as f32, y as f32, h]);
-        }
+/// Recomputes every case on the host and writes `dir/<backend>/`; removes the files of cases
+/// no longer in the manifest. Returns one line per case saying what changed.
+pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
+    if backend != Backend::compiled() {
+        bail!(
+            "this host-sim runs the library with {}, not {backend}",
+            Backend::compiled()
+        );
     }
-    let mut t = Vec::new();
-    for y in 0..n {
-        for x in 0..n {
-            let v = y * w + x;
-            t.push([v, v + 1, v + w + 1]);
-            t.push([v, v + w + 1, v + w]);
-        }
-    }
-    (p, t)
-}
-
-/// An icosphere (closed, no boundary): 12 vertices / 20 triangles, each subdivision ×4.
-pub fn icosphere(subdivisions: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-    let g = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut p: Vec<[f64; 3]> = vec![
-        [-1.0, g, 0.0],
-        [1.0, g, 0.0],
-        [-1.0, -g, 0.0],
-        [1.0, -g, 0.0],
-        [0.0, -1.0, g],
-        [0.0, 1.0, g],
-        [0.0, -1.0, -g],
-        [0.0, 1.0, -g],
-        [g, 0.0, -1.0],
-        [g, 0.0, 1.0],
-        [-g, 0.0, -1.0],
-        [-g, 0.0, 1.0],
-    ];
-    let mut t: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        let mut midpoint = |a: u32, b: u32, p: &mut Vec<[f64; 3]>| -> u32 {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (pa, pb) = (p[a as usize], p[b as usize]);
-                p.push([
-                    (pa[0] + pb[0]) / 2.0,
-                    (pa[1] + pb[1]) / 2.0,
-                    (pa[2] + pb[2]) / 2.0,
-                ]);
-                (p.len() - 1) as u32
-            })
+    let cases = load_cases(dir)?;
+    let mut lines = Vec::new();
+    for case in &cases {
+        let new = Golden::of(case, backend, &reference(case)?)?;
+        let line = match Golden::load(dir, backend, &case.name)? {
+            None => format!("{:<28} new      {}", case.name, new.summary()),
+            Some(old) if old == new => format!("{:<28} same     {}", case.name, new.summary()),
+            Some(old) => {
+                let mut s = format!(
+                    "{:<28} CHANGED  old {}\n{:<37}new {}",
+                    case.name,
+                    old.summary(),
+                    "",
+                    new.summary()
+                );
+                if let Verdict::Diff(d) = diff(case.index_type, &old, &new) {
+                    for l in d {
+                        let _ = write!(s, "\n{:<37}{l}", "");
+                    }
+                }
+                s
+            }
         };
-        for [a, b, c] in t {
-            let ab = midpoint(a, b, &mut p);
-            let bc = midpoint(b, c, &mut p);
-            let ca = midpoint(c, a, &mut p);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        t = next;
+        new.save(dir, backend, &case.name)?;
+        lines.push(line);
     }
-    let p = p
-        .into_iter()
-        .map(|v| {
-            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-            [(v[0] / l) as f32, (v[1] / l) as f32, (v[2] / l) as f32]
+    let sub = dir.join(backend.name());
+    let mut stale: Vec<_> = std::fs::read_dir(&sub)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("");
+            let ext = p.extension().and_then(|s| s.to_str()).unwrap_or("");
+            (ext == "txt" || ext == "bin") && !cases.iter().any(|c| c.name == stem)
         })
         .collect();
-    (p, t)
-}
-
-/// The built-in cases (all fit every board).
-pub fn builtin_cases() -> Vec<Case> {
-    let (gp, gt) = bumpy_grid(12); // 169 vertices, 288 triangles
-    let (sp, st) = icosphere(2); // 162 vertices, 320 triangles
-    let (tp, tt) = bumpy_grid(8); // 81 vertices, 128 triangles
-    let mut dirty = tt.clone();
-    dirty.extend([[3, 3, 4], [0, 1, 10], [5, 6, 6]]); // two degenerate, one duplicate
-    let mut bad = tt.clone();
-    bad[7][1] = 81; // one past the last vertex
-    let case = |name: &str, p: &Vec<[f32; 3]>, t: &Vec<[u32; 3]>, it, config| Case {
-        name: name.into(),
-        positions: p.clone(),
-        triangles: t.clone(),
-        index_type: it,
-        config,
-    };
-    let base = Config::new();
-    vec![
-        case(
-            "grid12-greedy-u16",
-            &gp,
-            &gt,
-            IndexType::U16,
-            base.with_ratio(0.25).with_schedule(Schedule::Greedy),
-        ),
-        case(
-            "grid12-passes-u16",
-            &gp,
-            &gt,
-            IndexType::U16,
-            base.with_ratio(0.5)
-                .with_schedule(Schedule::Passes)
-                .with_lambda(1.0),
-        ),
-        case(
-            "sphere2-greedy-u16",
-            &sp,
-            &st,
-            IndexType::U16,
-            base.with_ratio(0.2).with_schedule(Schedule::Greedy),
-        ),
-        case(
-            "sphere2-passes-valence-u16",
-            &sp,
-            &st,
-            IndexType::U16,
-            base.with_ratio(0.3)
-                .with_schedule(Schedule::Passes)
-                .with_feature_mode(FeatureMode::ValenceNormalized)
-                .with_lambda(1.5),
-        ),
-        case(
-            "grid8-greedy-u32",
-            &tp,
-            &tt,
-            IndexType::U32,
-            base.with_ratio(0.3).with_schedule(Schedule::Greedy),
-        ),
-        case(
-            "grid8-dirty-passes-u32",
-            &tp,
-            &dirty,
-            IndexType::U32,
-            base.with_ratio(0.4).with_schedule(Schedule::Passes),
-        ),
-        case(
-            "grid8-target-count-u16",
-            &tp,
-            &tt,
-            IndexType::U16,
-            base.with_ratio(0.0).with_target_triangles(40),
-        ),
-        case(
-            "grid8-bad-index-u16",
-            &tp,
-            &bad,
-            IndexType::U16,
-            base.with_ratio(0.5),
-        ),
-    ]
-}
-
-/// A grid case as large as `max_vertices` / `max_triangles` allow (for capacity runs).
-pub fn largest_grid_case(max_vertices: usize, max_triangles: usize, index_type: IndexType) -> Case {
-    let mut n = 1u32;
-    while ((n + 2) * (n + 2)) as usize <= max_vertices
-        && (2 * (n + 1) * (n + 1)) as usize <= max_triangles
-    {
-        n += 1;
+    stale.sort();
+    for p in stale {
+        std::fs::remove_file(&p)?;
+        lines.push(format!("removed {} (not in {MANIFEST})", p.display()));
     }
-    let (positions, triangles) = bumpy_grid(n);
-    Case {
-        name: format!("grid{n}-capacity"),
-        positions,
-        triangles,
-        index_type,
-        config: Config::new()
-            .with_ratio(0.25)
-            .with_schedule(Schedule::Greedy),
+    Ok(lines)
+}
+
+/// `host-sim golden`: checks or rewrites the golden files.
+#[derive(Clone, Debug, clap::Args)]
+pub struct Args {
+    /// Run every case on the host and compare with the golden files (the default). Exit 1 on
+    /// any difference, printing the first differing triangle.
+    #[arg(long, conflicts_with = "bless")]
+    pub check: bool,
+    /// Recompute every case on the host and rewrite the golden files; print per case the old
+    /// and new hash and counts.
+    #[arg(long)]
+    pub bless: bool,
+    /// Math backend of the library (default: the one host-sim was built with). Another one
+    /// re-runs host-sim through `cargo run` with or without `--features micromath`.
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    /// The golden directory (`cases.toml`, `libm/`, `micromath/`).
+    #[arg(long, value_name = "DIR", default_value_os_t = default_dir())]
+    pub dir: PathBuf,
+}
+
+/// Runs `host-sim golden`.
+pub fn run(a: &Args) -> Result<ExitCode> {
+    let backend = a.backend.unwrap_or(Backend::compiled());
+    if backend != Backend::compiled() {
+        return reinvoke(backend);
     }
-}
-
-/// The directory of stored goldens: `host-sim/golden`.
-pub fn default_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("golden")
-}
-
-/// Recomputes the reference of every built-in case and stores it in `dir`.
-pub fn bless(dir: &Path) -> Result<usize> {
-    let cases = builtin_cases();
-    for c in &cases {
-        save(dir, c, &reference(c)?)?;
-    }
-    Ok(cases.len())
-}
-
-/// Checks the stored goldens in `dir` against the library on the host: the stored case files
-/// still decode and the library still gives the stored results. Returns the names that differ.
-pub fn check_host(dir: &Path) -> Result<Vec<(String, Vec<String>)>> {
-    let mut bad = Vec::new();
-    for s in load_dir(dir)? {
-        let now = reference(&s.case()?)?;
-        if let Verdict::Mismatch(d) = compare(&s.golden, &now) {
-            bad.push((s.name.clone(), d));
+    if a.bless {
+        println!(
+            "blessing {} with the {backend} backend:",
+            a.dir.join(backend.name()).display()
+        );
+        for l in bless(&a.dir, backend)? {
+            println!("  {l}");
         }
+        return Ok(ExitCode::SUCCESS);
     }
-    Ok(bad)
+    println!(
+        "checking {} against the library on the host ({backend}):",
+        a.dir.join(backend.name()).display()
+    );
+    let results = check_host(&a.dir, backend)?;
+    let mut failed = 0;
+    for (case, v) in &results {
+        println!(
+            "  {:<28} {:>4} V {:>5} T {:<3}  {}",
+            case.name,
+            case.positions.len(),
+            case.triangles.len(),
+            if case.index_type == IndexType::U16 {
+                "u16"
+            } else {
+                "u32"
+            },
+            v.cell()
+        );
+        match v {
+            Verdict::Diff(d) => d.iter().for_each(|l| println!("      {l}")),
+            Verdict::Failed(why) | Verdict::Skipped(why) => println!("      {why}"),
+            Verdict::Identical => {}
+        }
+        failed += usize::from(v.is_failure());
+    }
+    if failed == 0 {
+        println!("{} cases identical", results.len());
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!(
+            "{failed} of {} cases differ; if the change is intended: host-sim golden --bless --backend {backend}",
+            results.len()
+        );
+        Ok(ExitCode::from(1))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// `host-sim golden --check` on the host, for the backend this test binary was built with
+    /// (`cargo test -p host-sim [--features micromath]`).
     #[test]
-    fn builtin_cases_fit_the_microbit_and_round_trip() {
-        for c in builtin_cases() {
-            assert!(c.positions.len() <= 240, "{}", c.name);
-            let cap = 440 * 6 / c.index_type.triangle_bytes();
-            assert!(c.triangles.len() <= cap, "{}", c.name);
+    fn golden_check_passes_on_the_host() {
+        let results = check_host(&default_dir(), Backend::compiled()).unwrap();
+        let bad: Vec<_> = results
+            .iter()
+            .filter(|(_, v)| *v != Verdict::Identical)
+            .map(|(c, v)| format!("{}: {v:?}", c.name))
+            .collect();
+        assert!(
+            bad.is_empty(),
+            "golden mismatch ({}):\n{}",
+            Backend::compiled(),
+            bad.join("\n")
+        );
+    }
+
+    /// The backend switch is real: the two backends' goldens exist for every case, and differ.
+    #[test]
+    fn libm_and_micromath_goldens_differ() {
+        let dir = default_dir();
+        let mut differ = Vec::new();
+        for spec in load_specs(&dir).unwrap() {
+            let l = Golden::load(&dir, Backend::Libm, &spec.name).unwrap();
+            let m = Golden::load(&dir, Backend::Micromath, &spec.name).unwrap();
+            let (l, m) = (l.expect("libm golden"), m.expect("micromath golden"));
+            if l.bin != m.bin {
+                differ.push(spec.name);
+            }
+        }
+        assert!(
+            !differ.is_empty(),
+            "libm and micromath give the same bytes in every case"
+        );
+    }
+
+    /// The cases cover what the goldens promise, and the micro:bit-sized ones fit it.
+    #[test]
+    fn manifest_covers_the_required_cases() {
+        let specs = load_specs(&default_dir()).unwrap();
+        let cases: Vec<_> = specs.iter().map(|s| Case::from_spec(s).unwrap()).collect();
+        let has =
+            |f: &dyn Fn(&CaseSpec, &Case) -> bool| specs.iter().zip(&cases).any(|(s, c)| f(s, c));
+        assert!(has(
+            &|s, _| s.config == Base::New && s.config() == Config::new().with_ratio(s.ratio)
+        ));
+        assert!(has(
+            &|s, _| s.config == Base::Paper && s.config() == Config::paper().with_ratio(s.ratio)
+        ));
+        assert!(has(&|s, _| s.schedule == ScheduleName::Greedy));
+        assert!(has(&|s, _| s.schedule == ScheduleName::Passes));
+        assert!(has(&|s, _| s.index == IndexName::U16));
+        assert!(has(&|s, _| s.index == IndexName::U32));
+        assert!(has(&|s, _| s.features == Features::Valence));
+        assert!(has(&|s, _| s.features == Features::Off));
+        assert!(has(&|s, _| s.target_triangles > 0));
+        // Edge use counts: open (an edge with one triangle), non-manifold (three).
+        let edge_uses = |c: &Case| {
+            let mut e = std::collections::HashMap::new();
+            for t in &c.triangles {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    if a != b {
+                        *e.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+                    }
+                }
+            }
+            e
+        };
+        assert!(
+            has(&|_, c| edge_uses(c).values().any(|&n| n == 1)),
+            "open mesh"
+        );
+        assert!(
+            has(&|_, c| edge_uses(c).values().all(|&n| n == 2)),
+            "closed mesh"
+        );
+        assert!(
+            has(&|_, c| edge_uses(c).values().any(|&n| n >= 3)),
+            "non-manifold edge"
+        );
+        assert!(
+            has(&|s, _| s.mesh.starts_with("tests/fixtures/plate_holes") && s.cut.is_some()),
+            "CAD cut"
+        );
+        assert!(
+            has(&|_, c| c
+                .triangles
+                .iter()
+                .any(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])),
+            "degenerate"
+        );
+        // Micro:bit: 240 vertices, 440 u16 / 220 u32 triangles.
+        let fits = |c: &Case| {
+            c.positions.len() <= 240 && c.triangles.len() * c.index_type.triangle_bytes() <= 440 * 6
+        };
+        assert!(cases.iter().filter(|c| fits(c)).count() >= 12);
+        assert!(cases.iter().any(|c| !fits(c)), "a case the micro:bit skips");
+    }
+
+    #[test]
+    fn cases_round_trip_through_the_case_file() {
+        for c in load_cases(&default_dir()).unwrap() {
             let bytes = c.encode().unwrap();
             let (h, p, t) = meshfmt::file::decode_case(&bytes).unwrap();
-            assert_eq!(p, c.positions);
-            assert_eq!(t, c.triangles);
-            assert_eq!(meshfmt::lib::config(&h), c.config);
+            assert_eq!(p, c.positions, "{}", c.name);
+            assert_eq!(t, c.triangles, "{}", c.name);
+            assert_eq!(meshfmt::lib::config(&h), c.config, "{}", c.name);
         }
     }
 
     #[test]
-    fn reference_is_deterministic_and_round_trips() {
-        for c in builtin_cases() {
-            let a = reference(&c).unwrap();
-            let b = reference(&c).unwrap();
-            assert_eq!(compare(&a, &b), Verdict::Match, "{}", c.name);
-            let again = Outcome::decode(&a.encode().unwrap()).unwrap();
-            assert_eq!(again, a);
-        }
-    }
-
-    #[test]
-    fn bad_index_is_a_library_error() {
-        let c = builtin_cases()
-            .into_iter()
-            .find(|c| c.name == "grid8-bad-index-u16")
-            .unwrap();
-        let r = reference(&c).unwrap();
-        assert_eq!(r.header.status, Status::LibraryError);
-        assert_eq!(r.header.error_kind, meshfmt::ErrorKind::IndexOutOfRange);
-    }
-
-    #[test]
-    fn compare_reports_differences() {
-        let c = &builtin_cases()[0];
-        let a = reference(c).unwrap();
+    fn diff_names_the_first_differing_triangle() {
+        let spec = &load_specs(&default_dir()).unwrap()[0];
+        let case = Case::from_spec(spec).unwrap();
+        let a = reference(&case).unwrap();
+        let ga = Golden::of(&case, Backend::compiled(), &a).unwrap();
         let mut b = a.clone();
         b.header.ticks = 99; // measurement: ignored
-        assert_eq!(compare(&a, &b), Verdict::Match);
+        b.header.stack_high_water = 7;
+        b.header.board = Board::Microbit;
+        assert_eq!(
+            judge(&case, Backend::compiled(), &ga, &b).unwrap(),
+            Verdict::Identical
+        );
         b.header.collapses += 1;
-        b.triangles[0][0] += 1;
-        match compare(&a, &b) {
-            Verdict::Mismatch(d) => assert_eq!(d.len(), 2, "{d:?}"),
+        b.triangles[3][1] += 1;
+        match judge(&case, Backend::compiled(), &ga, &b).unwrap() {
+            Verdict::Diff(d) => {
+                assert!(d[0].starts_with("first differing triangle: #3:"), "{d:?}");
+                assert!(d.iter().any(|l| l.contains("collapses")), "{d:?}");
+            }
             v => panic!("{v:?}"),
         }
+        b.header.status = Status::TooBig;
+        assert!(matches!(
+            judge(&case, Backend::compiled(), &ga, &b).unwrap(),
+            Verdict::Skipped(_)
+        ));
     }
 }

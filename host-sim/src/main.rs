@@ -5,7 +5,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::{bench, check, metro, qemu, render, simplify};
+use host_sim::{bench, check, demo, golden, metro, qemu, render, simplify};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
@@ -29,6 +29,11 @@ enum Command {
     /// The library on QEMU-emulated Cortex-M0/M3/M4F/M7/M33 boards, compared with the host;
     /// --measure for instructions, stack, image sizes and the largest mesh per board.
     Qemu(qemu::Args),
+    /// The golden files in tests/golden: --check them on the host, or --bless (rewrite) them.
+    Golden(golden::Args),
+    /// First impression: one mesh simplified on the host and on an emulated Cortex-M4F, side by
+    /// side, and whether the outputs are byte-identical.
+    Demo(demo::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +45,8 @@ fn main() -> ExitCode {
         Command::Render(a) => render::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Qemu(a) => qemu::run(a),
+        Command::Golden(a) => golden::run(a),
+        Command::Demo(a) => demo::run(a),
     };
     result.unwrap_or_else(|e| {
         eprintln!("error: {e:#}");

@@ -1,8 +1,9 @@
 //! The library on emulated Cortex-M cores: builds the firmware in `host-sim/firmware` for a
 //! board, runs it under `qemu-system-arm`, decodes its defmt log, collects its result file and
-//! compares it with the host reference ([`crate::golden`]). Also measures each board:
-//! instructions (SysTick under `-icount shift=0`), stack high-water mark, image sizes and the
-//! largest mesh it takes.
+//! compares it with the golden files ([`crate::golden`], `host-sim qemu --check`) or a fresh
+//! host run. Also measures each board (`--measure`): instructions (SysTick under
+//! `-icount shift=0`), stack high-water mark, image sizes of the firmware and of the library
+//! alone, and the largest mesh it simplifies.
 //!
 //! `host-sim qemu` ([`Args`], [`run`]); `host-sim qemu --help` lists the modes. By hand (what
 //! [`build`] and [`run_in`] do):
@@ -10,10 +11,10 @@
 //! ```text
 //! cd host-sim/firmware
 //! DEFMT_LOG=info cargo build --release --target thumbv7em-none-eabihf \
-//!     --features board-mps2-an386 --target-dir target/mps2-an386
+//!     --features board-mps2-an386            # [,micromath]
 //! qemu-system-arm -machine mps2-an386 -nographic -monitor none -serial null -icount shift=0 \
 //!     -semihosting-config enable=on,target=native,arg=fw,arg=case.bin,arg=result.bin \
-//!     -kernel target/mps2-an386/thumbv7em-none-eabihf/release/tinydecimate-firmware > log.defmt
+//!     -kernel target/thumbv7em-none-eabihf/release/tinydecimate-firmware > log.defmt
 //! ```
 //!
 //! (no `-cpu`: the mps2 machines refuse any but their own). `case.bin` and `result.bin` are
@@ -28,7 +29,7 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::{IndexType, Status};
 
-use crate::golden::{self, Case, Outcome, Verdict};
+use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
 
 /// An emulated board.
 #[derive(Clone, Copy, Debug)]
@@ -115,28 +116,40 @@ pub fn firmware_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("firmware")
 }
 
-/// Where [`build`] puts a board's image: one target directory per board, because two boards
-/// share a Rust target (an386/an500) and would overwrite each other's image.
-pub fn elf_path(board: &Board) -> PathBuf {
-    firmware_dir()
-        .join("target")
-        .join(board.name)
-        .join(board.target)
-        .join("release")
-        .join("tinydecimate-firmware")
+/// The firmware's target directory (also what `cargo build` in `host-sim/firmware` uses): one
+/// for every board and backend, so dependencies are built once per Rust target.
+pub fn firmware_target_dir() -> PathBuf {
+    firmware_dir().join("target")
 }
 
-/// Builds the firmware for `board` (release), with the library or (`with_library = false`)
-/// as a boot/semihosting/defmt smoke test that echoes its input. Returns the ELF.
-pub fn build(board: &Board, with_library: bool) -> Result<PathBuf> {
+/// Where [`build`] keeps a board's image: `target/images/<board>-<backend>[-nolib].elf`. Cargo
+/// leaves one `tinydecimate-firmware` per Rust target, which the next build for another board
+/// of the same target (an386/an500) or another backend overwrites, so each image is copied
+/// out right after its build.
+pub fn elf_path(board: &Board, backend: Backend, with_library: bool) -> PathBuf {
+    firmware_target_dir().join("images").join(format!(
+        "{}-{}{}.elf",
+        board.name,
+        backend,
+        if with_library { "" } else { "-nolib" }
+    ))
+}
+
+/// Builds the firmware for `board` (release) with the library on `backend`, or
+/// (`with_library = false`) as a boot/semihosting/defmt smoke test that echoes its input.
+/// Returns the image.
+pub fn build(board: &Board, backend: Backend, with_library: bool) -> Result<PathBuf> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut features = format!("board-{}", board.name);
+    if backend == Backend::Micromath {
+        features.push_str(",micromath");
+    }
     let mut cmd = Command::new(cargo);
     cmd.current_dir(firmware_dir())
         .args(["build", "--release", "--target", board.target])
-        .arg("--features")
-        .arg(format!("board-{}", board.name))
+        .args(["--features", &features])
         .arg("--target-dir")
-        .arg(firmware_dir().join("target").join(board.name))
+        .arg(firmware_target_dir())
         // Library debug logs stay out: they would cost instructions inside the measurement.
         .env("DEFMT_LOG", "info");
     if !with_library {
@@ -156,16 +169,110 @@ pub fn build(board: &Board, with_library: bool) -> Result<PathBuf> {
         .status()
         .context("running cargo for the firmware (is the target installed? `rustup target add`)")?;
     if !status.success() {
-        bail!("firmware build for {} failed ({status})", board.name);
+        bail!(
+            "firmware build for {} ({backend}) failed ({status})",
+            board.name
+        );
     }
-    let elf = elf_path(board);
-    if !elf.exists() {
-        bail!("firmware build succeeded but {} is missing", elf.display());
-    }
+    let built = firmware_target_dir()
+        .join(board.target)
+        .join("release")
+        .join("tinydecimate-firmware");
+    let elf = elf_path(board, backend, with_library);
+    std::fs::create_dir_all(elf.parent().expect("has a parent"))?;
+    std::fs::copy(&built, &elf)
+        .with_context(|| format!("copying {} to {}", built.display(), elf.display()))?;
     Ok(elf)
 }
 
-/// What one QEMU run gave.
+/// Whether `program --version` runs.
+fn runs(program: &str, arg: &str) -> bool {
+    Command::new(program)
+        .arg(arg)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// The exact command that installs QEMU's Arm system emulator on this machine.
+pub const QEMU_INSTALL: &str = "sudo apt-get install qemu-system-arm";
+
+/// Makes sure the tools for `boards` are there, on a fresh machine too:
+///
+/// * the Rust targets of the boards: missing ones are installed with `rustup target add`
+///   (harmless, per-user);
+/// * `qemu-system-arm`: if missing, and running as root with `CI` set (a throw-away CI
+///   machine), `apt-get install -y qemu-system-arm` is run; otherwise the exact install command
+///   is printed and the caller should exit with status 2 (`Ok(Some(2))`): installing system
+///   packages is the user's call.
+pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
+    let mut targets: Vec<&str> = boards.iter().map(|b| b.target).collect();
+    targets.sort_unstable();
+    targets.dedup();
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output();
+    match installed {
+        Ok(out) if out.status.success() => {
+            let have = String::from_utf8_lossy(&out.stdout).into_owned();
+            let missing: Vec<&str> = targets
+                .iter()
+                .copied()
+                .filter(|t| !have.lines().any(|l| l.trim() == *t))
+                .collect();
+            if !missing.is_empty() {
+                eprintln!(
+                    "installing Rust targets: rustup target add {}",
+                    missing.join(" ")
+                );
+                let ok = Command::new("rustup")
+                    .args(["target", "add"])
+                    .args(&missing)
+                    .status()
+                    .is_ok_and(|s| s.success());
+                if !ok {
+                    bail!("`rustup target add {}` failed", missing.join(" "));
+                }
+            }
+        }
+        _ => eprintln!(
+            "warning: rustup not found; the firmware needs the Rust targets {} installed",
+            targets.join(", ")
+        ),
+    }
+    if runs("qemu-system-arm", "--version") {
+        return Ok(None);
+    }
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    if root && std::env::var_os("CI").is_some() && runs("apt-get", "--version") {
+        eprintln!("qemu-system-arm missing; CI as root: apt-get install -y qemu-system-arm");
+        let ok = Command::new("apt-get")
+            .args(["update", "-qq"])
+            .status()
+            .is_ok_and(|s| s.success())
+            && Command::new("apt-get")
+                .args(["install", "-y", "-qq", "qemu-system-arm"])
+                .env("DEBIAN_FRONTEND", "noninteractive")
+                .status()
+                .is_ok_and(|s| s.success());
+        if ok && runs("qemu-system-arm", "--version") {
+            return Ok(None);
+        }
+        bail!("apt-get install qemu-system-arm failed");
+    }
+    eprintln!(
+        "error: qemu-system-arm (QEMU's Arm system emulator, 7.2 or newer) is not installed.\n\
+         Install it with:\n\n    {QEMU_INSTALL}\n\n\
+         (Debian/Ubuntu; Fedora: sudo dnf install qemu-system-arm; macOS: brew install qemu),\n\
+         then run this command again."
+    );
+    Ok(Some(ExitCode::from(2)))
+}
+
 #[derive(Debug)]
 pub struct Run {
     /// QEMU's exit code (the firmware's semihosting exit code: 0 done, 2 host I/O failed,
@@ -374,73 +481,173 @@ pub fn decode_defmt(elf: &[u8], stream: &[u8]) -> Result<Vec<String>> {
 }
 
 /// A case run on a board and compared with the host reference.
-#[derive(Debug)]
-pub struct Checked {
-    /// Case name.
-    pub case: String,
-    /// How the board's output relates to the reference.
-    pub verdict: Verdict,
-    /// The board's outcome (with measurements), if it wrote one.
-    pub outcome: Option<Outcome>,
-    /// The run.
-    pub run: Run,
-}
-
-impl Checked {
-    /// Instructions inside `Workspace::simplify`, from the SysTick ticks.
-    pub fn instructions(&self, board: &Board) -> Option<u64> {
-        let o = self.outcome.as_ref()?;
-        Some((o.header.ticks as f64 * board.instructions_per_tick()).round() as u64)
-    }
-}
-
-/// Runs `case` on `board` and compares with `expected` (the host reference if `None`).
-pub fn check_case(
+/// Runs one case on `board`: the decoded outcome (if the firmware exited 0 and wrote a result)
+/// and the run.
+pub fn run_case(
     board: &Board,
     elf: &Path,
     case: &Case,
-    expected: Option<&Outcome>,
     timeout: Duration,
-) -> Result<Checked> {
-    let reference;
-    let expected = match expected {
-        Some(e) => e,
-        None => {
-            reference = golden::reference(case)?;
-            &reference
-        }
-    };
+) -> Result<(Option<Outcome>, Run)> {
     let run = run_case_bytes(board, elf, &case.encode()?, timeout)?;
     let outcome = match (&run.result, run.ok()) {
         (Some(bytes), true) => Some(Outcome::decode(bytes)?),
         _ => None,
     };
-    let verdict = match &outcome {
-        Some(o) => golden::compare(expected, o),
-        None => Verdict::Mismatch(vec![format!("no result: {}", run.describe())]),
-    };
-    Ok(Checked {
-        case: case.name.clone(),
-        verdict,
-        outcome,
-        run,
-    })
+    Ok((outcome, run))
 }
 
-/// Builds the firmware for `board` and checks every case; prints one line per case.
-/// Returns how many cases failed (mismatch or crash; "too big" is not a failure).
-pub fn check_board(
-    board: &Board,
+impl Board {
+    /// Instructions in `ticks` SysTick ticks.
+    pub fn instructions(&self, ticks: u64) -> u64 {
+        (ticks as f64 * self.instructions_per_tick()).round() as u64
+    }
+}
+
+/// What the boards' outputs are compared with.
+#[derive(Clone, Debug)]
+pub enum Expected {
+    /// The golden files in this directory (`<backend>/<case>.txt|.bin`); the host is checked
+    /// against them too.
+    Golden(PathBuf),
+    /// A fresh run of the library on the host.
+    Host,
+}
+
+/// Runs `cases` on the host and on every board in `boards` and compares each output with the
+/// expectation. Prints a table cases × (host, boards) of identical / skipped / DIFF / FAILED,
+/// then a line for every cell that is not identical (board, case, first differing triangle or
+/// why it was skipped). Returns how many cells are DIFF or FAILED.
+pub fn check(
+    boards: &[&'static Board],
+    backend: Backend,
     cases: &[Case],
+    expected: &Expected,
     timeout: Duration,
     verbose: bool,
 ) -> Result<usize> {
-    let elf = build(board, true)?;
-    let mut failed = 0;
+    let mut expect: Vec<Option<Golden>> = Vec::new();
+    let mut host = Vec::new();
     for case in cases {
-        let c = check_case(board, &elf, case, None, timeout)?;
-        failed += print_checked(board, &c, verbose);
+        let now = golden::reference(case)?;
+        match expected {
+            Expected::Golden(dir) => match Golden::load(dir, backend, &case.name)? {
+                Some(g) => {
+                    host.push(golden::judge(case, backend, &g, &now)?);
+                    expect.push(Some(g));
+                }
+                None => {
+                    host.push(Verdict::Failed(format!(
+                        "no golden files {}/{backend}/{}.txt|.bin",
+                        dir.display(),
+                        case.name
+                    )));
+                    expect.push(None);
+                }
+            },
+            Expected::Host => {
+                host.push(Verdict::Identical);
+                expect.push(Some(Golden::of(case, backend, &now)?));
+            }
+        }
     }
+    let mut columns: Vec<(String, Vec<Verdict>)> = vec![("host".into(), host)];
+    for b in boards {
+        let t0 = Instant::now();
+        // A failed build or QEMU start fails this board's column, not the whole check.
+        let elf = match build(b, backend, true) {
+            Ok(elf) => elf,
+            Err(e) => {
+                let why = format!("firmware build failed: {e:#}");
+                eprintln!("{:<12} {why}", b.name);
+                columns.push((
+                    b.name.to_string(),
+                    cases.iter().map(|_| Verdict::Failed(why.clone())).collect(),
+                ));
+                continue;
+            }
+        };
+        let built = t0.elapsed();
+        let mut col = Vec::new();
+        for (case, exp) in cases.iter().zip(&expect) {
+            let v = match (run_case(b, &elf, case, timeout), exp) {
+                (Err(e), _) => Verdict::Failed(format!("{e:#}")),
+                (Ok((None, run)), _) => Verdict::Failed(format!("no result: {}", run.describe())),
+                (Ok((Some(o), run)), Some(g)) => {
+                    if verbose {
+                        println!("{} / {}: {}", b.name, case.name, run.describe());
+                    }
+                    golden::judge(case, backend, g, &o)?
+                }
+                (Ok(_), None) => Verdict::Failed("no golden files".into()),
+            };
+            col.push(v);
+        }
+        eprintln!(
+            "{:<12} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
+            b.name,
+            built.as_secs_f64(),
+            cases.len(),
+            (t0.elapsed() - built).as_secs_f64()
+        );
+        columns.push((b.name.to_string(), col));
+    }
+
+    let what = match expected {
+        Expected::Golden(dir) => format!("golden files {}/{backend}", dir.display()),
+        Expected::Host => format!("the library on the host ({backend})"),
+    };
+    println!("\ncases x boards, compared with {what}:\n");
+    let name_w = cases.iter().map(|c| c.name.len()).max().unwrap_or(4).max(4);
+    let col_w: Vec<usize> = columns.iter().map(|(n, _)| n.len().max(9)).collect();
+    let mut line = format!("{:<name_w$}", "case");
+    for ((n, _), w) in columns.iter().zip(&col_w) {
+        line.push_str(&format!("  {n:<w$}"));
+    }
+    println!("{}", line.trim_end());
+    for (i, case) in cases.iter().enumerate() {
+        let mut line = format!("{:<name_w$}", case.name);
+        for ((_, col), w) in columns.iter().zip(&col_w) {
+            line.push_str(&format!("  {:<w$}", col[i].cell()));
+        }
+        println!("{}", line.trim_end());
+    }
+    let (mut same, mut skipped, mut failed) = (0, 0, 0);
+    let mut details = Vec::new();
+    for (n, col) in &columns {
+        for (case, v) in cases.iter().zip(col) {
+            match v {
+                Verdict::Identical => same += 1,
+                Verdict::Skipped(why) => {
+                    skipped += 1;
+                    details.push(format!("skipped  {n} / {}: {why}", case.name));
+                }
+                Verdict::Diff(d) => {
+                    failed += 1;
+                    details.push(format!(
+                        "DIFF     {n} / {}: {}",
+                        case.name,
+                        d.join("\n           ")
+                    ));
+                }
+                Verdict::Failed(why) => {
+                    failed += 1;
+                    details.push(format!(
+                        "FAILED   {n} / {}: {}",
+                        case.name,
+                        why.replace('\n', "\n           ")
+                    ));
+                }
+            }
+        }
+    }
+    println!();
+    for d in &details {
+        println!("{d}");
+    }
+    println!(
+        "{backend}: {same} identical, {skipped} skipped (too big for the board), {failed} DIFF or FAILED"
+    );
     Ok(failed)
 }
 
@@ -546,23 +753,27 @@ pub fn calibrate(board: &Board, elf: &Path) -> Result<f64> {
 }
 
 /// What `host-sim qemu --measure` reports for one board.
+/// What `host-sim qemu --measure` reports for one board.
 #[derive(Clone, Debug)]
 pub struct Measurement {
     /// Board.
     pub board: &'static Board,
-    /// Image sizes.
+    /// Math backend.
+    pub backend: Backend,
+    /// Image sizes of the firmware with the library.
     pub sizes: Sizes,
+    /// Image sizes of the same firmware without the library (it echoes its input).
+    pub sizes_without: Sizes,
     /// Measured instructions per SysTick tick.
     pub instructions_per_tick: f64,
-    /// Workspace bytes.
+    /// Workspace bytes (the library's static RAM on this board).
     pub workspace_bytes: u32,
-    /// Stack available (RAM − static RAM).
-    pub stack_available: u64,
-    /// Capacity: vertices, u16 triangles.
-    pub capacity: (u32, u32),
-    /// Per case: name, triangles in → out, instructions, stack bytes in `simplify`,
-    /// stack high-water mark from the top, verdict.
+    /// Capacity: vertices, u16 triangles, u32 triangles.
+    pub capacity: (u32, u32, u32),
+    /// Per case.
     pub cases: Vec<CaseMeasurement>,
+    /// The largest mesh, per index type.
+    pub largest: Vec<Largest>,
 }
 
 /// One measured case.
@@ -574,21 +785,152 @@ pub struct CaseMeasurement {
     pub triangles_in: u32,
     /// Triangles out.
     pub triangles_out: u32,
-    /// Instructions inside `simplify`.
+    /// Collapses.
+    pub collapses: u32,
+    /// Instructions inside `Workspace::simplify`.
     pub instructions: u64,
-    /// Stack used by `simplify` (below its caller's frame).
+    /// Stack used by the library (below its caller's frame).
     pub stack_bytes: u32,
-    /// Deepest stack use of the whole firmware so far.
+    /// Deepest stack use of the whole firmware, from the top of the stack.
     pub stack_high_water: u32,
-    /// Matches the host reference.
-    pub matches: bool,
-    /// Host wall time of the QEMU run.
+    /// `identical` to the host, `skipped` (too big), `DIFF` or `FAILED`.
+    pub verdict: &'static str,
+    /// Why it was skipped or failed.
+    pub note: String,
+}
+
+/// The largest mesh a board simplifies, found by bisection.
+#[derive(Clone, Debug)]
+pub struct Largest {
+    /// Index type of the probes.
+    pub index_type: IndexType,
+    /// Largest success: vertices, triangles, instructions.
+    pub ok: Option<(usize, usize, u64)>,
+    /// Smallest failure: vertices, triangles, why.
+    pub fail: Option<(usize, usize, String)>,
+    /// QEMU runs.
+    pub probes: u32,
+    /// Host time of the search.
     pub wall: Duration,
 }
 
-/// Measures a board: sizes, calibration, the built-in cases and the largest grid it holds.
-pub fn measure(board: &'static Board, timeout: Duration) -> Result<Measurement> {
-    let elf = build(board, true)?;
+/// The generated mesh of the capacity search: `strip T` (exactly `t` triangles, ≈ t/2
+/// vertices), simplified with `Config::new()`.
+pub fn probe_case(t: usize, index_type: IndexType) -> Case {
+    let m = meshfmt::golden::strip(t);
+    Case {
+        name: format!("strip-{t}"),
+        mesh: format!("strip {t}"),
+        positions: m.positions,
+        triangles: m.triangles,
+        index_type,
+        config: tinydecimate::Config::new(),
+    }
+}
+
+/// One capacity probe: `Ok((vertices, triangles, instructions))` if the board simplified
+/// it, `Err((vertices, why))` if not.
+type Probe = std::result::Result<(usize, usize, u64), (usize, String)>;
+
+/// Bisects the triangle count of [`probe_case`] until a run fails (the mesh does not fit, the
+/// library reports an error, or the firmware crashes or times out). Nothing is assumed about
+/// the board's capacity: doubling from 64 triangles finds a failure, bisection the boundary.
+pub fn largest_mesh(
+    board: &Board,
+    elf: &Path,
+    index_type: IndexType,
+    timeout: Duration,
+) -> Result<Largest> {
+    const LIMIT: usize = 4_000_000;
+    let t0 = Instant::now();
+    let mut probes = 0;
+    let mut probe = |t: usize| -> Result<Probe> {
+        probes += 1;
+        let case = probe_case(t, index_type);
+        let v = case.positions.len();
+        if index_type == IndexType::U16 && v > 1 << 16 {
+            return Ok(Err((v, "more vertices than u16 indices reach".into())));
+        }
+        let (outcome, run) = run_case(board, elf, &case, timeout)?;
+        Ok(match outcome {
+            Some(o) if o.header.status == Status::Ok => {
+                Ok((v, t, board.instructions(o.header.ticks)))
+            }
+            Some(o) if o.header.status == Status::TooBig => Err((
+                v,
+                format!(
+                    "too big for the buffers (holds {} vertices, {} triangles)",
+                    o.header.capacity_vertices, o.header.capacity_triangles
+                ),
+            )),
+            Some(o) => Err((
+                v,
+                format!("{:?} {:?}", o.header.status, o.header.error_kind),
+            )),
+            None => Err((
+                v,
+                format!(
+                    "firmware exit {:?}{}",
+                    run.exit_code,
+                    if run.timed_out { " (timed out)" } else { "" }
+                ),
+            )),
+        })
+    };
+    let (mut ok, mut lo) = (None, 0usize);
+    let mut fail = None;
+    let mut t = 64usize;
+    loop {
+        match probe(t)? {
+            Ok(r) => {
+                ok = Some(r);
+                lo = t;
+                if t >= LIMIT {
+                    break;
+                }
+                t = (t * 2).min(LIMIT);
+            }
+            Err((v, why)) => {
+                fail = Some((v, t, why));
+                break;
+            }
+        }
+    }
+    if let Some((_, mut hi, _)) = fail {
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match probe(mid)? {
+                Ok(r) => {
+                    ok = Some(r);
+                    lo = mid;
+                }
+                Err((v, why)) => {
+                    fail = Some((v, mid, why));
+                    hi = mid;
+                }
+            }
+        }
+    }
+    Ok(Largest {
+        index_type,
+        ok,
+        fail,
+        probes,
+        wall: t0.elapsed(),
+    })
+}
+
+/// Measures a board: image sizes with and without the library, calibration, every case of the
+/// manifest (compared with a fresh host run), and the largest mesh per index type.
+pub fn measure(
+    board: &'static Board,
+    backend: Backend,
+    cases: &[Case],
+    timeout: Duration,
+) -> Result<Measurement> {
+    let without = build(board, backend, false)?;
+    let sizes_without = elf_sizes(&std::fs::read(&without)?)?;
+    let elf = build(board, backend, true)?;
     let sizes = elf_sizes(&std::fs::read(&elf)?)?;
     // The calibration loop carries a few instructions of overhead, so it measures slightly
     // over the exact figure; it only has to confirm the board's clock.
@@ -601,86 +943,221 @@ pub fn measure(board: &'static Board, timeout: Duration) -> Result<Measurement> 
             board.name
         );
     }
-    let mut cases = golden::builtin_cases();
-    cases.retain(|c| c.name != "grid8-bad-index-u16");
-    // Learn the capacity from a first run, then add the largest grid that fits.
-    let probe = check_case(board, &elf, &cases[0], None, timeout)?;
-    let head = probe
-        .outcome
-        .as_ref()
-        .map(|o| o.header.clone())
-        .ok_or_else(|| anyhow!("{} failed: {}", board.name, probe.run.describe()))?;
-    let cap_v = head.capacity_vertices;
-    let cap_t = head.capacity_triangles; // u16, the index type of cases[0]
-    cases.push(golden::largest_grid_case(
-        cap_v as usize,
-        cap_t as usize,
-        IndexType::U16,
-    ));
     let mut out = Vec::new();
-    let mut workspace_bytes = head.workspace_bytes;
-    for case in &cases {
-        let c = check_case(board, &elf, case, None, timeout)?;
-        let Some(o) = &c.outcome else {
-            bail!("{} / {}: {}", board.name, case.name, c.run.describe());
-        };
-        if o.header.status == Status::TooBig {
+    let (mut workspace_bytes, mut capacity) = (0, (0, 0, 0));
+    for case in cases {
+        let expected = Golden::of(case, backend, &golden::reference(case)?)?;
+        let (outcome, run) = run_case(board, &elf, case, timeout)?;
+        let Some(o) = outcome else {
+            out.push(CaseMeasurement {
+                name: case.name.clone(),
+                triangles_in: case.triangles.len() as u32,
+                triangles_out: 0,
+                collapses: 0,
+                instructions: 0,
+                stack_bytes: 0,
+                stack_high_water: 0,
+                verdict: "FAILED",
+                note: run.describe(),
+            });
             continue;
+        };
+        let h = &o.header;
+        if h.status != Status::TooBig {
+            workspace_bytes = h.workspace_bytes;
         }
-        workspace_bytes = o.header.workspace_bytes;
+        let it_cap = h.capacity_triangles;
+        match case.index_type {
+            IndexType::U16 => capacity = (h.capacity_vertices, it_cap, capacity.2),
+            IndexType::U32 => capacity = (h.capacity_vertices, capacity.1, it_cap),
+        }
+        let v = golden::judge(case, backend, &expected, &o)?;
         out.push(CaseMeasurement {
             name: case.name.clone(),
-            triangles_in: o.header.triangles_in,
-            triangles_out: o.header.triangles_out,
-            instructions: (o.header.ticks as f64 * ipt).round() as u64,
-            stack_bytes: o.header.stack_bytes,
-            stack_high_water: o.header.stack_high_water,
-            matches: c.verdict == Verdict::Match,
-            wall: c.run.wall,
+            triangles_in: h.triangles_in,
+            triangles_out: h.triangles_out,
+            collapses: h.collapses,
+            instructions: board.instructions(h.ticks),
+            stack_bytes: h.stack_bytes,
+            stack_high_water: h.stack_high_water,
+            verdict: v.cell(),
+            note: match &v {
+                Verdict::Skipped(w) | Verdict::Failed(w) => w.clone(),
+                Verdict::Diff(d) => d.join("; "),
+                Verdict::Identical => String::new(),
+            },
         });
+    }
+    let mut largest = Vec::new();
+    for it in [IndexType::U16, IndexType::U32] {
+        let l = largest_mesh(board, &elf, it, timeout)?;
+        eprintln!(
+            "{}: largest {} mesh found in {} QEMU runs, {:.1} s",
+            board.name,
+            if it == IndexType::U16 { "u16" } else { "u32" },
+            l.probes,
+            l.wall.as_secs_f64()
+        );
+        largest.push(l);
     }
     Ok(Measurement {
         board,
-        stack_available: u64::from(board.ram).saturating_sub(sizes.static_ram),
+        backend,
         sizes,
-        instructions_per_tick: ipt,
+        sizes_without,
+        instructions_per_tick: measured,
         workspace_bytes,
-        capacity: (cap_v, cap_t),
+        capacity,
         cases: out,
+        largest,
     })
 }
 
-/// Prints a measurement as a small table.
+/// Signed difference of two sizes.
+fn delta(a: u64, b: u64) -> i64 {
+    a as i64 - b as i64
+}
+
+/// Prints a measurement: sizes, then one line per case, then the largest meshes.
 pub fn print_measurement(m: &Measurement) {
     let b = m.board;
+    let (s, w) = (&m.sizes, &m.sizes_without);
     println!(
-        "{} ({}, {}): flash {} B (text {}, rodata {}), static RAM {} B (workspace {}), stack {} B free of {} KB RAM",
-        b.name,
-        b.core,
-        b.target,
-        m.sizes.flash,
-        m.sizes.text,
-        m.sizes.rodata,
-        m.sizes.static_ram,
-        m.workspace_bytes,
-        m.stack_available,
-        b.ram >> 10
+        "\n== {} ({}, {}), {} backend",
+        b.name, b.core, b.target, m.backend
     );
     println!(
-        "  capacity {} vertices / {} u16 triangles; {:.3} instructions per SysTick tick",
-        m.capacity.0, m.capacity.1, m.instructions_per_tick
+        "firmware:      flash {:>8} B (text {}, rodata {}, .data image {}), static RAM {:>8} B of {} KB, stack {} B",
+        s.flash,
+        s.text,
+        s.rodata,
+        s.data,
+        s.static_ram,
+        b.ram >> 10,
+        u64::from(b.ram).saturating_sub(s.static_ram)
+    );
+    let lib_stack = m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0);
+    println!(
+        "library alone: flash {:>8} B (text {:+}, rodata {:+}), static RAM {:>8} B (workspace {} B) + stack <= {} B \
+         [image with the library - image without]",
+        delta(s.flash, w.flash),
+        delta(s.text, w.text),
+        delta(s.rodata, w.rodata),
+        delta(s.static_ram, w.static_ram),
+        m.workspace_bytes,
+        lib_stack
+    );
+    println!(
+        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per SysTick tick (calibrated)",
+        m.capacity.0, m.capacity.1, m.capacity.2, m.instructions_per_tick
+    );
+    println!(
+        "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  vs host",
+        "case", "in", "out", "collapses", "instructions", "instr/coll", "stack lib", "high-water"
     );
     for c in &m.cases {
+        if c.verdict == "skipped" || c.verdict == "FAILED" {
+            println!(
+                "  {:<26} {:>6}  {}: {}",
+                c.name, c.triangles_in, c.verdict, c.note
+            );
+            continue;
+        }
+        let per = if c.collapses > 0 {
+            format!("{}", c.instructions / u64::from(c.collapses))
+        } else {
+            "-".into()
+        };
         println!(
-            "  {:<28} {:>6} -> {:<6} {:>12} instr  stack {:>5} B (high-water {:>5} B)  {}  {:.2} s",
+            "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  {}",
             c.name,
             c.triangles_in,
             c.triangles_out,
+            c.collapses,
             c.instructions,
+            per,
             c.stack_bytes,
             c.stack_high_water,
-            if c.matches { "= host" } else { "DIFFERS" },
-            c.wall.as_secs_f64()
+            c.verdict
+        );
+    }
+    for l in &m.largest {
+        let it = if l.index_type == IndexType::U16 {
+            "u16"
+        } else {
+            "u32"
+        };
+        let ok = match l.ok {
+            Some((v, t, i)) => format!("{t} triangles / {v} vertices simplify ({i} instructions)"),
+            None => "nothing simplifies".into(),
+        };
+        let fail = match &l.fail {
+            Some((v, t, why)) => format!("{t} / {v} fail: {why}"),
+            None => "no failure up to the search limit".into(),
+        };
+        println!(
+            "largest {it} mesh (bisecting `strip T`, Config::new()): {ok}; {fail} [{} runs, {:.1} s]",
+            l.probes,
+            l.wall.as_secs_f64()
+        );
+    }
+}
+
+/// The summary table of several boards' measurements.
+pub fn print_summary(ms: &[Measurement]) {
+    if ms.is_empty() {
+        return;
+    }
+    println!(
+        "\nsummary ({} backend); sizes in bytes; instr/collapse over the cases run (min..max)",
+        ms[0].backend
+    );
+    println!(
+        "{:<12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+        "board",
+        "fw flash",
+        "fw RAM",
+        "lib flash",
+        "lib RAM",
+        "lib stack",
+        "instr/collapse",
+        "high-water",
+        "largest u16",
+        "largest u32"
+    );
+    for m in ms {
+        let per: Vec<u64> = m
+            .cases
+            .iter()
+            .filter(|c| c.collapses > 0)
+            .map(|c| c.instructions / u64::from(c.collapses))
+            .collect();
+        let range = match (per.iter().min(), per.iter().max()) {
+            (Some(a), Some(b)) => format!("{a}..{b}"),
+            _ => "-".into(),
+        };
+        let largest = |i: usize| {
+            m.largest
+                .get(i)
+                .and_then(|l| l.ok)
+                .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
+        };
+        println!(
+            "{:<12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+            m.board.name,
+            m.sizes.flash,
+            m.sizes.static_ram,
+            delta(m.sizes.flash, m.sizes_without.flash),
+            delta(m.sizes.static_ram, m.sizes_without.static_ram),
+            m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0),
+            range,
+            m.cases
+                .iter()
+                .map(|c| c.stack_high_water)
+                .max()
+                .unwrap_or(0),
+            largest(0),
+            largest(1)
         );
     }
 }
@@ -692,20 +1169,25 @@ pub struct Args {
     /// (microbit, lm3s6965evb, mps2-an386, mps2-an500, mps2-an505).
     #[arg(long = "board", value_name = "MACHINE")]
     pub boards: Vec<String>,
-    /// Measure instructions (SysTick, -icount shift=0), stack high-water mark, image sizes and
-    /// the largest mesh each board simplifies.
+    /// Math backend of the library (default: the one host-sim was built with). Another one
+    /// re-runs host-sim through `cargo run` with or without `--features micromath`; the
+    /// firmware is built with the same backend.
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    /// Compare every board's output (and the host's) with the golden files; print a table
+    /// cases x boards. Exit 1 on any DIFF or failure. Without it, the boards are compared with
+    /// a fresh host run.
+    #[arg(long, conflicts_with_all = ["mesh", "measure", "smoke", "handlers"])]
+    pub check: bool,
+    /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
+    /// collapse and stack; per board the image sizes of the firmware and of the library alone,
+    /// and the largest mesh it simplifies (bisection). Not pass/fail.
     #[arg(long)]
     pub measure: bool,
-    /// Compare with the stored goldens (see --golden-dir) instead of a fresh host run.
-    #[arg(long)]
-    pub golden: bool,
-    /// Recompute the built-in cases' goldens on the host and store them, then stop.
-    #[arg(long)]
-    pub bless: bool,
-    /// Directory of the stored goldens (`<case>.case` + `<case>.golden`).
+    /// The golden directory (`cases.toml`, `libm/`, `micromath/`).
     #[arg(long, value_name = "DIR", default_value_os_t = golden::default_dir())]
-    pub golden_dir: PathBuf,
-    /// Run this mesh (.obj/.ply/.stl) instead of the built-in cases.
+    pub dir: PathBuf,
+    /// Run this mesh (.obj/.ply/.stl) instead of the golden cases.
     #[arg(long)]
     pub mesh: Option<PathBuf>,
     /// With --mesh: target ratio.
@@ -731,28 +1213,41 @@ pub struct Args {
     pub verbose: bool,
 }
 
-/// Runs `host-sim qemu`. Exit code 1 when a board differs from the reference or a run fails.
-pub fn run(a: &Args) -> Result<ExitCode> {
-    let boards: Vec<&'static Board> = if a.boards.is_empty() {
-        BOARDS.iter().collect()
+/// The boards named in `names`, or all of them.
+pub fn select_boards(names: &[String]) -> Result<Vec<&'static Board>> {
+    if names.is_empty() {
+        Ok(BOARDS.iter().collect())
     } else {
-        a.boards.iter().map(|n| board(n)).collect::<Result<_>>()?
-    };
+        names.iter().map(|n| board(n)).collect()
+    }
+}
+
+/// Runs `host-sim qemu`. Exit code 1 when a board differs or a run fails, 2 on errors (or
+/// when QEMU is missing).
+pub fn run(a: &Args) -> Result<ExitCode> {
+    let backend = a.backend.unwrap_or(Backend::compiled());
+    if backend != Backend::compiled() {
+        return golden::reinvoke(backend);
+    }
+    let boards = select_boards(&a.boards)?;
+    if let Some(code) = preflight(&boards)? {
+        return Ok(code);
+    }
     let timeout = Duration::from_secs(a.timeout);
     let mut failed = 0usize;
-    if a.bless {
-        let n = golden::bless(&a.golden_dir)?;
-        println!("wrote {n} cases to {}", a.golden_dir.display());
-        return Ok(ExitCode::SUCCESS);
-    }
     if a.measure {
+        let cases = golden::load_cases(&a.dir)?;
+        let mut all = Vec::new();
         for b in &boards {
-            print_measurement(&measure(b, timeout)?);
+            let m = measure(b, backend, &cases, timeout)?;
+            print_measurement(&m);
+            all.push(m);
         }
+        print_summary(&all);
     } else if a.smoke {
-        let case = &golden::builtin_cases()[0];
+        let case = &golden::load_cases(&a.dir)?[0];
         for b in &boards {
-            let elf = build(b, false)?;
+            let elf = build(b, backend, false)?;
             let run = run_case_bytes(b, &elf, &case.encode()?, timeout)?;
             let echoed = match run.result.as_deref().filter(|_| run.ok()) {
                 Some(bytes) => Outcome::decode(bytes)?.triangles == case.triangles,
@@ -770,7 +1265,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         }
     } else if a.handlers {
         for b in &boards {
-            let elf = build(b, true)?;
+            let elf = build(b, backend, true)?;
             for (cmd, want) in [
                 ("selftest", EXIT_DONE),
                 ("panic", EXIT_PANIC),
@@ -807,47 +1302,22 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 if ok { "ok" } else { "FAILED" }
             );
         }
-    } else if a.golden {
-        let stored = golden::load_dir(&a.golden_dir)?;
-        for b in &boards {
-            let elf = build(b, true)?;
-            for s in &stored {
-                let c = check_case(b, &elf, &s.case()?, Some(&s.golden), timeout)?;
-                failed += print_checked(b, &c, a.verbose);
-            }
-        }
     } else {
-        let cases = match &a.mesh {
-            Some(path) => {
-                let m = crate::io::load(path)?;
-                let config = tinydecimate::Config::new()
-                    .with_ratio(a.ratio)
-                    .with_schedule(if a.passes {
-                        tinydecimate::Schedule::Passes
-                    } else {
-                        tinydecimate::Schedule::Greedy
-                    });
-                vec![Case {
-                    name: path
-                        .file_stem()
-                        .unwrap_or_default()
-                        .to_string_lossy()
-                        .into_owned(),
-                    positions: m.positions,
-                    triangles: m.triangles,
-                    index_type: if a.u32 {
-                        IndexType::U32
-                    } else {
-                        IndexType::U16
-                    },
-                    config,
-                }]
-            }
-            None => golden::builtin_cases(),
+        let (cases, expected) = match &a.mesh {
+            Some(path) => (
+                vec![mesh_case(path, a.ratio, a.passes, a.u32)?],
+                Expected::Host,
+            ),
+            None => (
+                golden::load_cases(&a.dir)?,
+                if a.check {
+                    Expected::Golden(a.dir.clone())
+                } else {
+                    Expected::Host
+                },
+            ),
         };
-        for b in &boards {
-            failed += check_board(b, &cases, timeout, a.verbose)?;
-        }
+        failed = check(&boards, backend, &cases, &expected, timeout, a.verbose)?;
     }
     Ok(if failed == 0 {
         ExitCode::SUCCESS
@@ -857,32 +1327,28 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     })
 }
 
-/// One line per checked case; returns 1 for a failure.
-fn print_checked(board: &Board, c: &Checked, verbose: bool) -> usize {
-    let (what, failed) = match &c.verdict {
-        Verdict::Match => ("ok".to_string(), 0),
-        Verdict::TooBig => ("too big for this board (skipped)".to_string(), 0),
-        Verdict::Mismatch(d) => (format!("MISMATCH\n    {}", d.join("\n    ")), 1),
-    };
-    let instr = c
-        .instructions(board)
-        .map(|i| format!(", {i} instructions"))
-        .unwrap_or_default();
-    let stack = c
-        .outcome
-        .as_ref()
-        .map(|o| format!(", stack {} B", o.header.stack_bytes))
-        .unwrap_or_default();
-    println!("{:<12} {:<28} {what}{instr}{stack}", board.name, c.case);
-    if !c.run.stderr.trim().is_empty() && verbose {
-        println!("    qemu: {}", c.run.stderr.trim());
-    }
-    if verbose || failed > 0 {
-        for l in &c.run.log {
-            println!("    | {l}");
-        }
-    }
-    failed
+/// A case of a mesh file with `Config::new()` and the given ratio and schedule.
+pub fn mesh_case(path: &Path, ratio: f32, passes: bool, u32: bool) -> Result<Case> {
+    let m = crate::io::load(path)?;
+    let config = tinydecimate::Config::new()
+        .with_ratio(ratio)
+        .with_schedule(if passes {
+            tinydecimate::Schedule::Passes
+        } else {
+            tinydecimate::Schedule::Greedy
+        });
+    Ok(Case {
+        name: path
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned(),
+        mesh: path.display().to_string(),
+        positions: m.positions,
+        triangles: m.triangles,
+        index_type: if u32 { IndexType::U32 } else { IndexType::U16 },
+        config,
+    })
 }
 
 #[cfg(test)]

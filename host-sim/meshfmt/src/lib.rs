@@ -64,6 +64,10 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+/// Mesh generators of the golden cases (host side).
+#[cfg(feature = "std")]
+pub mod golden;
+
 /// Case file magic.
 pub const CASE_MAGIC: [u8; 4] = *b"TDCS";
 /// Result file magic.

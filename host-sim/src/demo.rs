@@ -1,0 +1,323 @@
+//! `host-sim demo [MESH]`: the first impression. Simplifies one mesh (default
+//! `tests/fixtures/cow.obj`, 5804 triangles) with the library on the host and on an emulated
+//! Cortex-M4F (QEMU `mps2-an386`, 4 MB), prints both reports side by side and whether the two
+//! outputs are byte-identical (exit 1 if not).
+//!
+//! On a fresh machine it first makes sure the tools are there ([`qemu::preflight`]): a missing
+//! Rust target is installed with `rustup target add`; a missing `qemu-system-arm` is installed
+//! with apt-get only when running as root with `CI` set, otherwise the exact install command is
+//! printed and the exit status is 2.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use meshfmt::{IndexType, Status};
+use tinydecimate::Config;
+
+use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
+use crate::qemu;
+
+/// `host-sim demo`.
+#[derive(Clone, Debug, clap::Args)]
+pub struct Args {
+    /// Mesh file (.obj, .ply, .stl). Default: tests/fixtures/cow.obj. A mesh larger than the
+    /// board holds is cut to its first triangles that fit (and says so).
+    pub mesh: Option<PathBuf>,
+    /// Board (QEMU machine).
+    #[arg(long, default_value = qemu::REFERENCE_BOARD, value_name = "MACHINE")]
+    pub board: String,
+    /// Target ratio (default: the configuration's, 0.1).
+    #[arg(long)]
+    pub ratio: Option<f32>,
+    /// `Config::paper()` (passes, λ = 1) instead of `Config::new()`.
+    #[arg(long)]
+    pub paper: bool,
+    /// u32 triangles (default u16; u32 anyway above 65535 vertices).
+    #[arg(long)]
+    pub u32: bool,
+    /// Math backend of the library (default: the one host-sim was built with).
+    #[arg(long, value_enum)]
+    pub backend: Option<Backend>,
+    /// Seconds before the QEMU run is killed.
+    #[arg(long, default_value_t = 600)]
+    pub timeout: u64,
+    /// Print the firmware's decoded defmt log.
+    #[arg(long, short)]
+    pub verbose: bool,
+}
+
+/// The first triangles of `case` that fit `max_vertices` / `max_triangles`, unused vertices
+/// dropped.
+pub fn subset_that_fits(case: &Case, max_vertices: usize, max_triangles: usize) -> Case {
+    let mut seen = std::collections::HashSet::new();
+    let mut k = 0;
+    for t in case.triangles.iter().take(max_triangles) {
+        let new = t.iter().filter(|i| !seen.contains(*i)).count();
+        if seen.len() + new > max_vertices {
+            break;
+        }
+        seen.extend(t.iter().copied());
+        k += 1;
+    }
+    let mut m = meshfmt::golden::Mesh {
+        positions: case.positions.clone(),
+        triangles: case.triangles[..k].to_vec(),
+    };
+    meshfmt::golden::compact(&mut m);
+    Case {
+        name: format!("{}-first{k}", case.name),
+        mesh: format!("{}, first {k} triangles", case.mesh),
+        positions: m.positions,
+        triangles: m.triangles,
+        index_type: case.index_type,
+        config: case.config,
+    }
+}
+
+/// Groups digits by thousands.
+fn thousands(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Runs `host-sim demo`.
+pub fn run(a: &Args) -> Result<ExitCode> {
+    let backend = a.backend.unwrap_or(Backend::compiled());
+    if backend != Backend::compiled() {
+        return golden::reinvoke(backend);
+    }
+    let board = qemu::board(&a.board)?;
+    if let Some(code) = qemu::preflight(&[board])? {
+        return Ok(code);
+    }
+    let path = a
+        .mesh
+        .clone()
+        .unwrap_or_else(|| golden::repo_root().join("tests/fixtures/cow.obj"));
+    let m = crate::io::load(&path)?;
+    let index_type = if a.u32 || m.positions.len() > usize::from(u16::MAX) {
+        IndexType::U32
+    } else {
+        IndexType::U16
+    };
+    let mut config = if a.paper {
+        Config::paper()
+    } else {
+        Config::new()
+    };
+    if let Some(r) = a.ratio {
+        config = config.with_ratio(r);
+    }
+    let mut case = Case {
+        name: path
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned(),
+        mesh: path.display().to_string(),
+        positions: m.positions,
+        triangles: m.triangles,
+        index_type,
+        config,
+    };
+    let timeout = Duration::from_secs(a.timeout);
+
+    eprintln!(
+        "building the firmware for {} ({}, {backend}) ...",
+        board.name, board.core
+    );
+    let elf = qemu::build(board, backend, true)?;
+    let mut ran = qemu::run_case(board, &elf, &case, timeout)?;
+    if let (Some(o), _) = &ran {
+        if o.header.status == Status::TooBig {
+            let (v, t) = (
+                o.header.capacity_vertices as usize,
+                o.header.capacity_triangles as usize,
+            );
+            let sub = subset_that_fits(&case, v, t);
+            println!(
+                "{} has {} vertices / {} triangles; {} holds {v} / {t}: using its first {} triangles ({} vertices)",
+                case.mesh,
+                case.positions.len(),
+                case.triangles.len(),
+                board.name,
+                sub.triangles.len(),
+                sub.positions.len()
+            );
+            case = sub;
+            ran = qemu::run_case(board, &elf, &case, timeout)?;
+        }
+    }
+    let (device, run) = ran;
+    if a.verbose {
+        println!("{}", run.describe());
+    }
+    let Some(device) = device else {
+        println!(
+            "the firmware on {} gave no result: {}",
+            board.name,
+            run.describe()
+        );
+        return Ok(ExitCode::from(1));
+    };
+    let t0 = Instant::now();
+    let host = golden::reference(&case)?;
+    let host_wall = t0.elapsed();
+
+    let (h, d) = (&host.header, &device.header);
+    let it = if index_type == IndexType::U16 {
+        "u16"
+    } else {
+        "u32"
+    };
+    println!(
+        "\ntinydecimate demo: {} ({} vertices, {} {it} triangles)\nconfig: {} ({:?}, ratio {}, lambda {}), {backend} backend\n",
+        case.mesh,
+        case.positions.len(),
+        case.triangles.len(),
+        if a.paper {
+            "Config::paper()"
+        } else {
+            "Config::new()"
+        },
+        case.config.schedule,
+        case.config.target_ratio,
+        case.config.lambda
+    );
+    let host_col = format!("host ({}, std)", std::env::consts::ARCH);
+    let dev_col = format!("{} ({}, QEMU)", board.name, board.core);
+    let row = |k: &str, x: String, y: String| println!("{k:<22} {x:<46} {y}");
+    row("", host_col, dev_col);
+    let status = |o: &Outcome| match o.header.status {
+        Status::Ok => "ok".to_string(),
+        s => format!("{s:?} {:?}", o.header.error_kind),
+    };
+    row("status", status(&host), status(&device));
+    row(
+        "triangles in",
+        thousands(h.triangles_in.into()),
+        thousands(d.triangles_in.into()),
+    );
+    row(
+        "triangles out",
+        thousands(h.triangles_out.into()),
+        thousands(d.triangles_out.into()),
+    );
+    row(
+        "collapses",
+        thousands(h.collapses.into()),
+        thousands(d.collapses.into()),
+    );
+    let instr = board.instructions(d.ticks);
+    row(
+        "emulated instructions",
+        "-".into(),
+        format!(
+            "{}{}",
+            thousands(instr),
+            if d.collapses > 0 {
+                format!(
+                    " ({} per collapse)",
+                    thousands(instr / u64::from(d.collapses))
+                )
+            } else {
+                String::new()
+            }
+        ),
+    );
+    row(
+        "time",
+        format!("{:.1} ms wall", host_wall.as_secs_f64() * 1e3),
+        format!("{:.2} s wall under QEMU", run.wall.as_secs_f64()),
+    );
+    row(
+        "workspace RAM",
+        format!(
+            "{} B ({} V / {} T capacity)",
+            thousands(golden::HostWorkspace::BYTES as u64),
+            golden::HOST_MAX_VERTICES,
+            golden::HOST_MAX_TRIANGLES
+        ),
+        format!(
+            "{} B ({} V / {} T capacity)",
+            thousands(d.workspace_bytes.into()),
+            d.capacity_vertices,
+            d.capacity_triangles
+        ),
+    );
+    row(
+        "stack high-water",
+        "-".into(),
+        format!(
+            "{} B (library: {} B)",
+            thousands(d.stack_high_water.into()),
+            thousands(d.stack_bytes.into())
+        ),
+    );
+    let (gh, gd) = (
+        Golden::of(&case, backend, &host)?,
+        Golden::of(&case, backend, &device)?,
+    );
+    row(
+        "output sha256",
+        golden::sha256_hex(&gh.bin)[..16].to_string(),
+        golden::sha256_hex(&gd.bin)[..16].to_string(),
+    );
+    println!();
+    match golden::diff(index_type, &gh, &gd) {
+        Verdict::Identical => {
+            println!(
+                "byte-identical: yes ({} bytes of output triangles, same report)",
+                gh.bin.len()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        v => {
+            println!("byte-identical: NO");
+            if let Verdict::Diff(d) = v {
+                for l in d {
+                    println!("  {l}");
+                }
+            }
+            Ok(ExitCode::from(1))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn subset_fits_and_is_compact() {
+        let m = meshfmt::golden::bumpy_grid(10);
+        let case = Case {
+            name: "g".into(),
+            mesh: "grid 10".into(),
+            positions: m.positions,
+            triangles: m.triangles,
+            index_type: IndexType::U16,
+            config: Config::new(),
+        };
+        let s = subset_that_fits(&case, 30, 1000);
+        assert!(s.positions.len() <= 30);
+        assert!(!s.triangles.is_empty());
+        assert_eq!(
+            s.triangles.iter().flatten().max().map(|&i| i as usize + 1),
+            Some(s.positions.len())
+        );
+        let s = subset_that_fits(&case, 1000, 7);
+        assert_eq!(s.triangles.len(), 7);
+        assert_eq!(thousands(1234567), "1 234 567");
+        assert_eq!(thousands(12), "12");
+    }
+}
