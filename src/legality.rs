@@ -59,14 +59,50 @@ fn moved(tri: [usize; 3], a: usize, b: usize) -> Option<[usize; 3]> {
     Some(tri.map(|v| if v == a { b } else { v }))
 }
 
-/// Area normal (twice the area vector) and sum of squared edge lengths of a triangle.
+/// What the rules need of one triangle.
+struct Shape {
+    /// Unit normal (zero if no area).
+    normal: [f32; 3],
+    /// Twice the area.
+    area2: f32,
+    /// quality² / 12 = |n|² / (Σ edge²)², scale-free; 1/12 for an equilateral triangle.
+    quality: f32,
+}
+
+/// The triangle's shape, computed on its edges divided by their largest component, so that
+/// neither squares nor products of tiny or huge edges leave f32's normal range.
 #[inline]
-fn shape(p: [[f32; 3]; 3]) -> ([f32; 3], f32) {
-    let e0 = math::sub(p[1], p[0]);
-    let e1 = math::sub(p[2], p[1]);
-    let e2 = math::sub(p[0], p[2]);
-    let n = math::cross(e0, math::sub(p[2], p[0]));
-    (n, math::dot(e0, e0) + math::dot(e1, e1) + math::dot(e2, e2))
+fn shape(p: [[f32; 3]; 3]) -> Shape {
+    let e = [
+        math::sub(p[1], p[0]),
+        math::sub(p[2], p[1]),
+        math::sub(p[0], p[2]),
+    ];
+    let m = math::max_abs(e[0])
+        .max(math::max_abs(e[1]))
+        .max(math::max_abs(e[2]));
+    if m.is_nan() || m <= 0.0 {
+        return Shape {
+            normal: [0.0; 3],
+            area2: 0.0,
+            quality: 0.0,
+        };
+    }
+    let e = e.map(|v| [v[0] / m, v[1] / m, v[2] / m]);
+    // cross(p1 - p0, p2 - p0), with p2 - p0 = -e2.
+    let n = math::cross(e[0], math::scale(e[2], -1.0));
+    let l2 = math::dot(n, n);
+    let s = math::dot(e[0], e[0]) + math::dot(e[1], e[1]) + math::dot(e[2], e[2]);
+    let len = math::sqrt(l2);
+    Shape {
+        normal: if len > 0.0 {
+            math::scale(n, 1.0 / len)
+        } else {
+            [0.0; 3]
+        },
+        area2: len * m * m,
+        quality: if s > 0.0 { l2 / (s * s) } else { 0.0 },
+    }
 }
 
 /// Checks every rule for `a -> b` and returns its cost.
@@ -147,31 +183,24 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
         if let Some(x) = r.get_mut(k) {
             *x = pb;
         }
-        let (n0, s0) = shape(q);
-        let (n1, s1) = shape(r);
-        let l0 = math::dot(n0, n0);
-        let l1 = math::dot(n1, n1);
-        // Zero or NaN: no area left.
-        if l1.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+        let old_shape = shape(q);
+        let new_shape = shape(r);
+        // No area left (or none representable).
+        if new_shape.quality <= 0.0 {
             return Err(Reject::Sliver);
         }
-        // quality² / 12 = |n|² / (Σ edge²)²; compared without dividing.
-        if l1 < rules.min_ratio * s1 * s1 && l1 * s0 * s0 < l0 * s1 * s1 {
+        if new_shape.quality < rules.min_ratio && new_shape.quality < old_shape.quality {
             return Err(Reject::Sliver);
         }
-        let (len0, len1) = (math::sqrt(l0), math::sqrt(l1));
-        if math::dot(n0, n1) < rules.cos_turn * (len0 * len1) {
+        // A zero-area triangle has no direction to turn from.
+        let (u0, u1) = (old_shape.normal, new_shape.normal);
+        if old_shape.quality > 0.0 && math::dot(u0, u1) < rules.cos_turn {
             return Err(Reject::NormalTurn);
         }
-        let u0 = if len0 > 0.0 {
-            math::scale(n0, 1.0 / len0)
-        } else {
-            [0.0; 3]
-        };
         sum += cost.triangle(&TriangleChange {
             old_normal: u0,
-            new_normal: math::scale(n1, 1.0 / len1),
-            old_area2: len0,
+            new_normal: u1,
+            old_area2: old_shape.area2,
             moved: shift,
         });
     }

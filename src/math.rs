@@ -64,12 +64,32 @@ pub(crate) fn scale(a: V3, s: f32) -> V3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
+/// Largest absolute component.
+#[inline]
+pub(crate) fn max_abs(a: V3) -> f32 {
+    let m = if a[0].abs() > a[1].abs() {
+        a[0].abs()
+    } else {
+        a[1].abs()
+    };
+    if a[2].abs() > m {
+        a[2].abs()
+    } else {
+        m
+    }
+}
+
 /// Unit vector, or zero for a zero vector (a zero-area triangle has no direction).
+///
+/// Divided by its largest component before squaring: the squared length of a tiny but valid
+/// normal (a mesh dwarfed by one stray vertex has cross products near 1e-22) would otherwise
+/// fall below f32's normal range and lose its direction (found by fuzzing).
 #[inline]
 pub(crate) fn unit(a: V3) -> V3 {
-    let l2 = dot(a, a);
-    if l2 > 0.0 {
-        scale(a, 1.0 / sqrt(l2))
+    let m = max_abs(a);
+    if m > 0.0 {
+        let b = [a[0] / m, a[1] / m, a[2] / m];
+        scale(b, 1.0 / sqrt(dot(b, b)))
     } else {
         [0.0; 3]
     }

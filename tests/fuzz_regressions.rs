@@ -58,3 +58,92 @@ fn duplicate_after_a_killed_duplicate_is_dropped() {
     assert_eq!(r.duplicates_dropped, 2, "{r:?}");
     assert_eq!(&tris[..r.triangles_out], &[[0, 1, 2], [1, 3, 4]]);
 }
+
+/// Unit normal (f64) of a triangle, zero if it has no area.
+fn normal64(p: &[[f32; 3]], t: [u32; 3]) -> [f64; 3] {
+    let q = |i: u32| p[i as usize].map(f64::from);
+    let (a, b, c) = (q(t[0]), q(t[1]), q(t[2]));
+    let (u, v) = (
+        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+    );
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 {
+        n.map(|x| x / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Pairs of triangles on a common edge whose unit normals have a dot product below -0.9.
+fn folded(p: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<([u32; 3], [u32; 3])> {
+    let mut out = Vec::new();
+    for (i, &t) in tris.iter().enumerate() {
+        for &u in &tris[i + 1..] {
+            if t.iter().filter(|v| u.contains(v)).count() == 2 {
+                let (a, b) = (normal64(p, t), normal64(p, u));
+                if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < -0.9 {
+                    out.push((t, u));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// `fuzz/regressions/simplify-fold-missed-normal-underflow`.
+///
+/// One stray vertex (y = -3.2e10) sets the bounding box, so in the engine's normalised units
+/// (src/mesh.rs `Mesh::p`) the rest of the mesh is ~1e-11 across: cross products are ~1e-22
+/// and their squares ~1e-44, below f32's normal range. `math::unit` (src/math.rs) then returns
+/// the zero vector (`l2 > 0.0` fails, or a subnormal `l2` loses all precision), so
+/// `legality::folds` (dot of zero vectors is 0, never < -0.9) and the `NormalTurn` test in
+/// `legality::price` (`len0 * len1` underflows) pass vacuously and the collapse 7 -> 8 folds
+/// triangle (0, 4, 8) onto (4, 5, 8) (normals 180° apart, f64 on the true positions).
+///
+/// Suggested fix: in `math::unit`, divide by the largest |component| before squaring
+/// (`m = max|a_i|; b = a / m; b / sqrt(dot(b, b))`), which cannot underflow for any non-zero
+/// finite vector; and in `price`, compare unit normals (`dot(u0, u1) < cos_turn`) instead of
+/// `dot(n0, n1) < cos_turn * len0 * len1`. (With that `unit` alone this case passes.)
+#[test]
+fn no_fold_when_a_stray_vertex_dwarfs_the_mesh() {
+    let positions: [[f32; 3]; 9] = [
+        [0.0, 0.0, 0.0],
+        [2.375, -32065930000.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, -5.0625, 0.0171875],
+        [0.0, 1.0, 0.0],
+        [0.0, 2.0, 0.075],
+        [1.0, 2.0, 0.0015625],
+        [2.0, 2.0, 0.06875],
+    ];
+    let input: [[u32; 3]; 9] = [
+        [0, 1, 4],
+        [0, 4, 3],
+        [1, 2, 5],
+        [1, 5, 4],
+        [3, 4, 7],
+        [3, 7, 6],
+        [4, 5, 8],
+        [4, 8, 7],
+        [0, 4, 5],
+    ];
+    let before = folded(&positions, &input);
+    let mut tris = input;
+    let mut ws = Workspace::<u16, 64, 64>::new();
+    let r = ws
+        .simplify(&positions, &mut tris, &Config::new().with_ratio(0.0))
+        .unwrap();
+    let out = &tris[..r.triangles_out];
+    let new: Vec<_> = folded(&positions, out)
+        .into_iter()
+        .filter(|f| !before.contains(f))
+        .collect();
+    assert!(new.is_empty(), "new folded pairs {new:?} in {out:?}");
+}
