@@ -1,0 +1,231 @@
+//! Link-time proof that tinydecimate cannot panic.
+//!
+//! The panic handler calls `rust_panic_reachable`, which is defined nowhere. After LTO every
+//! call that can still reach a panic (bounds checks, `unwrap`, overflow checks, `unreachable!`,
+//! slicing, division by zero, ...) refers to it, so the link fails iff a panic path survives
+//! optimisation. Every public entry point is called, with inputs the optimiser cannot see
+//! (`read_volatile`, `black_box`), for both index types and both link types.
+//!
+//! Run `./check.sh` (from any directory).
+#![no_std]
+#![no_main]
+
+use core::fmt::Write;
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+use tinydecimate::cost::{Cost, EdgeChange, NormalVariation, PlaneDistance, TriangleChange};
+use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Simplifier, Workspace};
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    extern "C" {
+        /// Defined nowhere: linking fails if any panic is reachable.
+        fn rust_panic_reachable() -> !;
+    }
+    // SAFETY: never linked; the whole point is that this call must be dead code.
+    unsafe { rust_panic_reachable() }
+}
+
+/// Opaque inputs: whatever is in RAM at run time, as far as the optimiser knows.
+static INPUT: [u32; 16] = [0; 16];
+
+fn input(k: usize) -> u32 {
+    // `k & 15` keeps the index provably in range (no bounds check of our own).
+    // SAFETY: a valid, aligned reference to a static.
+    unsafe { core::ptr::read_volatile(&INPUT[k & 15]) }
+}
+
+fn opaque_f32(k: usize) -> f32 {
+    f32::from_bits(input(k))
+}
+
+fn opaque_config() -> Config {
+    let c = Config {
+        schedule: if input(0) & 1 == 0 { Schedule::Greedy } else { Schedule::Passes },
+        target_triangles: input(1) as usize,
+        target_ratio: opaque_f32(2),
+        max_cost: opaque_f32(3),
+        max_passes: input(4),
+        lambda: opaque_f32(5),
+        features: input(6) & 1 == 0,
+        feature_mode: if input(6) & 2 == 0 {
+            FeatureMode::Paper
+        } else {
+            FeatureMode::ValenceNormalized
+        },
+        feature_targets: input(6) & 4 == 0,
+        max_normal_turn_deg: opaque_f32(7),
+        min_quality: opaque_f32(8),
+        boundary_weight: opaque_f32(9),
+    };
+    // The builders too.
+    let b = black_box(Config::paper())
+        .with_schedule(c.schedule)
+        .with_ratio(opaque_f32(10))
+        .with_target_triangles(input(11) as usize)
+        .with_lambda(opaque_f32(12))
+        .with_feature_mode(c.feature_mode)
+        .with_max_passes(input(13))
+        .with_max_cost(opaque_f32(14));
+    black_box(Config::default());
+    black_box(Config::new());
+    if input(15) & 1 == 0 {
+        c
+    } else {
+        b
+    }
+}
+
+/// A `core::fmt::Write` sink into a fixed buffer, itself panic-free.
+struct Sink {
+    buf: [u8; 160],
+    len: usize,
+}
+
+impl Write for Sink {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        for &b in s.as_bytes() {
+            match self.buf.get_mut(self.len) {
+                Some(slot) => {
+                    *slot = b;
+                    self.len += 1;
+                }
+                None => return Err(core::fmt::Error),
+            }
+        }
+        Ok(())
+    }
+}
+
+fn display(e: &Error) {
+    let mut sink = Sink {
+        buf: [0; 160],
+        len: 0,
+    };
+    let _ = black_box(write!(sink, "{e}"));
+    black_box(&sink.buf);
+    black_box(sink.len);
+}
+
+fn use_report(r: &Report) {
+    black_box(r.rejected.total());
+    black_box(r.clone());
+    black_box(r);
+}
+
+fn drive<L: Index, I: Index, C: Cost>(mut s: Simplifier<'_, L, I, C>) {
+    let budget = input(0);
+    loop {
+        let done = s.step(budget);
+        black_box(s.live_triangles());
+        use_report(&s.report());
+        for t in s.triangles() {
+            black_box(t);
+        }
+        black_box(s.buffer());
+        let v = input(1) as usize;
+        black_box(s.is_feature(v));
+        black_box(s.is_used(v));
+        if done || input(2) == 0 {
+            break;
+        }
+    }
+    use_report(&s.finish());
+}
+
+fn run<L: Index, I: Index, const V: usize, const T: usize>() {
+    let mut ws = black_box(Workspace::<L, V, T>::new());
+    let mut ws_default = black_box(Workspace::<L, V, T>::default());
+    black_box(Workspace::<L, V, T>::BYTES);
+    let positions: [[f32; 3]; V] = black_box([[0.0; 3]; V]);
+    let mut tris: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let (np, nt) = (input(3) as usize, input(4) as usize);
+    let (Some(p), Some(t)) = (positions.get(..np), tris.get_mut(..nt)) else {
+        return;
+    };
+    let config = opaque_config();
+    if let Err(e) = config.validate() {
+        display(&e);
+    }
+
+    match ws.simplify(p, t, &config) {
+        Ok(r) => use_report(&r),
+        Err(e) => display(&e),
+    }
+    match ws_default.start(p, t, &config) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    let nv = if input(5) & 1 == 0 {
+        NormalVariation::greedy(opaque_f32(6))
+    } else {
+        NormalVariation::paper(opaque_f32(6))
+    };
+    let nv = NormalVariation {
+        length_weighted: input(7) & 1 == 0 || nv.length_weighted,
+        boundary_weight: nv.boundary_weight,
+    };
+    match ws.start_with_cost(p, t, &config, nv) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    let pd = PlaneDistance {
+        boundary_weight: opaque_f32(8),
+    };
+    match ws.start_with_cost(p, t, &config, pd) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    black_box(&tris);
+
+    // The cost trait's methods by themselves.
+    let change = TriangleChange {
+        old_normal: [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
+        new_normal: [opaque_f32(4), opaque_f32(5), opaque_f32(6)],
+        old_area2: opaque_f32(7),
+        moved: [opaque_f32(8), opaque_f32(9), opaque_f32(10)],
+    };
+    let edge = EdgeChange {
+        length2: opaque_f32(11),
+        boundary_retreat2: opaque_f32(12),
+    };
+    black_box(nv.total(nv.triangle(&change), &edge));
+    black_box(pd.total(pd.triangle(&change), &edge));
+
+    // Index.
+    let i = I::from_usize(input(9) as usize);
+    black_box(i.map(Index::to_usize));
+    black_box(I::narrow(input(10) as usize).to_usize());
+    black_box((I::NIL, I::COUNT, L::NIL, L::COUNT));
+}
+
+#[cfg(feature = "defmt")]
+mod log {
+    /// A logger that drops everything (defmt needs one to link).
+    #[defmt::global_logger]
+    struct Null;
+
+    // SAFETY: nothing is shared; every method does nothing.
+    unsafe impl defmt::Logger for Null {
+        fn acquire() {}
+        unsafe fn flush() {}
+        unsafe fn release() {}
+        unsafe fn write(bytes: &[u8]) {
+            core::hint::black_box(bytes);
+        }
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    #[cfg(feature = "selftest")]
+    black_box([1u8, 2, 3][input(0) as usize]);
+    run::<u16, u16, 96, 160>();
+    run::<u32, u32, 96, 160>();
+    run::<u16, u32, 96, 160>();
+    run::<u32, u16, 96, 160>();
+    loop {
+        black_box(());
+    }
+}
