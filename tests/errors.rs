@@ -233,6 +233,7 @@ fn inconsistent_winding_is_locked_not_rejected() {
     let mut m = grid(6, 6, 0.0);
     m.triangles[20].swap(0, 1);
     let (out, report) = simplify(&m, &Config::new().with_ratio(0.3));
+    assert_valid("flipped", &m, &out, &report);
     assert!(report.locked_vertices >= 3);
     assert!(out.triangles.len() < m.triangles.len());
     let t = m.triangles[20];
