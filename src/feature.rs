@@ -29,7 +29,7 @@ pub(crate) fn variation<L: Index, I: Index>(
     let mut sum = [0.0f32; 3];
     let mut sq = 0.0f32;
     for (t, _) in mesh.corners(v) {
-        let n = math::unit(mesh.normal_of(mesh.tri(t)));
+        let n = mesh.unit_normal(mesh.tri(t));
         sum = math::add(sum, n);
         sq += math::dot(n, n);
         k += 1;

@@ -252,7 +252,7 @@ pub(crate) fn connectivity<L: Index, I: Index>(
         let Some(new) = moved(mesh.tri(t), a, b) else {
             continue;
         };
-        let u1 = math::unit(mesh.normal_of(new));
+        let u1 = mesh.unit_normal(new);
         if folds(mesh, t, new, u1, a, b) {
             return Err(Reject::Fold);
         }
@@ -326,7 +326,7 @@ fn folds<L: Index, I: Index>(
                     continue;
                 };
                 if post.contains(&p) && post.contains(&q) {
-                    let us = math::unit(mesh.normal_of(post));
+                    let us = mesh.unit_normal(post);
                     if math::dot(u1, us) < FOLD_DOT {
                         return true;
                     }

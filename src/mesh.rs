@@ -320,11 +320,22 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Area-weighted normal (twice the area vector) of the triangle `[a, b, c]`.
+    /// Unit normal of the triangle `[a, b, c]` (zero if it has no area). The edges are
+    /// divided by their largest component before the cross product, so that a triangle that is
+    /// tiny in normalised units (a mesh dwarfed by one stray far vertex) keeps its direction
+    /// instead of underflowing to zero (found by fuzzing).
     #[inline]
-    pub(crate) fn normal_of(&self, tri: [usize; 3]) -> V3 {
+    pub(crate) fn unit_normal(&self, tri: [usize; 3]) -> V3 {
         let p0 = self.p(tri[0]);
-        math::cross(math::sub(self.p(tri[1]), p0), math::sub(self.p(tri[2]), p0))
+        let e1 = math::sub(self.p(tri[1]), p0);
+        let e2 = math::sub(self.p(tri[2]), p0);
+        let m = math::max_abs(e1).max(math::max_abs(e2));
+        if m.is_nan() || m <= 0.0 {
+            return [0.0; 3];
+        }
+        // Componentwise division: `* (1 / m)` would overflow for a subnormal m.
+        let d = |v: V3| [v[0] / m, v[1] / m, v[2] / m];
+        math::unit(math::cross(d(e1), d(e2)))
     }
 
     // ---- queries ----------------------------------------------------------------------

@@ -39,9 +39,8 @@ fn dead_duplicate_does_not_swallow_later_triangles() {
 /// the dead triangle (`corner_of` finds no 1 in `[0, 0, 0]`): the copy `[1, 4, 3]` never meets
 /// `[1, 3, 4]` and both stay, so the output holds a duplicate triangle.
 ///
-/// Suggested fix (src/mesh.rs, `Mesh::build` step 3): unlink a duplicate from its three lists
-/// while it is intact (`self.unlink(x, t)` for each vertex, as `collapse` does), then `kill`
-/// it, so that walks never meet a dead triangle.
+/// Fixed in c26274b (src/mesh.rs, `Mesh::build` step 3): a duplicate leaves its three lists
+/// while it is intact, then is killed, so that walks never meet a dead triangle.
 #[test]
 fn duplicate_after_a_killed_duplicate_is_dropped() {
     let positions = [
@@ -106,10 +105,7 @@ fn folded(p: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<([u32; 3], [u32; 3])> {
 /// `legality::price` (`len0 * len1` underflows) pass vacuously and the collapse 7 -> 8 folds
 /// triangle (0, 4, 8) onto (4, 5, 8) (normals 180° apart, f64 on the true positions).
 ///
-/// Suggested fix: in `math::unit`, divide by the largest |component| before squaring
-/// (`m = max|a_i|; b = a / m; b / sqrt(dot(b, b))`), which cannot underflow for any non-zero
-/// finite vector; and in `price`, compare unit normals (`dot(u0, u1) < cos_turn`) instead of
-/// `dot(n0, n1) < cos_turn * len0 * len1`. (With that `unit` alone this case passes.)
+/// Fixed in f055ab3 (scale-safe unit normals and triangle shape).
 #[test]
 fn no_fold_when_a_stray_vertex_dwarfs_the_mesh() {
     let positions: [[f32; 3]; 9] = [
@@ -140,6 +136,60 @@ fn no_fold_when_a_stray_vertex_dwarfs_the_mesh() {
     let r = ws
         .simplify(&positions, &mut tris, &Config::new().with_ratio(0.0))
         .unwrap();
+    let out = &tris[..r.triangles_out];
+    let new: Vec<_> = folded(&positions, out)
+        .into_iter()
+        .filter(|f| !before.contains(f))
+        .collect();
+    assert!(new.is_empty(), "new folded pairs {new:?} in {out:?}");
+}
+
+/// `fuzz/regressions/simplify-fold-missed-cross-product-underflow`: the same stray-vertex
+/// failure one step further (after f055ab3).
+///
+/// With the stray vertex at x = 1e30 the rest of the mesh is ~1e-30 across in normalised
+/// units, so the *cross product* in `Mesh::normal_of` (src/mesh.rs) underflows to zero before
+/// `math::unit` can rescale anything. `price` is safe now (its `shape` divides the edges by
+/// their largest component first), but `legality::connectivity`/`folds` still take
+/// `math::unit(mesh.normal_of(..))`, get zero vectors and never see a fold: collapses fold
+/// (0, 2, 6) onto (0, 2, 5) and (2, 6, 7) onto (2, 5, 7).
+///
+/// Suggested fix: make `Mesh::normal_of` divide both edge vectors by their largest |component|
+/// (componentwise `e / m`, not `e * (1 / m)`, which overflows for subnormal `m`) before the
+/// cross product; its callers only use the direction (`unit`), and `feature::variation` gets
+/// the same protection. (With that change this case passes.)
+#[test]
+fn no_fold_when_a_stray_vertex_is_1e30_away() {
+    let positions: [[f32; 3]; 8] = [
+        [0.0, 0.0, 1.0],
+        [1e30, 0.0, -4.28918e-8],
+        [-3.4375, 0.9005312, -4.5453017e-8],
+        [-0.51210946, 0.8869995, -4.4770026e-8],
+        [-0.9785156, -8.5544556e-8, -4.2772278e-8],
+        [-0.50722647, -0.87854224, -4.4343157e-8],
+        [0.49374992, -0.8552001, -4.3164995e-8],
+        [0.0, 0.0, -1.0],
+    ];
+    let input: [[u32; 3]; 12] = [
+        [0, 1, 2],
+        [7, 2, 1],
+        [0, 2, 3],
+        [7, 3, 2],
+        [0, 3, 4],
+        [7, 4, 3],
+        [0, 4, 5],
+        [7, 5, 4],
+        [0, 5, 6],
+        [7, 0, 5],
+        [0, 6, 1],
+        [7, 1, 6],
+    ];
+    let before = folded(&positions, &input);
+    let mut tris = input;
+    let mut ws = Workspace::<u32, 512, 1024>::new();
+    let mut config = Config::new().with_ratio(0.0);
+    config.features = false;
+    let r = ws.simplify(&positions, &mut tris, &config).unwrap();
     let out = &tris[..r.triangles_out];
     let new: Vec<_> = folded(&positions, out)
         .into_iter()

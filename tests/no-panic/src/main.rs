@@ -42,7 +42,11 @@ fn opaque_f32(k: usize) -> f32 {
 
 fn opaque_config() -> Config {
     let c = Config {
-        schedule: if input(0) & 1 == 0 { Schedule::Greedy } else { Schedule::Passes },
+        schedule: if input(0) & 1 == 0 {
+            Schedule::Greedy
+        } else {
+            Schedule::Passes
+        },
         target_triangles: input(1) as usize,
         target_ratio: opaque_f32(2),
         max_cost: opaque_f32(3),

@@ -1,0 +1,962 @@
+//! Shared code of the fuzz targets: the `simplify` case generator and an invariant checker
+//! written independently of the library (std collections, f64 geometry).
+
+use std::collections::{BTreeSet, HashMap, HashSet};
+
+use arbitrary::{Result, Unstructured};
+use tinydecimate::cost::{NormalVariation, PlaneDistance};
+use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Stop, Workspace};
+
+/// The caller's index type: `u16` or `u32`, converted from the generator's `u32` by truncation
+/// (so out-of-range and NIL-valued indices reach the library as they are).
+pub trait Idx: Index {
+    fn from_u32(v: u32) -> Self;
+    fn to_u32(self) -> u32;
+}
+
+impl Idx for u16 {
+    fn from_u32(v: u32) -> Self {
+        v as u16
+    }
+    fn to_u32(self) -> u32 {
+        u32::from(self)
+    }
+}
+
+impl Idx for u32 {
+    fn from_u32(v: u32) -> Self {
+        v
+    }
+    fn to_u32(self) -> u32 {
+        self
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CostKind {
+    /// `Workspace::start` / `simplify`: the schedule's own normal variation.
+    Default,
+    Plane(f32),
+    Normal {
+        length_weighted: bool,
+        boundary_weight: f32,
+    },
+}
+
+/// One generated run.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// 0: `<u16, 64, 64>`, 1: `<u16, 512, 512>`, 2: `<u32, 512, 1024>`.
+    pub workspace: u8,
+    /// Caller's triangles as `u32` (else `u16`).
+    pub wide: bool,
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub config: Config,
+    pub cost: CostKind,
+    /// Step budgets, used in turn.
+    pub budgets: Vec<u32>,
+    /// Also finish a third run early, after this many `step` calls.
+    pub early: Option<u16>,
+}
+
+const SPECIAL: [f32; 16] = [
+    f32::NAN,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::MAX,
+    f32::MIN,
+    f32::MIN_POSITIVE,
+    1e-45, // smallest subnormal
+    -1e-45,
+    1e-40, // subnormal
+    0.0,
+    -0.0,
+    1e30,
+    -1e30,
+    1e-30,
+    1.0,
+    -1.0,
+];
+
+/// A float in `[lo, hi]` most of the time, else a special value or raw bits.
+fn float(u: &mut Unstructured, lo: f32, hi: f32) -> Result<f32> {
+    let tag: u8 = u.arbitrary()?;
+    Ok(match tag {
+        0..=199 => {
+            let x: u16 = u.arbitrary()?;
+            lo + (hi - lo) * (x as f32 / 65535.0)
+        }
+        200..=239 => SPECIAL[u.choose_index(SPECIAL.len())?],
+        _ => f32::from_bits(u.arbitrary()?),
+    })
+}
+
+/// A coordinate: small grid values mostly (so that meshes are meaningful), else anything.
+fn coord(u: &mut Unstructured) -> Result<f32> {
+    let tag: u8 = u.arbitrary()?;
+    Ok(match tag {
+        0..=191 => (u.arbitrary::<i8>()? as f32) / 16.0,
+        192..=231 => SPECIAL[u.choose_index(SPECIAL.len())?],
+        _ => f32::from_bits(u.arbitrary()?),
+    })
+}
+
+/// A vertex index below `n` mostly, else anything.
+fn index(u: &mut Unstructured, n: usize) -> Result<u32> {
+    let tag: u8 = u.arbitrary()?;
+    Ok(if tag < 240 && n > 0 {
+        u.int_in_range(0..=(n - 1) as u32)?
+    } else {
+        match tag % 4 {
+            0 => n as u32,
+            1 => u16::MAX as u32,
+            2 => u32::MAX,
+            _ => u.arbitrary()?,
+        }
+    })
+}
+
+fn config(u: &mut Unstructured) -> Result<Config> {
+    let mut c = Config::new();
+    c.schedule = if u.arbitrary()? {
+        Schedule::Passes
+    } else {
+        Schedule::Greedy
+    };
+    c.target_triangles = match u.int_in_range(0..=3u8)? {
+        0 => 0,
+        1 | 2 => u.int_in_range(0..=1200)?,
+        _ => u.arbitrary::<u64>()? as usize,
+    };
+    c.target_ratio = float(u, 0.0, 1.0)?;
+    c.max_cost = match u.int_in_range(0..=3u8)? {
+        0 | 1 => f32::INFINITY,
+        2 => float(u, 0.0, 0.05)?,
+        _ => float(u, 0.0, 10.0)?,
+    };
+    c.max_passes = match u.int_in_range(0..=7u8)? {
+        0 => u.arbitrary()?,
+        _ => u.int_in_range(1..=40)?,
+    };
+    c.lambda = float(u, 0.0, 4.0)?;
+    c.features = u.arbitrary()?;
+    c.feature_mode = if u.arbitrary()? {
+        FeatureMode::ValenceNormalized
+    } else {
+        FeatureMode::Paper
+    };
+    c.feature_targets = u.arbitrary()?;
+    c.max_normal_turn_deg = float(u, 0.0, 180.0)?;
+    c.min_quality = float(u, 0.0, 1.0)?;
+    c.boundary_weight = float(u, 0.0, 10.0)?;
+    Ok(c)
+}
+
+/// Height/displacement in a sane range, from one byte.
+fn bump(u: &mut Unstructured, amp: f32) -> Result<f32> {
+    Ok((u.arbitrary::<i8>()? as f32) / 128.0 * amp)
+}
+
+fn quad(tris: &mut Vec<[u32; 3]>, a: u32, b: u32, c: u32, d: u32, diag: bool) {
+    if diag {
+        tris.push([a, b, c]);
+        tris.push([a, c, d]);
+    } else {
+        tris.push([a, b, d]);
+        tris.push([b, c, d]);
+    }
+}
+
+/// Positions and triangles: raw, or a generated shape with fuzzed geometry and edits.
+/// Positions and triangles.
+type MeshParts = (Vec<[f32; 3]>, Vec<[u32; 3]>);
+
+fn mesh(u: &mut Unstructured) -> Result<MeshParts> {
+    let mut p: Vec<[f32; 3]> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    let amp = match u.int_in_range(0..=3u8)? {
+        0 => 0.0,
+        1 => 0.05,
+        2 => 0.3,
+        _ => 2.0,
+    };
+    match u.int_in_range(0..=5u8)? {
+        0 => {
+            // Raw.
+            let n = u.int_in_range(0..=600usize)?;
+            for _ in 0..n {
+                p.push([coord(u)?, coord(u)?, coord(u)?]);
+            }
+            let m = u.int_in_range(0..=1100usize)?;
+            for _ in 0..m {
+                if u.is_empty() {
+                    break;
+                }
+                t.push([index(u, n)?, index(u, n)?, index(u, n)?]);
+            }
+        }
+        1 => {
+            // Open grid on a height field.
+            let nx = u.int_in_range(1..=20u32)?;
+            let ny = u.int_in_range(1..=20u32)?;
+            let diag_mode = u.int_in_range(0..=2u8)?;
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    p.push([i as f32, j as f32, bump(u, amp * 4.0)?]);
+                }
+            }
+            let w = nx + 1;
+            for j in 0..ny {
+                for i in 0..nx {
+                    let v = j * w + i;
+                    let diag = match diag_mode {
+                        0 => true,
+                        1 => (i + j) % 2 == 0,
+                        _ => u.arbitrary()?,
+                    };
+                    quad(&mut t, v, v + 1, v + w + 1, v + w, diag);
+                }
+            }
+        }
+        2 => {
+            // Torus: closed, genus 1.
+            let nx = u.int_in_range(3..=20u32)?;
+            let ny = u.int_in_range(3..=20u32)?;
+            let (r0, r1) = (3.0f32, 1.0f32);
+            for j in 0..ny {
+                for i in 0..nx {
+                    let a = i as f32 / nx as f32 * std::f32::consts::TAU;
+                    let b = j as f32 / ny as f32 * std::f32::consts::TAU;
+                    let r = r1 + bump(u, amp)?;
+                    p.push([
+                        (r0 + r * b.cos()) * a.cos(),
+                        (r0 + r * b.cos()) * a.sin(),
+                        r * b.sin(),
+                    ]);
+                }
+            }
+            let diag_random: bool = u.arbitrary()?;
+            for j in 0..ny {
+                for i in 0..nx {
+                    let at = |i: u32, j: u32| (j % ny) * nx + (i % nx);
+                    let diag = if diag_random { u.arbitrary()? } else { true };
+                    quad(
+                        &mut t,
+                        at(i, j),
+                        at(i + 1, j),
+                        at(i + 1, j + 1),
+                        at(i, j + 1),
+                        diag,
+                    );
+                }
+            }
+        }
+        3 => {
+            // UV sphere with poles: closed, genus 0, high-valence poles.
+            let rings = u.int_in_range(1..=14u32)?;
+            let segs = u.int_in_range(3..=24u32)?;
+            p.push([0.0, 0.0, 1.0]);
+            for j in 1..=rings {
+                let th = j as f32 / (rings + 1) as f32 * std::f32::consts::PI;
+                for i in 0..segs {
+                    let ph = i as f32 / segs as f32 * std::f32::consts::TAU;
+                    let r = 1.0 + bump(u, amp)?;
+                    p.push([
+                        r * th.sin() * ph.cos(),
+                        r * th.sin() * ph.sin(),
+                        r * th.cos(),
+                    ]);
+                }
+            }
+            p.push([0.0, 0.0, -1.0]);
+            let south = (p.len() - 1) as u32;
+            let ring = |j: u32, i: u32| 1 + (j - 1) * segs + (i % segs);
+            for i in 0..segs {
+                t.push([0, ring(1, i), ring(1, i + 1)]);
+                t.push([south, ring(rings, i + 1), ring(rings, i)]);
+            }
+            for j in 1..rings {
+                for i in 0..segs {
+                    quad(
+                        &mut t,
+                        ring(j, i),
+                        ring(j + 1, i),
+                        ring(j + 1, i + 1),
+                        ring(j, i + 1),
+                        u.arbitrary()?,
+                    );
+                }
+            }
+        }
+        4 => {
+            // Welded cube with n x n quads per face: sharp creases.
+            let n = u.int_in_range(1..=6u32)?;
+            let mut ids: HashMap<[i32; 3], u32> = HashMap::new();
+            let faces: [([i32; 3], [i32; 3], [i32; 3]); 6] = [
+                ([0, 0, 0], [0, 1, 0], [1, 0, 0]),
+                ([0, 0, 1], [1, 0, 0], [0, 1, 0]),
+                ([0, 0, 0], [1, 0, 0], [0, 0, 1]),
+                ([0, 1, 0], [0, 0, 1], [1, 0, 0]),
+                ([0, 0, 0], [0, 0, 1], [0, 1, 0]),
+                ([1, 0, 0], [0, 1, 0], [0, 0, 1]),
+            ];
+            let ni = n as i32;
+            for (o, a, b) in faces {
+                let mut vid = |i: i32, j: i32, p: &mut Vec<[f32; 3]>| -> u32 {
+                    let k = [0, 1, 2].map(|c| o[c] * ni + a[c] * i + b[c] * j);
+                    *ids.entry(k).or_insert_with(|| {
+                        p.push(k.map(|x| x as f32 / ni as f32));
+                        (p.len() - 1) as u32
+                    })
+                };
+                for j in 0..ni {
+                    for i in 0..ni {
+                        let q = [
+                            vid(i, j, &mut p),
+                            vid(i + 1, j, &mut p),
+                            vid(i + 1, j + 1, &mut p),
+                            vid(i, j + 1, &mut p),
+                        ];
+                        quad(&mut t, q[0], q[1], q[2], q[3], u.arbitrary()?);
+                    }
+                }
+            }
+            for q in p.iter_mut() {
+                for c in q.iter_mut() {
+                    *c += bump(u, amp * 0.1)?;
+                }
+            }
+        }
+        _ => {
+            // A fan around one vertex (open disc) of high valence, or a closed double cone.
+            let k = u.int_in_range(3..=80u32)?;
+            let closed: bool = u.arbitrary()?;
+            p.push([0.0, 0.0, bump(u, amp)?]);
+            for i in 0..k {
+                let a = i as f32 / k as f32 * std::f32::consts::TAU;
+                p.push([a.cos(), a.sin(), bump(u, amp)?]);
+            }
+            for i in 0..k {
+                t.push([0, 1 + i, 1 + (i + 1) % k]);
+            }
+            if closed {
+                p.push([0.0, 0.0, -1.0 + bump(u, amp)?]);
+                let s = k + 1;
+                for i in 0..k {
+                    t.push([s, 1 + (i + 1) % k, 1 + i]);
+                }
+            }
+        }
+    }
+    // Scale and offset (normalisation must make the result scale-free).
+    if u.int_in_range(0..=3u8)? == 0 {
+        let s = match u.int_in_range(0..=4u8)? {
+            0 => 1e-38,
+            1 => 1e30,
+            2 => 1e-20,
+            3 => 1e6,
+            _ => float(u, -1e3, 1e3)?,
+        };
+        let off = float(u, -1e6, 1e6)?;
+        for q in p.iter_mut() {
+            for c in q.iter_mut() {
+                *c = *c * s + off;
+            }
+        }
+    }
+    // Edits.
+    let edits = u.int_in_range(0..=8u8)?;
+    for _ in 0..edits {
+        let n = p.len();
+        match u.int_in_range(0..=7u8)? {
+            0 if n > 0 => {
+                let v = u.choose_index(n)?;
+                let c = u.choose_index(3)?;
+                p[v][c] = coord(u)?;
+            }
+            1 if !t.is_empty() => {
+                let i = u.choose_index(t.len())?;
+                let c = u.choose_index(3)?;
+                t[i][c] = index(u, n)?;
+            }
+            2 if !t.is_empty() => {
+                let i = u.choose_index(t.len())?;
+                t[i].swap(0, 1);
+            }
+            3 if !t.is_empty() => {
+                let i = u.choose_index(t.len())?;
+                t.swap_remove(i);
+            }
+            4 if !t.is_empty() => {
+                let i = u.choose_index(t.len())?;
+                let mut x = t[i];
+                x.rotate_left(u.choose_index(3)?);
+                let at = u.choose_index(t.len() + 1)?;
+                t.insert(at, x);
+            }
+            5 => t.push([index(u, n)?, index(u, n)?, index(u, n)?]),
+            6 => p.push([coord(u)?, coord(u)?, coord(u)?]),
+            _ => {
+                if !t.is_empty() {
+                    let i = u.choose_index(t.len())?;
+                    let j = u.choose_index(t.len())?;
+                    t.swap(i, j);
+                }
+            }
+        }
+    }
+    Ok((p, t))
+}
+
+impl Case {
+    pub fn generate(u: &mut Unstructured) -> Result<Case> {
+        let workspace = u.int_in_range(0..=2u8)?;
+        let wide = u.arbitrary()?;
+        let config = config(u)?;
+        let cost = match u.int_in_range(0..=5u8)? {
+            0..=3 => CostKind::Default,
+            4 => CostKind::Plane(float(u, 0.0, 10.0)?),
+            _ => CostKind::Normal {
+                length_weighted: u.arbitrary()?,
+                boundary_weight: float(u, 0.0, 10.0)?,
+            },
+        };
+        let nb = u.int_in_range(1..=8usize)?;
+        let mut budgets = Vec::with_capacity(nb);
+        for _ in 0..nb {
+            budgets.push(match u.int_in_range(0..=9u8)? {
+                0 => 0,
+                1..=3 => 1,
+                4..=8 => u.int_in_range(2..=300)?,
+                _ => u.arbitrary()?,
+            });
+        }
+        let early = if u.int_in_range(0..=3u8)? == 0 {
+            Some(u.arbitrary()?)
+        } else {
+            None
+        };
+        let (positions, triangles) = mesh(u)?;
+        Ok(Case {
+            workspace,
+            wide,
+            positions,
+            triangles,
+            config,
+            cost,
+            budgets,
+            early,
+        })
+    }
+
+    /// Runs every check; panics with a description on a violation.
+    pub fn check(&self) {
+        match (self.workspace, self.wide) {
+            (0, false) => run::<u16, u16, 64, 64>(self),
+            (0, true) => run::<u16, u32, 64, 64>(self),
+            (1, false) => run::<u16, u16, 512, 512>(self),
+            (1, true) => run::<u16, u32, 512, 512>(self),
+            (_, false) => run::<u32, u16, 512, 1024>(self),
+            (_, true) => run::<u32, u32, 512, 1024>(self),
+        }
+    }
+}
+
+/// The error `start` must return, by the documented order of checks.
+fn expected_error<L: Index, I: Idx, const V: usize, const T: usize>(
+    positions: &[[f32; 3]],
+    tris: &[[I; 3]],
+    config: &Config,
+) -> Option<Error> {
+    if let Err(e) = config.validate() {
+        return Some(e);
+    }
+    if positions.len() > V.min(L::COUNT) {
+        return Some(Error::Capacity {
+            what: tinydecimate::Capacity::Vertices,
+            needed: positions.len(),
+            available: V.min(L::COUNT),
+        });
+    }
+    let cap_t = T.min(L::COUNT / 3);
+    if tris.len() > cap_t {
+        return Some(Error::Capacity {
+            what: tinydecimate::Capacity::Triangles,
+            needed: tris.len(),
+            available: cap_t,
+        });
+    }
+    for (t, tri) in tris.iter().enumerate() {
+        for &i in tri {
+            let index = i.to_u32() as usize;
+            match positions.get(index) {
+                None => return Some(Error::IndexOutOfRange { triangle: t, index }),
+                Some(p) if !p.iter().all(|c| c.is_finite()) => {
+                    return Some(Error::NonFinitePosition { vertex: index })
+                }
+                _ => {}
+            }
+        }
+    }
+    None
+}
+
+struct Dirty<L: Index, const V: usize, const T: usize>(Box<Workspace<L, V, T>>);
+
+thread_local! {
+    static WS0: std::cell::RefCell<Dirty<u16, 64, 64>> = std::cell::RefCell::new(Dirty(Box::new(Workspace::new())));
+    static WS1: std::cell::RefCell<Dirty<u16, 512, 512>> = std::cell::RefCell::new(Dirty(Box::new(Workspace::new())));
+    static WS2: std::cell::RefCell<Dirty<u32, 512, 1024>> = std::cell::RefCell::new(Dirty(Box::new(Workspace::new())));
+}
+
+/// Runs `f` on a long-lived workspace of the type (reused across runs, so stale state from
+/// earlier inputs is there to leak if it could).
+fn with_dirty<L: Index + 'static, const V: usize, const T: usize, R>(
+    f: impl FnOnce(&mut Workspace<L, V, T>) -> R,
+) -> R {
+    use std::any::Any;
+    let mut f = Some(f);
+    let mut out = None;
+    macro_rules! try_ws {
+        ($ws:ident) => {
+            if out.is_none() {
+                $ws.with(|w| {
+                    let mut w = w.borrow_mut();
+                    if let Some(ws) =
+                        (&mut *w.0 as &mut dyn Any).downcast_mut::<Workspace<L, V, T>>()
+                    {
+                        out = Some((f.take().unwrap())(ws));
+                    }
+                });
+            }
+        };
+    }
+    try_ws!(WS0);
+    try_ws!(WS1);
+    try_ws!(WS2);
+    out.unwrap_or_else(|| (f.take().unwrap())(&mut Workspace::new()))
+}
+
+/// Drives `start`/`start_with_cost` to the end with the given budgets, checking the state
+/// between steps; `stop_after`: finish early after that many `step` calls.
+fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
+    ws: &mut Workspace<L, V, T>,
+    case: &Case,
+    tris: &mut [[I; 3]],
+    stop_after: Option<usize>,
+) -> std::result::Result<Report, Error> {
+    macro_rules! drive {
+        ($s:expr) => {{
+            let mut s = $s?;
+            let nv = case.positions.len();
+            let mut calls = 0usize;
+            let mut zero_run = 0usize;
+            loop {
+                if stop_after.is_some_and(|k| calls >= k) {
+                    break;
+                }
+                let mut b = case.budgets[calls % case.budgets.len()];
+                if b == 0 {
+                    zero_run += 1;
+                    if zero_run > case.budgets.len() {
+                        b = 1; // every budget is 0: make progress anyway
+                    }
+                } else {
+                    zero_run = 0;
+                }
+                let live_before = s.live_triangles();
+                let done = s.step(b);
+                calls += 1;
+                if b == 0 {
+                    assert_eq!(s.live_triangles(), live_before, "step(0) changed the mesh");
+                }
+                // Between steps: the view, the buffer and the report agree.
+                if calls % 16 == 1 || done || nv <= 64 {
+                    let live: Vec<[I; 3]> = s.triangles().collect();
+                    assert_eq!(
+                        live.len(),
+                        s.live_triangles(),
+                        "triangles() vs live_triangles()"
+                    );
+                    let buf_live: Vec<[I; 3]> = s
+                        .buffer()
+                        .iter()
+                        .copied()
+                        .filter(|t| !(t[0] == t[1] && t[1] == t[2]))
+                        .collect();
+                    assert_eq!(buf_live, live, "buffer's live triangles vs triangles()");
+                    let r = s.report();
+                    assert_eq!(r.triangles_out, s.live_triangles());
+                    assert_eq!(r.stop == Stop::Running, !done, "report().stop vs step()");
+                    let mut used = vec![false; nv];
+                    for t in &live {
+                        for &i in t {
+                            used[i.to_u32() as usize] = true;
+                        }
+                    }
+                    for (v, &u) in used.iter().enumerate() {
+                        assert_eq!(s.is_used(v), u, "is_used({v})");
+                        if !u {
+                            let _ = s.is_feature(v);
+                        }
+                    }
+                    assert!(!s.is_used(nv) && !s.is_used(usize::MAX));
+                    let _ = s.is_feature(nv);
+                }
+                if done {
+                    // Finished stays finished.
+                    assert!(s.step(1) && s.step(0) && s.step(u32::MAX));
+                    break;
+                }
+                assert!(calls < 50_000_000, "no end in sight");
+            }
+            Ok(s.finish())
+        }};
+    }
+    match case.cost {
+        CostKind::Default => drive!(ws.start(&case.positions, tris, &case.config)),
+        CostKind::Plane(w) => drive!(ws.start_with_cost(
+            &case.positions,
+            tris,
+            &case.config,
+            PlaneDistance { boundary_weight: w }
+        )),
+        CostKind::Normal {
+            length_weighted,
+            boundary_weight,
+        } => drive!(ws.start_with_cost(
+            &case.positions,
+            tris,
+            &case.config,
+            NormalVariation {
+                length_weighted,
+                boundary_weight
+            }
+        )),
+    }
+}
+
+fn run<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &Case) {
+    let input: Vec<[I; 3]> = case.triangles.iter().map(|t| t.map(I::from_u32)).collect();
+    let expected = expected_error::<L, I, V, T>(&case.positions, &input, &case.config);
+
+    // 1. One shot, on a reused workspace.
+    let mut one = input.clone();
+    let r1 = with_dirty::<L, V, T, _>(|ws| match case.cost {
+        CostKind::Default => ws.simplify(&case.positions, &mut one, &case.config),
+        _ => stepped(
+            ws,
+            &Case {
+                budgets: vec![u32::MAX],
+                ..case.clone()
+            },
+            &mut one,
+            None,
+        ),
+    });
+    // 2. Stepped with the fuzzed budgets, on a fresh workspace.
+    let mut two = input.clone();
+    let mut ws = Box::new(Workspace::<L, V, T>::new());
+    let r2 = stepped(&mut ws, case, &mut two, None);
+
+    match (&r1, &r2) {
+        (Err(e1), Err(e2)) => {
+            assert_eq!(e1, e2, "one-shot and stepped errors differ");
+            assert_eq!(Some(*e1), expected, "unexpected error");
+            assert!(
+                one == input && two == input,
+                "buffer modified on error {e1:?}"
+            );
+            let mut s = String::new();
+            std::fmt::Write::write_fmt(&mut s, format_args!("{e1}")).unwrap();
+            assert!(!s.is_empty());
+            return;
+        }
+        (Ok(a), Ok(b)) => {
+            assert_eq!(expected, None, "expected an error");
+            assert_eq!(a, b, "stepped report differs from one-shot");
+            assert!(one == two, "stepped buffer differs from one-shot");
+        }
+        _ => panic!("one-shot {r1:?} vs stepped {r2:?}"),
+    }
+    let report = r1.unwrap();
+    assert_ne!(report.stop, Stop::Running);
+    check_output(case, &input, &one, &report, "complete");
+
+    // 3. Finished early: still a valid mesh.
+    if let Some(k) = case.early {
+        let mut three = input.clone();
+        let r3 = stepped(&mut ws, case, &mut three, Some(k as usize)).expect("early run");
+        check_output(case, &input, &three, &r3, "early");
+    }
+}
+
+fn check_output<I: Idx>(
+    case: &Case,
+    input: &[[I; 3]],
+    buf: &[[I; 3]],
+    report: &Report,
+    what: &str,
+) {
+    let pos = &case.positions;
+    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
+    assert_eq!(report.triangles_in, inp.len());
+    assert!(
+        report.triangles_out <= inp.len(),
+        "{what}: more triangles out than in"
+    );
+    let out: Vec<[u32; 3]> = buf[..report.triangles_out]
+        .iter()
+        .map(|t| t.map(I::to_u32))
+        .collect();
+    assert_eq!(
+        report.target_reached,
+        report.triangles_out <= report.target_triangles
+    );
+    if report.stop == Stop::Target {
+        assert!(
+            report.target_reached,
+            "{what}: stop Target but target not reached"
+        );
+    }
+    let a = analyse(pos, &inp);
+    let b = analyse(pos, &out);
+    // Folds count only if the true geometry (f64) and the engine's own f32 view of it agree:
+    // where they disagree, the input has detail below f32 resolution at its scale.
+    let view = engine_view(pos, &inp);
+    let av = analyse_view(pos, &view, &inp);
+    let bv = analyse_view(pos, &view, &out);
+    let new_in_view: BTreeSet<_> = bv.folded.difference(&av.folded).collect();
+    assert_eq!(b.out_of_range, 0, "{what}: output index out of range");
+    assert_eq!(b.degenerate, 0, "{what}: degenerate output triangle");
+    assert_eq!(b.duplicates, 0, "{what}: duplicate output triangle");
+    assert_eq!(
+        report.degenerate_dropped, a.degenerate,
+        "{what}: degenerate_dropped"
+    );
+    assert_eq!(
+        report.duplicates_dropped, a.duplicates,
+        "{what}: duplicates_dropped"
+    );
+    assert!(
+        b.vertices.is_subset(&a.vertices),
+        "{what}: output uses a vertex the input did not"
+    );
+    assert!(
+        b.non_manifold_edges <= a.non_manifold_edges,
+        "{what}: non-manifold edges {} -> {}",
+        a.non_manifold_edges,
+        b.non_manifold_edges
+    );
+    let new_folds: Vec<_> = b
+        .folded
+        .difference(&a.folded)
+        .filter(|p| new_in_view.contains(p))
+        .collect();
+    assert!(
+        new_folds.is_empty(),
+        "{what}: new folded pairs {new_folds:?}"
+    );
+    if a.non_manifold_edges == 0 && a.duplicates == 0 && a.degenerate == 0 {
+        assert_eq!(b.boundary_loops, a.boundary_loops, "{what}: boundary loops");
+        assert_eq!(b.euler(), a.euler(), "{what}: Euler characteristic");
+    }
+}
+
+#[derive(Debug, Default)]
+pub struct Topology {
+    pub vertices: BTreeSet<u32>,
+    pub edges: usize,
+    pub faces: usize,
+    pub boundary_loops: usize,
+    pub non_manifold_edges: usize,
+    pub degenerate: usize,
+    pub duplicates: usize,
+    pub out_of_range: usize,
+    pub folded: BTreeSet<([u32; 3], [u32; 3])>,
+}
+
+impl Topology {
+    pub fn euler(&self) -> i64 {
+        self.vertices.len() as i64 - self.edges as i64 + self.faces as i64
+    }
+}
+
+/// Unit normals of adjacent triangles with a dot product below this are folded.
+pub const FOLD_DOT: f64 = -0.9;
+
+fn normal(pos: &[[f32; 3]], t: [u32; 3]) -> [f64; 3] {
+    let p = |i: u32| pos[i as usize].map(f64::from);
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 && l.is_finite() {
+        n.map(|x| x / l)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// The engine tests `dot < -0.9` in f32; pairs within this of the limit may go either way.
+pub const FOLD_MARGIN: f64 = 1e-4;
+
+/// Below this quality (`4√3·area / Σ edge²`, f64) a triangle's f32 normal may point anywhere.
+pub const MIN_Q: f64 = 1e-3;
+
+fn quality(pos: &[[f32; 3]], t: [u32; 3]) -> f64 {
+    let p = |i: u32| pos[i as usize].map(f64::from);
+    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+    let d = |x: [f64; 3], y: [f64; 3]| [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
+    let (u, v, w) = (d(a, b), d(a, c), d(b, c));
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let l2 = |x: [f64; 3]| x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
+    let s = l2(u) + l2(v) + l2(w);
+    if s > 0.0 && s.is_finite() {
+        2.0 * 3f64.sqrt() * l2(n).sqrt() / s
+    } else {
+        0.0
+    }
+}
+
+fn sorted(t: [u32; 3]) -> [u32; 3] {
+    let mut s = t;
+    s.sort_unstable();
+    s
+}
+
+/// The positions as the engine sees them: its affine map of the input's bounding box (over
+/// the vertices the triangles use) into about `[-1, 1]³`, in f32 (src/mesh.rs, `Mesh::build`).
+/// Fold checks use these, so that geometry finer than f32 resolves at the mesh's scale (say a
+/// 1e-20 detail beside a 1e-11 extent) does not count as a fold the engine failed to see.
+pub fn engine_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for t in tris {
+        for &i in t {
+            if let Some(p) = pos.get(i as usize) {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+    }
+    let mut centre = [0.0f32; 3];
+    let mut half = 0.0f32;
+    if !tris.is_empty() {
+        for a in 0..3 {
+            centre[a] = lo[a] * 0.5 + hi[a] * 0.5;
+            half = half.max(hi[a] * 0.5 - lo[a] * 0.5);
+        }
+    }
+    let inv = 1.0 / half;
+    let inv = if inv.is_finite() { inv } else { 1.0 };
+    pos.iter()
+        .map(|q| [0, 1, 2].map(|a| (q[a] * 0.5 - centre[a] * 0.5) * inv))
+        .collect()
+}
+
+/// Pairs on a common edge whose unit normals (f64, from `view`) have a dot product below
+/// `FOLD_DOT`; pairs with a triangle too thin for f32 normals to mean anything are left out.
+pub fn analyse(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Topology {
+    analyse_view(pos, pos, tris)
+}
+
+pub fn analyse_view(pos: &[[f32; 3]], view: &[[f32; 3]], tris: &[[u32; 3]]) -> Topology {
+    let mut top = Topology::default();
+    let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    let mut seen = HashSet::new();
+    for (i, &t) in tris.iter().enumerate() {
+        if t.iter().any(|&v| v as usize >= pos.len()) {
+            top.out_of_range += 1;
+            continue;
+        }
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            top.degenerate += 1;
+            continue;
+        }
+        if !seen.insert(sorted(t)) {
+            top.duplicates += 1;
+        }
+        top.faces += 1;
+        for k in 0..3 {
+            top.vertices.insert(t[k]);
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.entry((a.min(b), a.max(b))).or_default().push(i);
+        }
+    }
+    top.edges = edges.len();
+    top.non_manifold_edges = edges.values().filter(|f| f.len() > 2).count();
+    // Boundary loops: connected components of the boundary-edge graph.
+    let mut parent: HashMap<u32, u32> = HashMap::new();
+    fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
+        let mut r = x;
+        while let Some(&q) = p.get(&r) {
+            if q == r {
+                break;
+            }
+            r = q;
+        }
+        p.insert(x, r);
+        r
+    }
+    for (&(a, b), f) in &edges {
+        if f.len() == 1 {
+            parent.entry(a).or_insert(a);
+            parent.entry(b).or_insert(b);
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+            if ra != rb {
+                parent.insert(ra, rb);
+            }
+        }
+    }
+    let keys: Vec<u32> = parent.keys().copied().collect();
+    let roots: HashSet<u32> = keys.into_iter().map(|k| find(&mut parent, k)).collect();
+    top.boundary_loops = roots.len();
+    // Folded pairs: any two triangles with different vertex sets on a common edge (on a
+    // non-manifold edge too, so that dropping a duplicate does not make an old pair "new").
+    for f in edges.values() {
+        for (i, &ti) in f.iter().enumerate() {
+            for &tj in &f[i + 1..] {
+                let (t, u) = (tris[ti], tris[tj]);
+                let (x, y) = (sorted(t), sorted(u));
+                if x == y {
+                    continue;
+                }
+                let (a, b) = (normal(view, t), normal(view, u));
+                if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < FOLD_DOT - FOLD_MARGIN
+                    && quality(view, t) > MIN_Q
+                    && quality(view, u) > MIN_Q
+                {
+                    top.folded.insert((x.min(y), x.max(y)));
+                }
+            }
+        }
+    }
+    top
+}
+
+/// What `host_sim::io` promises of a loaded mesh.
+pub fn check_mesh_data(m: &host_sim::io::MeshData) {
+    assert!(!m.triangles.is_empty(), "loaded a mesh without triangles");
+    for t in &m.triangles {
+        for &i in t {
+            assert!((i as usize) < m.positions.len(), "index {i} out of range");
+        }
+    }
+    for p in &m.positions {
+        assert!(p.iter().all(|c| c.is_finite()), "non-finite position {p:?}");
+    }
+    let _ = m.bbox_diagonal();
+}
