@@ -656,86 +656,18 @@ mod tests {
         m
     }
 
-    fn icosahedron() -> MeshData {
-        let t = (1.0 + 5f64.sqrt()) / 2.0;
-        let raw = [
-            [-1.0, t, 0.0],
-            [1.0, t, 0.0],
-            [-1.0, -t, 0.0],
-            [1.0, -t, 0.0],
-            [0.0, -1.0, t],
-            [0.0, 1.0, t],
-            [0.0, -1.0, -t],
-            [0.0, 1.0, -t],
-            [t, 0.0, -1.0],
-            [t, 0.0, 1.0],
-            [-t, 0.0, -1.0],
-            [-t, 0.0, 1.0],
-        ];
-        let positions = raw
-            .iter()
-            .map(|p: &[f64; 3]| {
-                let l = norm2(*p).sqrt();
-                p.map(|c| (c / l) as f32)
-            })
-            .collect();
-        let triangles = vec![
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ];
+    /// Icosphere on the unit sphere: `levels` subdivisions of the icosahedron (the golden
+    /// cases' generator).
+    fn sphere(levels: u32) -> MeshData {
+        let m = meshfmt::golden::icosphere(levels);
         MeshData {
-            positions,
-            triangles,
+            positions: m.positions,
+            triangles: m.triangles,
         }
     }
 
-    /// Icosphere: `levels` midpoint subdivisions of the icosahedron, projected on the sphere.
-    fn sphere(levels: u32) -> MeshData {
-        let mut m = icosahedron();
-        for _ in 0..levels {
-            let mut mid = std::collections::HashMap::new();
-            let mut tris = Vec::new();
-            for t in m.triangles.clone() {
-                let mut e = [0u32; 3];
-                for k in 0..3 {
-                    let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-                    e[k] = *mid.entry((a, b)).or_insert_with(|| {
-                        let p = lerp(
-                            m.positions[a as usize].map(f64::from),
-                            m.positions[b as usize].map(f64::from),
-                            0.5,
-                        );
-                        let l = norm2(p).sqrt();
-                        m.positions.push(p.map(|c| (c / l) as f32));
-                        (m.positions.len() - 1) as u32
-                    });
-                }
-                tris.push([t[0], e[0], e[2]]);
-                tris.push([t[1], e[1], e[0]]);
-                tris.push([t[2], e[2], e[1]]);
-                tris.push(e);
-            }
-            m.triangles = tris;
-        }
-        m
+    fn icosahedron() -> MeshData {
+        sphere(0)
     }
 
     #[test]
