@@ -88,7 +88,7 @@ fn shape(p: [[f32; 3]; 3]) -> Shape {
             quality: 0.0,
         };
     }
-    let e = e.map(|v| [v[0] / m, v[1] / m, v[2] / m]);
+    let e = e.map(|v| math::div(v, m));
     // cross(p1 - p0, p2 - p0), with p2 - p0 = -e2.
     let n = math::cross(e[0], math::scale(e[2], -1.0));
     let l2 = math::dot(n, n);

@@ -79,6 +79,19 @@ pub(crate) fn max_abs(a: V3) -> f32 {
     }
 }
 
+/// `v / m` for `m > 0`: one reciprocal and three products, or three divisions when `1 / m`
+/// would overflow (a subnormal `m`). The branch depends only on the data, so every target
+/// takes the same one.
+#[inline]
+pub(crate) fn div(v: V3, m: f32) -> V3 {
+    let k = 1.0 / m;
+    if k.is_finite() {
+        scale(v, k)
+    } else {
+        [v[0] / m, v[1] / m, v[2] / m]
+    }
+}
+
 /// Unit vector, or zero for a zero vector (a zero-area triangle has no direction).
 ///
 /// Divided by its largest component before squaring: the squared length of a tiny but valid
@@ -88,7 +101,7 @@ pub(crate) fn max_abs(a: V3) -> f32 {
 pub(crate) fn unit(a: V3) -> V3 {
     let m = max_abs(a);
     if m > 0.0 {
-        let b = [a[0] / m, a[1] / m, a[2] / m];
+        let b = div(a, m);
         scale(b, 1.0 / sqrt(dot(b, b)))
     } else {
         [0.0; 3]

@@ -333,9 +333,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         if m.is_nan() || m <= 0.0 {
             return [0.0; 3];
         }
-        // Componentwise division: `* (1 / m)` would overflow for a subnormal m.
-        let d = |v: V3| [v[0] / m, v[1] / m, v[2] / m];
-        math::unit(math::cross(d(e1), d(e2)))
+        math::unit(math::cross(math::div(e1, m), math::div(e2, m)))
     }
 
     // ---- queries ----------------------------------------------------------------------
