@@ -278,6 +278,17 @@ fn obj_bytes(mesh: &MeshData) -> Vec<u8> {
 // ---------------------------------------------------------------------------------------------
 // PLY
 
+/// Bytes of one binary PLY scalar.
+fn scalar_bytes(t: &ply_rs_bw::ply::ScalarType) -> usize {
+    use ply_rs_bw::ply::ScalarType::*;
+    match t {
+        Char | UChar => 1,
+        Short | UShort => 2,
+        Int | UInt | Float => 4,
+        Double => 8,
+    }
+}
+
 fn parse_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
     use ply_rs_bw::parser::{Parser, Reader};
     use ply_rs_bw::ply::{DefaultElement, Encoding};
@@ -290,6 +301,36 @@ fn parse_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             Some(_) => format!("PLY header: {e}"),
             None => format!("PLY header (line {}): {e}", reader.line()),
         })?;
+    // A header can declare any element count; the payload reader then keeps adding elements
+    // (fuzzing found one that used 2 GB) before it notices the file is short. Every element
+    // takes at least one byte (an ASCII line; a binary scalar or list length), most take more,
+    // so a count the rest of the file cannot hold is refused here as a truncated file.
+    let rest = bytes
+        .len()
+        .saturating_sub(reader.get_ref().position() as usize);
+    for e in header.elements.values() {
+        let each = match header.encoding {
+            Encoding::Ascii => 1,
+            _ => e
+                .properties
+                .values()
+                .map(|p| match &p.data_type {
+                    ply_rs_bw::ply::PropertyType::Scalar(t) => scalar_bytes(t),
+                    ply_rs_bw::ply::PropertyType::List(n, _) => scalar_bytes(n),
+                })
+                .sum::<usize>()
+                .max(1),
+        };
+        if e.count.saturating_mul(each) > rest {
+            return Err(format!(
+                "PLY header declares {} `{}` elements, at least {} bytes, but only {rest} bytes \
+                 follow the header (truncated file?)",
+                e.count,
+                e.name,
+                e.count.saturating_mul(each)
+            ));
+        }
+    }
     let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
         let offset = reader.get_ref().position();
         match header.encoding {
@@ -650,6 +691,49 @@ mod tests {
         .unwrap();
         let e = err_of(&p);
         assert!(e.contains("only triangles"), "{e}");
+    }
+
+    /// Element counts the file cannot hold are refused before the payload is read: found by
+    /// the `ply` fuzz target (`fuzz/regressions/ply-huge-element-count`), which took 20 s and
+    /// 6.8 GB before failing, because an element without properties takes no bytes to read.
+    #[test]
+    fn ply_element_count_larger_than_the_file_is_refused_at_once() {
+        let found = include_bytes!("../../fuzz/regressions/ply-huge-element-count");
+        let e = format!("{:#}", parse_bytes(found, "ply").unwrap_err());
+        assert!(
+            e.contains("41111111111110") && e.contains("truncated"),
+            "{e}"
+        );
+
+        let end = "property float x\nproperty float y\nproperty float z\n\
+                   element face 0\nproperty list uchar int vertex_indices\nend_header\n";
+        // ASCII: at least a line per element.
+        let ascii = format!("ply\nformat ascii 1.0\nelement vertex 4000000000\n{end}0 0 0\n");
+        let e = format!("{:#}", parse_bytes(ascii.as_bytes(), "ply").unwrap_err());
+        assert!(
+            e.contains("4000000000 `vertex`") && e.contains("6 bytes"),
+            "{e}"
+        );
+        // Binary: 12 bytes per vertex, so 3 vertices do not fit in 24 bytes...
+        let bin = |n: usize, body: usize| {
+            let mut b = format!("ply\nformat binary_little_endian 1.0\nelement vertex {n}\n{end}")
+                .into_bytes();
+            b.resize(b.len() + body, 0);
+            parse_bytes(&b, "ply").map_err(|e| format!("{e:#}"))
+        };
+        let e = bin(3, 24).unwrap_err();
+        assert!(e.contains("at least 36 bytes"), "{e}");
+        // ...but 2 do: the payload is read, and the file fails later, for having no triangles.
+        let e = bin(2, 24).unwrap_err();
+        assert!(e.contains("no triangles"), "{e}");
+        // An element without properties counts one byte each.
+        let mut b = b"ply\nformat binary_big_endian 1.0\nelement junk 99999999999\n".to_vec();
+        b.extend_from_slice(
+            end.replace("element face 0\n", "element vertex 0\n")
+                .as_bytes(),
+        );
+        let e = format!("{:#}", parse_bytes(&b, "ply").unwrap_err());
+        assert!(e.contains("99999999999 `junk`"), "{e}");
     }
 
     fn stl_binary(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
