@@ -44,10 +44,13 @@
 //! // can be a `static`.
 //! let mut ws = Workspace::<u16, 64, 64>::new();
 //! let config = Config::new().with_ratio(0.25).with_schedule(Schedule::Greedy);
-//! let report = ws.simplify(&positions, &mut triangles, &config).unwrap();
+//! // An error is a typed value and the buffer is untouched: firmware hands it on (`?`) or
+//! // logs it; it never needs to panic.
+//! let report = ws.simplify(&positions, &mut triangles, &config)?;
 //! let simplified = &triangles[..report.triangles_out];
 //! assert!(report.triangles_out < 32);
 //! assert_eq!(simplified.len(), report.triangles_out);
+//! # Ok::<(), tinydecimate::Error>(())
 //! ```
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
