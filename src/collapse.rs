@@ -20,7 +20,7 @@ use crate::cost::Cost;
 use crate::feature::{self, Mean};
 use crate::heap::Heap;
 use crate::index::Index;
-use crate::legality::{self, Rules};
+use crate::legality::{self, on, Rules};
 use crate::mesh::{flag, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
@@ -278,7 +278,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     fn best(&mut self, from: usize) -> Option<(f32, usize)> {
         const CANDIDATES: usize = 32;
         let f = self.mesh.flags(from);
-        if f & flag::USED == 0 || f & (flag::LOCKED | flag::FEATURE) != 0 {
+        if f & flag::USED == 0 || f & skip() != 0 {
             return None;
         }
         let mut cand = [(f32::INFINITY, NIL); CANDIDATES];
@@ -340,7 +340,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// true cost equals its bound is cheaper than every other vertex's bound.
     fn rekey(&mut self, v: usize) {
         let f = self.mesh.flags(v);
-        if f & flag::USED == 0 || f & (flag::LOCKED | flag::FEATURE) != 0 {
+        if f & flag::USED == 0 || f & skip() != 0 {
             return self.heap.remove(v);
         }
         let mut key: Option<f32> = None;
@@ -493,8 +493,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
         let v = self.v;
         self.v += 1;
-        let skip = flag::DONE | flag::FEATURE | flag::LOCKED;
-        if !self.mesh.has(v, flag::USED) || self.mesh.has(v, skip) {
+        if !self.mesh.has(v, flag::USED) || self.mesh.has(v, flag::DONE | skip()) {
             return;
         }
         // Cheapest legal collapse between v and an unpaired neighbour, in either direction:
@@ -531,6 +530,11 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             self.pass_collapses += 1;
         }
     }
+}
+
+/// Flags that keep a vertex from moving (with the legality switches of `legality::on`).
+const fn skip() -> u8 {
+    (if on::LOCKED { flag::LOCKED } else { 0 }) | (if on::FEATURE { flag::FEATURE } else { 0 })
 }
 
 /// `(cost, vertex)` order: cheaper first, then the lower vertex number.

@@ -14,6 +14,18 @@ pub enum Schedule {
     Passes,
 }
 
+/// Which cost ranks the collapses (see [`crate::cost`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CostKind {
+    /// Memoryless quadric (Lindstrom-Turk style): the squared distance from the kept vertex to
+    /// the planes of the removed vertex's current triangles, plus a boundary term. The default.
+    Quadric,
+    /// The paper's normal variation W (seed 004 eq. 1-2); greedy multiplies it by the squared
+    /// edge length, passes uses it as written.
+    NormalVariation,
+}
+
 /// How the feature test (seed 004 §3, eq. 3-5) weighs a vertex's normal variation D.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -32,6 +44,8 @@ pub enum FeatureMode {
 pub struct Config {
     /// Collapse order.
     pub schedule: Schedule,
+    /// What a collapse costs.
+    pub cost: CostKind,
     /// Stop at or below this many triangles (`0`: use [`Config::target_ratio`] only).
     pub target_triangles: usize,
     /// Stop at or below this fraction of the valid input triangles, in `[0, 1]`.
@@ -70,6 +84,7 @@ impl Config {
     pub const fn new() -> Self {
         Config {
             schedule: Schedule::Greedy,
+            cost: CostKind::Quadric,
             target_triangles: 0,
             target_ratio: 0.1,
             max_cost: f32::INFINITY,
@@ -89,6 +104,7 @@ impl Config {
     pub const fn paper() -> Self {
         let mut c = Self::new();
         c.schedule = Schedule::Passes;
+        c.cost = CostKind::NormalVariation;
         c.lambda = 1.0;
         c.feature_targets = false;
         c
@@ -97,6 +113,12 @@ impl Config {
     /// Sets the schedule.
     pub const fn with_schedule(mut self, schedule: Schedule) -> Self {
         self.schedule = schedule;
+        self
+    }
+
+    /// Sets the cost.
+    pub const fn with_cost(mut self, cost: CostKind) -> Self {
+        self.cost = cost;
         self
     }
 

@@ -25,6 +25,40 @@ use crate::mesh::{flag, is_dead, Mesh, NIL};
 use crate::report::Reject;
 use crate::{Config, Schedule};
 
+/// Which rules are on. All of them, in every normal build. Building with the environment
+/// variable `TINYDECIMATE_RULE_OFF` set to one rule's name (`locked`, `feature`, `boundary`,
+/// `link`, `duplicate`, `sliver`, `normal_turn`, `fold`) switches that rule off, so that
+/// `scripts/rules-off.sh` can show that the test suite fails without each of them. Constants,
+/// so a normal build carries no trace of the switch.
+pub(crate) mod on {
+    const OFF: &str = match option_env!("TINYDECIMATE_RULE_OFF") {
+        Some(s) => s,
+        None => "",
+    };
+    const fn off(name: &str) -> bool {
+        let (a, b) = (OFF.as_bytes(), name.as_bytes());
+        if a.len() != b.len() {
+            return false;
+        }
+        let mut i = 0;
+        while i < a.len() {
+            if a[i] != b[i] {
+                return false;
+            }
+            i += 1;
+        }
+        true
+    }
+    pub(crate) const LOCKED: bool = !off("locked");
+    pub(crate) const FEATURE: bool = !off("feature");
+    pub(crate) const BOUNDARY: bool = !off("boundary");
+    pub(crate) const LINK: bool = !off("link");
+    pub(crate) const DUPLICATE: bool = !off("duplicate");
+    pub(crate) const SLIVER: bool = !off("sliver");
+    pub(crate) const NORMAL_TURN: bool = !off("normal_turn");
+    pub(crate) const FOLD: bool = !off("fold");
+}
+
 /// Two adjacent triangles whose unit normals have a dot product below this are folded onto
 /// each other (more than about 154° apart).
 pub(crate) const FOLD_DOT: f32 = -0.9;
@@ -129,10 +163,12 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
     b: usize,
 ) -> Result<f32, Reject> {
     let (fa, fb) = (mesh.flags(a), mesh.flags(b));
-    if fa & fb & flag::USED == 0 || (fa | fb) & flag::LOCKED != 0 {
+    if fa & fb & flag::USED == 0 || (on::LOCKED && (fa | fb) & flag::LOCKED != 0) {
         return Err(Reject::Locked);
     }
-    if fa & flag::FEATURE != 0 || (fb & flag::FEATURE != 0 && !rules.feature_targets) {
+    if on::FEATURE
+        && (fa & flag::FEATURE != 0 || (fb & flag::FEATURE != 0 && !rules.feature_targets))
+    {
         return Err(Reject::Feature);
     }
 
@@ -146,19 +182,19 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
     if n_ab == 0 {
         return Err(Reject::Link);
     }
-    if n_ab > 2 {
+    if on::LOCKED && n_ab > 2 {
         return Err(Reject::Locked);
     }
 
     // Boundary: a boundary vertex only slides along its own boundary edge.
     let mut retreat2 = 0.0;
     if fa & flag::BOUNDARY != 0 {
-        if n_ab != 1 {
+        if on::BOUNDARY && n_ab != 1 {
             return Err(Reject::Boundary);
         }
         let x = mesh.boundary_neighbour(a, b);
         let y = mesh.boundary_neighbour(b, a);
-        if x == y {
+        if on::BOUNDARY && x == y {
             // A loop of three edges would close up (or a lone triangle vanish).
             return Err(Reject::Boundary);
         }
@@ -186,15 +222,18 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
         let old_shape = shape(q);
         let new_shape = shape(r);
         // No area left (or none representable).
-        if new_shape.quality <= 0.0 {
+        if on::SLIVER && new_shape.quality <= 0.0 {
             return Err(Reject::Sliver);
         }
-        if new_shape.quality < rules.min_ratio && new_shape.quality < old_shape.quality {
+        if on::SLIVER
+            && new_shape.quality < rules.min_ratio
+            && new_shape.quality < old_shape.quality
+        {
             return Err(Reject::Sliver);
         }
         // A zero-area triangle has no direction to turn from.
         let (u0, u1) = (old_shape.normal, new_shape.normal);
-        if old_shape.quality > 0.0 && math::dot(u0, u1) < rules.cos_turn {
+        if on::NORMAL_TURN && old_shape.quality > 0.0 && math::dot(u0, u1) < rules.cos_turn {
             return Err(Reject::NormalTurn);
         }
         sum += cost.triangle(&TriangleChange {
@@ -253,7 +292,7 @@ pub(crate) fn connectivity<L: Index, I: Index>(
             continue;
         };
         let u1 = mesh.unit_normal(new);
-        if folds(mesh, t, new, u1, a, b) {
+        if on::FOLD && folds(mesh, t, new, u1, a, b) {
             return Err(Reject::Fold);
         }
     }
@@ -277,11 +316,11 @@ fn link_and_duplicates<L: Index, I: Index>(
                 continue;
             }
             both_opposite = false;
-            if mesh.has(x, flag::MARK) {
+            if on::LINK && mesh.has(x, flag::MARK) {
                 return Err(Reject::Link);
             }
         }
-        if both_opposite {
+        if on::DUPLICATE && both_opposite {
             // a's triangle (a, c, d) with c and d both opposite a-b becomes (b, c, d): refuse if
             // b already has it.
             let others = tri.map(|v| if v == a { b } else { v });

@@ -69,7 +69,7 @@ mod report;
 mod workspace;
 
 pub use collapse::Simplifier;
-pub use config::{Config, FeatureMode, Schedule};
+pub use config::{Config, CostKind, FeatureMode, Schedule};
 pub use index::Index;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
 pub use workspace::Workspace;
