@@ -6,24 +6,44 @@
 //! budget.
 //!
 //! ```text
-//! Mean ─> Flags ─┬─ Greedy: Keys ─> Queue (pop cheapest, re-check, collapse, update around it)
-//!                └─ Passes: Pairs (sweep vertices in index order, pair, collapse) ─> next pass: Mean
+//! Greedy: Mean ─> Keys ─> Queue: pop the cheapest vertex, check the rules on its candidates
+//!                   ^             in cost order, collapse, re-key the vertices whose fan changed
+//!                   └── when the mesh has halved (fresh feature threshold) or the queue is empty
+//! Passes: Mean ─> Flags ─> Pairs: sweep vertices in index order, pair, collapse ─> next pass
 //! ```
+//!
+//! A vertex's key is a lower bound: the price of its cheapest candidate under the flag and
+//! boundary rules only, from one walk around its fan. The connectivity and shape rules run when
+//! it reaches the top; if its cheapest *legal* collapse costs more than the key it goes back in
+//! at that price, so collapses still come out in exact cost order.
 //!
 //! Termination: every collapse removes a vertex, so there are fewer collapses than vertices.
 //! Between two collapses the queue only re-keys a popped vertex to its exact current cost (so
-//! its next pop collapses it) or drops it, so at most `2·V` pops separate two collapses; each
-//! pass of `Passes` visits each vertex once, and a pass without a collapse ends the run. Every
-//! operation below is bounded by the valences involved.
+//! its next pop collapses it) or drops it, so at most `2·V` pops separate two collapses; a
+//! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
+//! ends the run. Every operation below is bounded by the valences involved.
 
-use crate::cost::Cost;
-use crate::feature::{self, Mean};
+use crate::cost::{Cost, Move};
+use crate::feature::{Mean, Variation};
 use crate::heap::Heap;
 use crate::index::Index;
-use crate::legality::{self, on, Rules};
+use crate::legality::{self, on, Rules, Shape};
+use crate::math;
 use crate::mesh::{flag, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
+
+/// Candidates priced per vertex: its first `MAX_CANDIDATES` neighbours in fan order (a vertex
+/// of higher valence never moves onto the others).
+const MAX_CANDIDATES: usize = 32;
+
+/// One walk around a fan: the cost's summary, D, and the boundary ends.
+struct Walk<F> {
+    fan: F,
+    variation: Variation,
+    /// For a boundary vertex: the `a` of its first triangle and the `b` of its last.
+    ends: (usize, usize),
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Phase {
@@ -31,7 +51,7 @@ enum Phase {
     Mean,
     /// Setting feature flags.
     Flags,
-    /// Greedy: computing every vertex's cheapest collapse.
+    /// Greedy: classifying every vertex and computing its key.
     Keys,
     /// Greedy: collapsing from the queue.
     Queue,
@@ -66,13 +86,16 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     pass_collapses: usize,
     /// A legal collapse was skipped because it cost more than `max_cost`.
     over_cost: bool,
+    /// Greedy: refresh the feature threshold when the mesh is down to this many triangles.
+    refresh_at: usize,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
 }
 
 impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
-        let by_ratio = (config.target_ratio as f64 * mesh.valid_in as f64) as usize;
+        // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
+        let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
             config.target_triangles
         } else {
@@ -101,6 +124,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             passes: 0,
             pass_collapses: 0,
             over_cost: false,
+            refresh_at: 0,
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
         }
@@ -219,41 +243,45 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     self.mean = Mean::default();
                 }
                 if self.v < nv {
-                    if self.config.features {
-                        let d = feature::variation(&self.mesh, self.v, self.config.feature_mode);
-                        self.mean.add(d);
+                    if self.config.features && self.mesh.has(self.v, flag::USED) {
+                        let w = self.walk(self.v);
+                        self.mean.add(w.variation.value(self.config.feature_mode));
                     }
                     self.v += 1;
                 } else {
                     self.threshold = self.mean.threshold(self.config.lambda);
-                    self.phase = Phase::Flags;
                     self.v = 0;
                     self.features = 0;
+                    self.passes += 1;
+                    self.pass_collapses = 0;
+                    self.phase = match self.config.schedule {
+                        Schedule::Greedy => Phase::Keys,
+                        Schedule::Passes => Phase::Flags,
+                    };
                 }
             }
             Phase::Flags => {
                 if self.v < nv {
                     let v = self.v;
-                    let is = self.classify(v);
+                    let is = self.config.features
+                        && self.mesh.has(v, flag::USED)
+                        && self.is_feature_now(&self.walk(v));
                     self.mesh.set_flag(v, flag::FEATURE, is);
                     self.mesh.set_flag(v, flag::DONE, false);
                     self.features += is as usize;
                     self.v += 1;
                 } else {
                     self.v = 0;
-                    self.passes += 1;
-                    self.pass_collapses = 0;
-                    self.phase = match self.config.schedule {
-                        Schedule::Greedy => Phase::Keys,
-                        Schedule::Passes => Phase::Pairs,
-                    };
+                    self.phase = Phase::Pairs;
                 }
             }
             Phase::Keys => {
                 if self.v < nv {
                     self.rekey(self.v);
+                    self.features += self.mesh.has(self.v, flag::FEATURE) as usize;
                     self.v += 1;
                 } else {
+                    self.refresh_at = self.mesh.live / 2;
                     self.phase = Phase::Queue;
                 }
             }
@@ -262,101 +290,153 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
     }
 
-    fn classify(&self, v: usize) -> bool {
-        self.config.features
-            && feature::variation(&self.mesh, v, self.config.feature_mode)
-                .is_some_and(|d| d > self.threshold)
+    fn is_feature_now(&self, w: &Walk<C::Fan>) -> bool {
+        w.variation
+            .value(self.config.feature_mode)
+            .is_some_and(|d| d > self.threshold)
     }
 
-    /// The cheapest legal collapse of `from` onto one of its neighbours: `(cost, to)`.
-    /// Ties go to the lower vertex number.
-    ///
-    /// Every neighbour is priced first (cheap rules and cost); the connectivity rules then run
-    /// on the candidates in cost order only until one passes. Up to `CANDIDATES` candidates are
-    /// kept on the stack; any beyond (valence > 32) are checked in full on the spot. Either way
-    /// the answer is the minimum over the legal candidates.
-    fn best(&mut self, from: usize) -> Option<(f32, usize)> {
-        const CANDIDATES: usize = 32;
-        let f = self.mesh.flags(from);
-        if f & flag::USED == 0 || f & skip() != 0 {
-            return None;
+    /// One walk around `v`'s fan: the cost's summary of it, D and the boundary ends.
+    fn walk(&self, v: usize) -> Walk<C::Fan> {
+        let mesh = &self.mesh;
+        let pv = mesh.p(v);
+        let mut w = Walk {
+            fan: self.cost.empty(),
+            variation: Variation::default(),
+            ends: (NIL, NIL),
+        };
+        let mut c = mesh.first(v);
+        let mut first = true;
+        while c != NIL {
+            let tri = mesh.tri(c / 3);
+            let (x, y) = (tri[(c % 3 + 1) % 3], tri[(c % 3 + 2) % 3]);
+            // Twice the area and the unit normal from one cross product and one 1/√.
+            let n = math::cross(math::sub(mesh.p(x), pv), math::sub(mesh.p(y), pv));
+            let l2 = math::dot(n, n);
+            let (unit, area2) = if l2 > math::TINY2 && l2.is_finite() {
+                let r = math::rsqrt(l2);
+                (math::scale(n, r), l2 * r)
+            } else {
+                ([0.0; 3], 0.0)
+            };
+            self.cost.add(&mut w.fan, unit, area2);
+            w.variation.add(unit);
+            if first {
+                w.ends.0 = x;
+                first = false;
+            }
+            w.ends.1 = y;
+            c = mesh.after(c);
         }
-        let mut cand = [(f32::INFINITY, NIL); CANDIDATES];
+        w
+    }
+
+    /// The price of moving `from` (walked as `w`) onto `to`, if the flag and boundary rules
+    /// allow it: the cheap half of legality, enough for a lower bound.
+    fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<f32> {
+        let mesh = &self.mesh;
+        let ff = mesh.flags(from);
+        legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
+        let pf = mesh.p(from);
+        let pt = mesh.p(to);
+        let mut retreat2 = 0.0;
+        if ff & flag::BOUNDARY != 0 && on::BOUNDARY {
+            // Only along its own boundary edges; the boundary retreats to the segment from
+            // its other boundary neighbour to `to`.
+            let (x1, x2) = w.ends;
+            let other = if to == x1 {
+                x2
+            } else if to == x2 {
+                x1
+            } else {
+                return None;
+            };
+            retreat2 = math::segment_distance2(pf, mesh.p(other), pt);
+        }
+        let turn = if self.cost.needs_turn() {
+            self.turn(from, to)
+        } else {
+            0.0
+        };
+        let m = Move {
+            d: math::sub(pt, pf),
+            retreat2,
+            turn,
+        };
+        let c = self.cost.price(&w.fan, &m);
+        if c.is_finite() {
+            Some(if c > 0.0 { c } else { 0.0 })
+        } else {
+            None
+        }
+    }
+
+    /// Σ ‖N_new − N_old‖² over `from`'s triangles that survive the move onto `to` (seed 004
+    /// eq. 1-2), for costs that need it.
+    fn turn(&self, from: usize, to: usize) -> f32 {
+        let mesh = &self.mesh;
+        let pt = mesh.p(to);
+        let mut sum = 0.0;
+        for (t, k) in mesh.corners(from) {
+            let tri = mesh.tri(t);
+            if tri.contains(&to) {
+                continue;
+            }
+            let q = tri.map(|v| mesh.p(v));
+            let mut r = q;
+            if let Some(x) = r.get_mut(k) {
+                *x = pt;
+            }
+            let d = math::sub(Shape::of(r).unit(), Shape::of(q).unit());
+            sum += math::dot(d, d);
+        }
+        sum
+    }
+
+    /// `v`'s candidates with their prices, in fan order; returns how many.
+    fn candidates(
+        &self,
+        v: usize,
+        w: &Walk<C::Fan>,
+        out: &mut [(f32, usize); MAX_CANDIDATES],
+    ) -> usize {
         let mut n = 0;
-        let mut overflow: Option<(f32, usize)> = None;
-        let (mesh, rules, cost, rejected) =
-            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
-        mesh.for_each_neighbour(from, |to| {
-            match legality::price(mesh, rules, cost, from, to) {
-                Ok(c) => {
-                    if let Some(slot) = cand.get_mut(n) {
-                        *slot = (c, to);
-                        n += 1;
-                    } else {
-                        match legality::connectivity(mesh, from, to) {
-                            Ok(()) => {
-                                if overflow.is_none_or(|o| less((c, to), o)) {
-                                    overflow = Some((c, to));
-                                }
-                            }
-                            Err(r) => rejected.count(r),
-                        }
-                    }
+        self.mesh.for_each_neighbour(v, |x| {
+            if let Some(p) = self.price(v, w, x) {
+                if let Some(slot) = out.get_mut(n) {
+                    *slot = (p, x);
+                    n += 1;
                 }
-                Err(r) => rejected.count(r),
             }
         });
-        let cand = cand.get_mut(..n).unwrap_or(&mut []);
-        loop {
-            let mut min: Option<(usize, (f32, usize))> = None;
-            for (i, &c) in cand.iter().enumerate() {
-                if c.1 != NIL && min.is_none_or(|(_, m)| less(c, m)) {
-                    min = Some((i, c));
-                }
-            }
-            let Some((i, c)) = min else {
-                return overflow;
-            };
-            if overflow.is_some_and(|o| less(o, c)) {
-                return overflow;
-            }
-            match legality::connectivity(mesh, from, c.1) {
-                Ok(()) => return Some(c),
-                Err(r) => {
-                    rejected.count(r);
-                    if let Some(slot) = cand.get_mut(i) {
-                        slot.1 = NIL;
-                    }
-                }
-            }
-        }
+        n
     }
 
-    /// Greedy: recompute `v`'s key, a lower bound of its cheapest legal collapse: the
-    /// cheapest candidate that passes the cheap rules. The connectivity rules wait until the
-    /// vertex reaches the top of the queue (`pop` re-checks everything and re-queues it at its
-    /// true cost if the bound was not legal), so they run about once per collapse instead of
-    /// once per re-keyed vertex. The order of collapses is the same: a popped vertex whose
-    /// true cost equals its bound is cheaper than every other vertex's bound.
+    /// Greedy: re-classify `v` against the round's threshold and re-key it: the cheapest
+    /// price among its candidates (a lower bound of its cheapest legal collapse).
     fn rekey(&mut self, v: usize) {
         let f = self.mesh.flags(v);
-        if f & flag::USED == 0 || f & skip() != 0 {
+        if f & flag::USED == 0 || (on::LOCKED && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
         }
-        let mut key: Option<f32> = None;
-        let (mesh, rules, cost, rejected) =
-            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
-        mesh.for_each_neighbour(v, |to| match legality::price(mesh, rules, cost, v, to) {
-            Ok(c) => {
-                if key.is_none_or(|k| c < k) {
-                    key = Some(c);
-                }
+        let w = self.walk(v);
+        let is = self.config.features && self.is_feature_now(&w);
+        self.mesh.set_flag(v, flag::FEATURE, is);
+        if is && on::FEATURE {
+            return self.heap.remove(v);
+        }
+        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
+        let n = self.candidates(v, &w, &mut cand);
+        let mut key = f32::INFINITY;
+        for &(c, _) in cand.iter().take(n) {
+            if c < key {
+                key = c;
             }
-            Err(r) => rejected.count(r),
-        });
-        match key {
-            Some(c) => self.heap.set(v, c),
-            None => self.heap.remove(v),
+        }
+        if n > 0 {
+            self.heap.set(v, key)
+        } else {
+            self.heap.remove(v)
         }
     }
 
@@ -366,96 +446,79 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             return self.done(Stop::Target);
         }
         let Some((v, key)) = self.heap.peek() else {
-            // Flags far from recent collapses are stale: refresh everything once more (a new
-            // round) and stop only when a round finds nothing to collapse.
+            // Rules that look past a vertex's own fan may have changed far from recent
+            // collapses: a new round re-keys everything, and only a round without a collapse
+            // ends the run.
             if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
                 return self.done(Stop::NoLegalCollapse);
             }
-            self.log_pass();
-            self.phase = Phase::Mean;
-            self.v = 0;
-            return;
+            return self.new_round();
         };
+        if self.mesh.live <= self.refresh_at && self.passes < self.config.max_passes {
+            // The mesh has halved since the threshold was taken: take it afresh.
+            return self.new_round();
+        }
         if key > self.config.max_cost {
             return self.done(Stop::MaxCost);
         }
-        match self.best(v) {
-            None => self.heap.remove(v),
-            // Its neighbourhood changed since it was keyed: queue it at its true cost.
-            Some((c, _)) if c > key => self.heap.set(v, c),
-            Some((_, to)) => {
-                self.heap.remove(v);
-                self.collapse_greedy(v, to);
-                self.pass_collapses += 1;
+        let w = self.walk(v);
+        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
+        let n = self.candidates(v, &w, &mut cand);
+        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        while let Some((c, to)) = take_cheapest(cand) {
+            match legality::check(&self.mesh, &self.rules, v, to) {
+                Ok(()) => {
+                    if c > key {
+                        // Its cheapest candidate was illegal: back in at its true price.
+                        self.heap.set(v, c);
+                    } else {
+                        self.heap.remove(v);
+                        self.collapse_greedy(v, to);
+                    }
+                    return;
+                }
+                Err(r) => self.rejected.count(r),
             }
         }
+        self.heap.remove(v);
     }
 
-    /// Greedy: collapse `a -> b`, then refresh feature flags (seed 004 eq. 5 with a running
-    /// mean) and queue keys where the surface changed.
-    ///
-    /// Only the fans of `a`'s neighbours change (`b` is one of them): they are marked before
-    /// the collapse, their old D taken out of the mean and their new D put back, and they are
-    /// re-keyed. All of `b`'s neighbours are re-classified against the new mean (it rises as
-    /// the mesh coarsens, and stale flags would pin vertices that are no longer features);
-    /// an unmarked one is re-keyed only if its flag changed.
+    fn new_round(&mut self) {
+        self.log_pass();
+        self.phase = Phase::Mean;
+        self.v = 0;
+    }
+
+    /// Greedy: collapse `a -> b`, then re-key the vertices whose fan changed: `b` and `a`'s
+    /// other neighbours (marked before the collapse). Nothing else changes: the other
+    /// neighbours of `b` keep their fans, so their prices stand.
     fn collapse_greedy(&mut self, a: usize, b: usize) {
-        let mode = self.config.feature_mode;
-        let features = self.config.features;
-        self.mesh.mark_fan(a, true);
-        if features {
-            let mean = &mut self.mean;
-            let mesh = &self.mesh;
-            mean.sub(feature::variation(mesh, a, mode));
-            mesh.for_each_neighbour(a, |x| mean.sub(feature::variation(mesh, x, mode)));
-        }
+        let mesh = &self.mesh;
+        mesh.for_each_neighbour(a, |x| mesh.mark(x, true));
         self.mesh.collapse(a, b);
         self.collapses += 1;
-        if features {
-            let mean = &mut self.mean;
-            let mesh = &self.mesh;
-            mean.add(feature::variation(mesh, b, mode));
-            mesh.for_each_neighbour(b, |x| {
-                if mesh.has(x, flag::MARK) {
-                    mean.add(feature::variation(mesh, x, mode))
-                }
-            });
-            self.threshold = self.mean.threshold(self.config.lambda);
-        }
-        // b and the marked neighbours: new flag, new key, mark cleared. (a lost its flags in
-        // the collapse, and so did any vertex left without triangles.)
-        self.refresh(b);
-        self.for_neighbours(b, |s, x| s.refresh(x));
-    }
-
-    /// Greedy: re-classify `v`, and re-key it if its fan changed (marked) or its flag did;
-    /// clear its mark.
-    fn refresh(&mut self, v: usize) {
-        let mut changed = self.mesh.has(v, flag::MARK);
-        self.mesh.set_flag(v, flag::MARK, false);
-        if self.config.features {
-            let is = self.classify(v);
-            changed |= is != self.mesh.has(v, flag::FEATURE);
-            self.mesh.set_flag(v, flag::FEATURE, is);
-        }
-        if changed {
-            self.rekey(v);
-        }
-    }
-
-    /// Calls `f(self, x)` once for each neighbour `x` of `v`; `f` may change flags and keys,
-    /// never adjacency, so the walk can hold a corner number across the call.
-    fn for_neighbours(&mut self, v: usize, mut f: impl FnMut(&mut Self, usize)) {
-        let mut c = self.mesh.first(v);
+        self.pass_collapses += 1;
+        self.mesh.mark(b, false);
+        self.rekey(b);
+        let mut c = self.mesh.first(b);
+        let mut last = NIL;
         while c != NIL {
-            let tri = self.mesh.tri(c / 3);
-            let k = c % 3;
-            for x in [tri[(k + 1) % 3], tri[(k + 2) % 3]] {
-                if !self.mesh.seen_before(v, c, x) {
-                    f(self, x);
-                }
-            }
+            let x = self.mesh.tri(c / 3)[(c % 3 + 1) % 3];
+            self.refresh(x);
+            last = c;
             c = self.mesh.after(c);
+        }
+        if last != NIL {
+            let y = self.mesh.tri(last / 3)[(last % 3 + 2) % 3];
+            self.refresh(y);
+        }
+    }
+
+    /// Re-keys `x` if it is marked, and clears the mark.
+    fn refresh(&mut self, x: usize) {
+        if self.mesh.has(x, flag::MARK) {
+            self.mesh.mark(x, false);
+            self.rekey(x);
         }
     }
 
@@ -496,40 +559,80 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         if !self.mesh.has(v, flag::USED) || self.mesh.has(v, flag::DONE | skip()) {
             return;
         }
-        // Cheapest legal collapse between v and an unpaired neighbour, in either direction:
-        // Algorithm 1 moves the endpoint whose W is smaller.
-        let mut best: Option<(f32, usize, usize)> = None;
-        let (mesh, rules, cost, rejected) =
-            (&self.mesh, &self.rules, &self.cost, &mut self.rejected);
-        mesh.for_each_neighbour(v, |y| {
-            if mesh.has(y, flag::DONE) {
+        // Every collapse between v and an unpaired neighbour, in either direction (Algorithm 1
+        // moves the endpoint whose W is smaller), priced; the rules then run in price order.
+        let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
+        let mut n = 0;
+        let wv = self.walk(v);
+        self.mesh.for_each_neighbour(v, |y| {
+            if self.mesh.has(y, flag::DONE) {
                 return;
             }
-            for (from, to) in [(v, y), (y, v)] {
-                match legality::evaluate(mesh, rules, cost, from, to) {
-                    Ok(c) => {
-                        let better = best.is_none_or(|(bc, bf, bt)| {
-                            c < bc || (c == bc && (from, to) < (bf, bt))
-                        });
-                        if better {
-                            best = Some((c, from, to));
-                        }
+            let wy = self.walk(y);
+            for (from, to, w) in [(v, y, &wv), (y, v, &wy)] {
+                if let Some(p) = self.price(from, w, to) {
+                    if let Some(slot) = cand.get_mut(n) {
+                        *slot = (p, from, to);
+                        n += 1;
                     }
-                    Err(r) => rejected.count(r),
                 }
             }
         });
-        if let Some((c, from, to)) = best {
-            if c > self.config.max_cost {
-                self.over_cost = true;
-                return;
+        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        loop {
+            let mut min: Option<usize> = None;
+            for (i, c) in cand.iter().enumerate() {
+                if c.1 != NIL && min.is_none_or(|m| cand_less(*c, cand[m])) {
+                    min = Some(i);
+                }
             }
-            self.mesh.collapse(from, to);
-            self.mesh.set_flag(to, flag::DONE, true);
-            self.collapses += 1;
-            self.pass_collapses += 1;
+            let Some((c, from, to)) = min.and_then(|i| cand.get(i).copied()) else {
+                return;
+            };
+            if let Some(slot) = min.and_then(|i| cand.get_mut(i)) {
+                slot.1 = NIL;
+            }
+            match legality::check(&self.mesh, &self.rules, from, to) {
+                Ok(()) => {
+                    if c > self.config.max_cost {
+                        self.over_cost = true;
+                        return;
+                    }
+                    self.mesh.collapse(from, to);
+                    self.mesh.set_flag(to, flag::DONE, true);
+                    self.collapses += 1;
+                    self.pass_collapses += 1;
+                    return;
+                }
+                Err(r) => self.rejected.count(r),
+            }
         }
     }
+}
+
+/// Removes and returns the cheapest `(price, vertex)` (ties: lower vertex), if any is left.
+fn take_cheapest(cand: &mut [(f32, usize)]) -> Option<(f32, usize)> {
+    let mut min: Option<usize> = None;
+    for (i, c) in cand.iter().enumerate() {
+        if c.1 != NIL {
+            if let Some(m) = min.and_then(|m| cand.get(m)) {
+                if !less(*c, *m) {
+                    continue;
+                }
+            }
+            min = Some(i);
+        }
+    }
+    let slot = cand.get_mut(min?)?;
+    let c = *slot;
+    slot.1 = NIL;
+    Some(c)
+}
+
+/// `(price, from, to)` order: cheaper first, then the lower `(from, to)`.
+#[inline]
+fn cand_less(a: (f32, usize, usize), b: (f32, usize, usize)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && (a.1, a.2) < (b.1, b.2))
 }
 
 /// Flags that keep a vertex from moving (with the legality switches of `legality::on`).

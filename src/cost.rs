@@ -1,58 +1,124 @@
 //! Collapse costs: how much moving one vertex onto a neighbour changes the surface.
 //!
-//! The engine evaluates a collapse `from -> to` triangle by triangle (it needs each surviving
-//! triangle's old and new normal for the legality rules anyway) and hands every surviving
-//! triangle to [`Cost::triangle`]; triangles on the collapsed edge vanish and count 0
-//! (seed 004 §2.1). [`Cost::total`] then turns the sum into the collapse's priority. A new cost
-//! is a new implementation of this trait, passed to
-//! [`Workspace::start_with_cost`](crate::Workspace::start_with_cost); the engine does not change.
+//! The engine prices a vertex's collapses in one walk around its fan. Each triangle of the fan
+//! is handed to [`Cost::add`] (its unit normal and twice its area), building a small summary
+//! of the fan on the stack, then each candidate target is priced from that summary by
+//! [`Cost::price`] in O(1). A cost that needs every surviving triangle's *new* normal (the
+//! paper's W) says so with [`Cost::needs_turn`]; the engine then walks the fan once more per
+//! candidate and passes the summed normal change. A new cost is one more implementation of this
+//! trait, passed to [`Workspace::start_with_cost`](crate::Workspace::start_with_cost); the
+//! engine does not change.
 //!
 //! All lengths are in the engine's normalised units (the input's bounding box mapped to about
 //! `[-1, 1]³`), so costs do not depend on the scale of the input.
 
-/// One triangle of the moving vertex that survives the collapse.
-#[derive(Clone, Copy, Debug)]
-pub struct TriangleChange {
-    /// Unit normal before the collapse (zero for a zero-area triangle).
-    pub old_normal: [f32; 3],
-    /// Unit normal after the collapse.
-    pub new_normal: [f32; 3],
-    /// Twice the triangle's area before the collapse.
-    pub old_area2: f32,
-    /// How far the moving vertex moves (`to - from`).
-    pub moved: [f32; 3],
-}
+use crate::math::{self, V3};
+use crate::CostKind;
 
-/// The collapsed edge.
+/// One candidate collapse `from -> to`, as a cost sees it.
 #[derive(Clone, Copy, Debug)]
-pub struct EdgeChange {
-    /// Squared length of the edge.
-    pub length2: f32,
+pub struct Move {
+    /// How far the moving vertex moves (`to - from`).
+    pub d: [f32; 3],
     /// For a boundary vertex moving along its boundary: squared distance from it to the new
     /// boundary edge, i.e. how far the boundary retreats. Zero otherwise.
-    pub boundary_retreat2: f32,
+    pub retreat2: f32,
+    /// Σ ‖N_new − N_old‖² over the surviving triangles (unit normals; seed 004 eq. 2), when
+    /// [`Cost::needs_turn`]; zero otherwise.
+    pub turn: f32,
 }
 
-/// A collapse cost. Lower is better; the engine never performs a collapse whose total is not
+/// A collapse cost. Lower is better; the engine never performs a collapse whose price is not
 /// finite.
 pub trait Cost {
-    /// Contribution of one surviving triangle.
-    fn triangle(&self, change: &TriangleChange) -> f32;
-    /// The collapse's cost from the sum of the triangle terms.
-    fn total(&self, sum: f32, edge: &EdgeChange) -> f32;
+    /// What the cost keeps of one fan while the engine walks it.
+    type Fan: Copy;
+    /// The summary of an empty fan.
+    fn empty(&self) -> Self::Fan;
+    /// Adds one triangle of the moving vertex's fan: its unit normal (zero if it has no area)
+    /// and twice its area.
+    fn add(&self, fan: &mut Self::Fan, normal: V3, area2: f32);
+    /// The price of one move of the vertex whose fan was summarised.
+    fn price(&self, fan: &Self::Fan, m: &Move) -> f32;
+    /// Whether [`Move::turn`] must be computed (one more fan walk per candidate).
+    fn needs_turn(&self) -> bool;
+}
+
+/// Memoryless quadric error (Lindstrom and Turk's "memoryless" simplification, 1998; the
+/// quadrics of seeds 000 §3.3 and 003 without the per-vertex matrix): the mean squared
+/// distance from the kept vertex to the planes of the removed vertex's current triangles,
+/// weighted by area,
+///
+/// ```text
+/// E(a -> b) = Σ_t A_t (n_t · (p_b − p_a))² / Σ_t A_t  =  dᵀ Q d / Σ_t A_t,   Q = Σ_t A_t n_t n_tᵀ
+/// ```
+///
+/// plus `boundary_weight` times the squared boundary retreat. `Q` is six floats on the stack,
+/// built in one fan walk; each candidate then costs a 3×3 quadratic form. Dividing by the fan's
+/// area makes the price a squared distance (a plain sum would make small triangles cheap to
+/// remove however far they move, and thin parts would be eaten first).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Quadric {
+    /// Weight of the boundary retreat.
+    pub boundary_weight: f32,
+}
+
+/// The memoryless quadric under its former name.
+pub type PlaneDistance = Quadric;
+
+/// The fan summary of [`Quadric`]: `Q` (upper triangle, row by row) and the area.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct QuadricFan {
+    q: [f32; 6],
+    area2: f32,
+}
+
+impl Cost for Quadric {
+    type Fan = QuadricFan;
+
+    fn empty(&self) -> QuadricFan {
+        QuadricFan::default()
+    }
+
+    #[inline]
+    fn add(&self, f: &mut QuadricFan, n: V3, area2: f32) {
+        let w = area2;
+        let q = &mut f.q;
+        q[0] += w * n[0] * n[0];
+        q[1] += w * n[0] * n[1];
+        q[2] += w * n[0] * n[2];
+        q[3] += w * n[1] * n[1];
+        q[4] += w * n[1] * n[2];
+        q[5] += w * n[2] * n[2];
+        f.area2 += area2;
+    }
+
+    #[inline]
+    fn price(&self, f: &QuadricFan, m: &Move) -> f32 {
+        let (q, d) = (&f.q, &m.d);
+        let e = q[0] * d[0] * d[0]
+            + q[3] * d[1] * d[1]
+            + q[5] * d[2] * d[2]
+            + 2.0 * (q[1] * d[0] * d[1] + q[2] * d[0] * d[2] + q[4] * d[1] * d[2]);
+        let e = if f.area2 > 0.0 { e / f.area2 } else { 0.0 };
+        let e = if e > 0.0 { e } else { 0.0 };
+        e + self.boundary_weight * m.retreat2
+    }
+
+    fn needs_turn(&self) -> bool {
+        false
+    }
 }
 
 /// The paper's normal variation W (seed 004 §2, eq. 1-2, Algorithm 1): the sum over the moving
-/// vertex's triangles of ‖N_new − N_old‖², with no trigonometry.
+/// vertex's surviving triangles of ‖N_new − N_old‖², with no trigonometry.
 ///
-/// Two refinements, both reducing to the paper's W on an interior vertex when switched off:
-///
-/// * `length_weighted`: multiply by the squared edge length. W measures how far normals turn,
-///   not how far the surface moves; as a *global* priority alone it prefers long collapses
-///   across flat or cylindrical regions and piles edges onto hubs. Displacement is about
-///   length × normal change, so W·ℓ² ranks collapses by a squared distance.
+/// * `length_weighted`: multiply by the squared edge length (greedy). W measures how far
+///   normals turn, not how far the surface moves; as a *global* priority alone it prefers long
+///   collapses across flat regions. Displacement is about length × normal change, so W·ℓ²
+///   ranks collapses by a squared distance.
 /// * `boundary_weight`: a boundary vertex moving along its boundary adds
-///   `boundary_weight · retreat² / ℓ²` (scale-free like W; W·ℓ² then gets `boundary_weight ·
+///   `boundary_weight · retreat² / ℓ²` (scale-free like W; with W·ℓ², `boundary_weight ·
 ///   retreat²`), so open meshes keep their rims.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NormalVariation {
@@ -63,7 +129,7 @@ pub struct NormalVariation {
 }
 
 impl NormalVariation {
-    /// W as in the paper, plus the boundary term: the cost of the `Passes` schedule.
+    /// W as in the paper, plus the boundary term: the cost of `Config::paper()`.
     pub const fn paper(boundary_weight: f32) -> Self {
         NormalVariation {
             length_weighted: false,
@@ -71,7 +137,7 @@ impl NormalVariation {
         }
     }
 
-    /// W·ℓ² plus the boundary term: the cost of the `Greedy` schedule.
+    /// W·ℓ² plus the boundary term: greedy with `CostKind::NormalVariation`.
     pub const fn greedy(boundary_weight: f32) -> Self {
         NormalVariation {
             length_weighted: true,
@@ -81,45 +147,76 @@ impl NormalVariation {
 }
 
 impl Cost for NormalVariation {
-    #[inline]
-    fn triangle(&self, c: &TriangleChange) -> f32 {
-        // Eq. 2: ‖U − V‖² = (Ux − Vx)² + (Uy − Vy)² + (Uz − Vz)².
-        let d = crate::math::sub(c.new_normal, c.old_normal);
-        crate::math::dot(d, d)
-    }
+    type Fan = ();
+
+    fn empty(&self) {}
 
     #[inline]
-    fn total(&self, sum: f32, e: &EdgeChange) -> f32 {
+    fn add(&self, _: &mut (), _: V3, _: f32) {}
+
+    #[inline]
+    fn price(&self, _: &(), m: &Move) -> f32 {
+        let l2 = math::dot(m.d, m.d);
         if self.length_weighted {
-            sum * e.length2 + self.boundary_weight * e.boundary_retreat2
-        } else if e.length2 > 0.0 {
-            sum + self.boundary_weight * e.boundary_retreat2 / e.length2
+            m.turn * l2 + self.boundary_weight * m.retreat2
+        } else if l2 > 0.0 {
+            m.turn + self.boundary_weight * m.retreat2 / l2
         } else {
-            sum
+            m.turn
+        }
+    }
+
+    fn needs_turn(&self) -> bool {
+        true
+    }
+}
+
+/// The built-in costs, chosen at run time by [`Config::cost`](crate::Config::cost).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Builtin {
+    /// [`Quadric`].
+    Quadric(Quadric),
+    /// [`NormalVariation`].
+    NormalVariation(NormalVariation),
+}
+
+impl Builtin {
+    /// The cost a configuration names (W is length-weighted under the greedy schedule).
+    pub fn of(config: &crate::Config) -> Self {
+        let boundary_weight = config.boundary_weight;
+        match config.cost {
+            CostKind::Quadric => Builtin::Quadric(Quadric { boundary_weight }),
+            CostKind::NormalVariation => Builtin::NormalVariation(NormalVariation {
+                length_weighted: config.schedule == crate::Schedule::Greedy,
+                boundary_weight,
+            }),
         }
     }
 }
 
-/// Memoryless quadric error (Lindstrom and Turk's variant of seeds 000/003's quadrics, which
-/// needs no per-vertex matrix): the sum over the moving vertex's triangles of the area-weighted
-/// squared distance from the new position to the triangle's old plane. Shown here as the
-/// second cost that plugs into the same engine.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlaneDistance {
-    /// Weight of the boundary retreat, as in [`NormalVariation`].
-    pub boundary_weight: f32,
-}
+impl Cost for Builtin {
+    type Fan = QuadricFan;
 
-impl Cost for PlaneDistance {
-    #[inline]
-    fn triangle(&self, c: &TriangleChange) -> f32 {
-        let d = crate::math::dot(c.old_normal, c.moved);
-        d * d * c.old_area2
+    fn empty(&self) -> QuadricFan {
+        QuadricFan::default()
     }
 
     #[inline]
-    fn total(&self, sum: f32, e: &EdgeChange) -> f32 {
-        // retreat² · ℓ² has the units of the triangle terms (squared distance × area).
-        sum + self.boundary_weight * e.boundary_retreat2 * e.length2
+    fn add(&self, f: &mut QuadricFan, n: V3, area2: f32) {
+        if let Builtin::Quadric(q) = self {
+            q.add(f, n, area2)
+        }
+    }
+
+    #[inline]
+    fn price(&self, f: &QuadricFan, m: &Move) -> f32 {
+        match self {
+            Builtin::Quadric(q) => q.price(f, m),
+            Builtin::NormalVariation(w) => w.price(&(), m),
+        }
+    }
+
+    fn needs_turn(&self) -> bool {
+        matches!(self, Builtin::NormalVariation(_))
     }
 }

@@ -1,7 +1,9 @@
-//! Which collapses keep the mesh valid, and what they cost.
+//! Which collapses keep the mesh valid.
 //!
 //! A half-edge collapse `a -> b` (a moves onto b, b stays where it is) is refused when any rule
-//! below fails. The rules, in the order they are checked (cheapest first):
+//! below fails. The engine keys vertices by cost alone and runs these rules only when a vertex
+//! reaches the top of the queue, on its candidates in cost order. The rules, in the order they
+//! are checked (cheapest first):
 //!
 //! | rule       | refuses when                                                        | source |
 //! |------------|---------------------------------------------------------------------|--------|
@@ -17,11 +19,13 @@
 //! Interior vertices may move onto boundary vertices (the boundary does not change), never the
 //! reverse. Together with the link condition this keeps a closed manifold closed, keeps the
 //! Euler characteristic and the number of boundary loops, and never creates a non-manifold edge.
+//!
+//! No square root anywhere: angles are compared as `dot² ≶ cos²·|n₁|²·|n₂|²` on normals scaled
+//! by powers of two (exact), which is both cheaper and scale-safe.
 
-use crate::cost::{Cost, EdgeChange, TriangleChange};
 use crate::index::Index;
-use crate::math;
-use crate::mesh::{flag, is_dead, Mesh, NIL};
+use crate::math::{self, V3};
+use crate::mesh::{flag, Mesh, NIL};
 use crate::report::Reject;
 use crate::{Config, Schedule};
 
@@ -59,24 +63,27 @@ pub(crate) mod on {
     pub(crate) const FOLD: bool = !off("fold");
 }
 
-/// Two adjacent triangles whose unit normals have a dot product below this are folded onto
-/// each other (more than about 154° apart).
-pub(crate) const FOLD_DOT: f32 = -0.9;
+/// Two adjacent triangles whose unit normals have a dot product below −0.9 are folded onto
+/// each other (more than about 154° apart); compared squared: 0.81.
+const FOLD_DOT2: f32 = 0.81;
 
 /// The geometric limits of a [`Config`], precomputed.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Rules {
     cos_turn: f32,
+    cos_turn2: f32,
     /// `min_quality² / 12`, compared with `|n|² / (Σ edge²)²`.
     min_ratio: f32,
-    feature_targets: bool,
+    pub(crate) feature_targets: bool,
 }
 
 impl Rules {
     pub(crate) fn new(config: &Config) -> Self {
         let q = config.min_quality;
+        let c = math::cos(config.max_normal_turn_deg * (core::f32::consts::PI / 180.0));
         Rules {
-            cos_turn: math::cos(config.max_normal_turn_deg * (core::f32::consts::PI / 180.0)),
+            cos_turn: c,
+            cos_turn2: c * c,
             min_ratio: q * q / 12.0,
             // The paper's schedule keeps the paper's rule.
             feature_targets: config.feature_targets && config.schedule == Schedule::Greedy,
@@ -84,85 +91,87 @@ impl Rules {
     }
 }
 
-/// `tri` after moving `a` onto `b`, or `None` if it contains both and vanishes.
-#[inline]
-fn moved(tri: [usize; 3], a: usize, b: usize) -> Option<[usize; 3]> {
-    if tri.contains(&a) && tri.contains(&b) {
-        return None;
-    }
-    Some(tri.map(|v| if v == a { b } else { v }))
-}
-
 /// What the rules need of one triangle.
-struct Shape {
-    /// Unit normal (zero if no area).
-    normal: [f32; 3],
-    /// Twice the area.
-    area2: f32,
-    /// quality² / 12 = |n|² / (Σ edge²)², scale-free; 1/12 for an equilateral triangle.
+#[derive(Clone, Copy)]
+pub(crate) struct Shape {
+    /// The normal (cross product of the edges), scaled by a power of two to a largest
+    /// component in `[1, 2)`; zero if the triangle has no area.
+    n: V3,
+    /// `|n|²`.
+    n2: f32,
+    /// quality² / 12 = |cross|² / (Σ edge²)², scale-free; 1/12 for an equilateral triangle.
     quality: f32,
 }
 
-/// The triangle's shape, computed on its edges divided by their largest component, so that
-/// neither squares nor products of tiny or huge edges leave f32's normal range.
+impl Shape {
+    /// The shape of triangle `p`, computed on its edges scaled by a power of two (exact), so
+    /// that neither squares nor products of tiny or huge edges leave f32's normal range.
+    #[inline]
+    pub(crate) fn of(p: [V3; 3]) -> Shape {
+        let e = [
+            math::sub(p[1], p[0]),
+            math::sub(p[2], p[1]),
+            math::sub(p[0], p[2]),
+        ];
+        let m = math::max_abs(e[0])
+            .max(math::max_abs(e[1]))
+            .max(math::max_abs(e[2]));
+        let k = math::pow2_inverse(m);
+        if k == 0.0 {
+            return Shape {
+                n: [0.0; 3],
+                n2: 0.0,
+                quality: 0.0,
+            };
+        }
+        let e = e.map(|v| math::scale(v, k));
+        // cross(p1 - p0, p2 - p0), with p2 - p0 = -e2.
+        let c = math::cross(e[0], math::scale(e[2], -1.0));
+        let l2 = math::dot(c, c);
+        let s = math::dot(e[0], e[0]) + math::dot(e[1], e[1]) + math::dot(e[2], e[2]);
+        let n = math::pow2_normalize(c);
+        Shape {
+            n,
+            n2: math::dot(n, n),
+            quality: if s > 0.0 { l2 / (s * s) } else { 0.0 },
+        }
+    }
+
+    /// The unit normal (zero if no area).
+    #[inline]
+    pub(crate) fn unit(&self) -> V3 {
+        math::unit_of(self.n, self.n2)
+    }
+}
+
+/// Whether the angle between the normals of `u` and `v` exceeds the one whose cosine is `cos`.
 #[inline]
-fn shape(p: [[f32; 3]; 3]) -> Shape {
-    let e = [
-        math::sub(p[1], p[0]),
-        math::sub(p[2], p[1]),
-        math::sub(p[0], p[2]),
-    ];
-    let m = math::max_abs(e[0])
-        .max(math::max_abs(e[1]))
-        .max(math::max_abs(e[2]));
-    if m.is_nan() || m <= 0.0 {
-        return Shape {
-            normal: [0.0; 3],
-            area2: 0.0,
-            quality: 0.0,
-        };
-    }
-    let e = e.map(|v| math::div(v, m));
-    // cross(p1 - p0, p2 - p0), with p2 - p0 = -e2.
-    let n = math::cross(e[0], math::scale(e[2], -1.0));
-    let l2 = math::dot(n, n);
-    let s = math::dot(e[0], e[0]) + math::dot(e[1], e[1]) + math::dot(e[2], e[2]);
-    let len = math::sqrt(l2);
-    Shape {
-        normal: if len > 0.0 {
-            math::scale(n, 1.0 / len)
-        } else {
-            [0.0; 3]
-        },
-        area2: len * m * m,
-        quality: if s > 0.0 { l2 / (s * s) } else { 0.0 },
+fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
+    let d = math::dot(u.n, v.n);
+    let lim = cos2 * u.n2 * v.n2;
+    if cos >= 0.0 {
+        d < 0.0 || d * d < lim
+    } else {
+        d < 0.0 && d * d > lim
     }
 }
 
-/// Checks every rule for `a -> b` and returns its cost.
-pub(crate) fn evaluate<L: Index, I: Index, C: Cost>(
-    mesh: &Mesh<'_, L, I>,
-    rules: &Rules,
-    cost: &C,
-    a: usize,
-    b: usize,
-) -> Result<f32, Reject> {
-    let c = price(mesh, rules, cost, a, b)?;
-    connectivity(mesh, a, b)?;
-    Ok(c)
+/// Whether two triangles sharing an edge are folded onto each other.
+#[inline]
+fn folded(u: &Shape, v: &Shape) -> bool {
+    let d = math::dot(u.n, v.n);
+    d < 0.0 && d * d > FOLD_DOT2 * u.n2 * v.n2
 }
 
-/// The cheap rules (flags, boundary, each surviving triangle's own shape and turn) and the
-/// cost. The schedules call this for every candidate and [`connectivity`] only for the
-/// cheapest ones, in cost order, until one passes.
-pub(crate) fn price<L: Index, I: Index, C: Cost>(
-    mesh: &Mesh<'_, L, I>,
-    rules: &Rules,
-    cost: &C,
-    a: usize,
-    b: usize,
-) -> Result<f32, Reject> {
-    let (fa, fb) = (mesh.flags(a), mesh.flags(b));
+/// The shape of live triangle `t`.
+#[inline]
+fn shape_of<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, t: usize) -> Shape {
+    Shape::of(mesh.tri(t).map(|v| mesh.p(v)))
+}
+
+/// The flag rules alone: whether `a` may move at all, and onto a vertex with flags `fb`.
+#[inline]
+pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
     if fa & fb & flag::USED == 0 || (on::LOCKED && (fa | fb) & flag::LOCKED != 0) {
         return Err(Reject::Locked);
     }
@@ -171,11 +180,29 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
     {
         return Err(Reject::Feature);
     }
+    Ok(())
+}
 
-    // The number of triangles on edge a-b.
-    let mut n_ab = 0;
-    for (t, _) in mesh.corners(a) {
-        if mesh.tri(t).contains(&b) {
+/// Checks every rule for `a -> b`.
+pub(crate) fn check<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    a: usize,
+    b: usize,
+) -> Result<(), Reject> {
+    let fa = mesh.flags(a);
+    flags_allow(rules, fa, mesh.flags(b))?;
+
+    // The vertices opposite edge a-b: o1 in (a, b, o1), o2 in (a, o2, b).
+    let (mut o1, mut o2, mut n_ab) = (NIL, NIL, 0);
+    for (t, k) in mesh.corners(a) {
+        let tri = mesh.tri(t);
+        let (x, y) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        if x == b {
+            o1 = y;
+            n_ab += 1;
+        } else if y == b {
+            o2 = x;
             n_ab += 1;
         }
     }
@@ -186,192 +213,117 @@ pub(crate) fn price<L: Index, I: Index, C: Cost>(
         return Err(Reject::Locked);
     }
 
-    // Boundary: a boundary vertex only slides along its own boundary edge.
-    let mut retreat2 = 0.0;
-    if fa & flag::BOUNDARY != 0 {
-        if on::BOUNDARY && n_ab != 1 {
+    // Boundary: a boundary vertex only slides along its own boundary edge, and a boundary
+    // loop of three edges must not close up (or a lone triangle vanish).
+    if fa & flag::BOUNDARY != 0 && on::BOUNDARY {
+        if n_ab != 1 {
             return Err(Reject::Boundary);
         }
-        let x = mesh.boundary_neighbour(a, b);
-        let y = mesh.boundary_neighbour(b, a);
-        if on::BOUNDARY && x == y {
-            // A loop of three edges would close up (or a lone triangle vanish).
+        let (x1, x2) = mesh.boundary_ends(a);
+        let (y1, y2) = mesh.boundary_ends(b);
+        let x = if x1 == b { x2 } else { x1 };
+        let y = if y1 == a { y2 } else { y1 };
+        if x == y {
             return Err(Reject::Boundary);
-        }
-        if x != NIL {
-            retreat2 = math::segment_distance2(mesh.p(a), mesh.p(x), mesh.p(b));
         }
     }
 
-    // Each surviving triangle's shape and turn, and the cost. Positions are read once per
-    // triangle; the moved one differs from the old one in a's corner only.
-    let pa = mesh.p(a);
+    // Link condition: the only common neighbours of a and b are o1 and o2. b's neighbours are
+    // marked, so this is O(valence). The same walk finds b's triangles across (b, o1) and
+    // (b, o2), for the fold test.
+    let (mut across_o1, mut across_o2) = (NIL, NIL);
+    let mut c = mesh.first(b);
+    while c != NIL {
+        let tri = mesh.tri(c / 3);
+        let (x, y) = (tri[(c % 3 + 1) % 3], tri[(c % 3 + 2) % 3]);
+        if y == o1 && x != a {
+            across_o1 = c / 3;
+        }
+        if x == o2 && y != a {
+            across_o2 = c / 3;
+        }
+        c = mesh.after(c);
+    }
+    mesh.for_each_neighbour(b, |x| mesh.mark(x, true));
+    let mut common = false;
+    mesh.for_each_neighbour(a, |x| {
+        common |= x != b && x != o1 && x != o2 && mesh.has(x, flag::MARK);
+    });
+    mesh.for_each_neighbour(b, |x| mesh.mark(x, false));
+    if on::LINK && common {
+        return Err(Reject::Link);
+    }
+
+    // Each surviving triangle: duplicate, own shape and turn, folds with its neighbours
+    // after the collapse (the next survivor across a spoke, b's triangles across (b, o1) and
+    // (b, o2), and the unchanged triangles across its outer edge).
     let pb = mesh.p(b);
-    let shift = math::sub(pb, pa);
-    let mut sum = 0.0f32;
+    let mut first: Option<(usize, Shape)> = None;
+    let mut prev: Option<(usize, Shape)> = None;
     for (t, k) in mesh.corners(a) {
         let old = mesh.tri(t);
         if old.contains(&b) {
             continue;
         }
+        let (x, y) = (old[(k + 1) % 3], old[(k + 2) % 3]);
+        if on::DUPLICATE
+            && ((x == o1 && y == o2) || (x == o2 && y == o1))
+            && mesh.corners(b).any(|(u, _)| {
+                let s = mesh.tri(u);
+                s.contains(&x) && s.contains(&y)
+            })
+        {
+            return Err(Reject::Duplicate);
+        }
         let q = old.map(|v| mesh.p(v));
         let mut r = q;
-        if let Some(x) = r.get_mut(k) {
-            *x = pb;
+        if let Some(v) = r.get_mut(k) {
+            *v = pb;
         }
-        let old_shape = shape(q);
-        let new_shape = shape(r);
-        // No area left (or none representable).
-        if on::SLIVER && new_shape.quality <= 0.0 {
-            return Err(Reject::Sliver);
-        }
+        let was = Shape::of(q);
+        let now = Shape::of(r);
         if on::SLIVER
-            && new_shape.quality < rules.min_ratio
-            && new_shape.quality < old_shape.quality
+            && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
         {
             return Err(Reject::Sliver);
         }
         // A zero-area triangle has no direction to turn from.
-        let (u0, u1) = (old_shape.normal, new_shape.normal);
-        if on::NORMAL_TURN && old_shape.quality > 0.0 && math::dot(u0, u1) < rules.cos_turn {
+        if on::NORMAL_TURN
+            && was.quality > 0.0
+            && turned(&was, &now, rules.cos_turn, rules.cos_turn2)
+        {
             return Err(Reject::NormalTurn);
         }
-        sum += cost.triangle(&TriangleChange {
-            old_normal: u0,
-            new_normal: u1,
-            old_area2: old_shape.area2,
-            moved: shift,
-        });
-    }
-    let total = cost.total(
-        sum,
-        &EdgeChange {
-            length2: math::dot(shift, shift),
-            boundary_retreat2: retreat2,
-        },
-    );
-    if total.is_nan() || total == f32::INFINITY {
-        return Err(Reject::Sliver);
-    }
-    Ok(if total > 0.0 { total } else { 0.0 })
-}
-
-/// The rules that look past `a`'s own triangles: link condition, duplicates, folds.
-pub(crate) fn connectivity<L: Index, I: Index>(
-    mesh: &Mesh<'_, L, I>,
-    a: usize,
-    b: usize,
-) -> Result<(), Reject> {
-    // The vertices opposite edge a-b (at most two: `price` refused more).
-    let mut opp = [NIL; 2];
-    let mut n_ab = 0;
-    for (t, _) in mesh.corners(a) {
-        let tri = mesh.tri(t);
-        if tri.contains(&b) {
-            if let Some(slot) = opp.get_mut(n_ab) {
-                *slot = tri
-                    .iter()
-                    .copied()
-                    .find(|&x| x != a && x != b)
-                    .unwrap_or(NIL);
+        if on::FOLD {
+            let mut fold = false;
+            if let Some((py, ps)) = prev {
+                fold |= py == x && folded(&ps, &now);
             }
-            n_ab += 1;
+            for (v, u) in [(o1, across_o1), (o2, across_o2)] {
+                if (x == v || y == v) && u != NIL {
+                    fold |= folded(&now, &shape_of(mesh, u));
+                }
+            }
+            // Outer edge x-y: every other triangle holding both (one, on a manifold edge).
+            for (u, _) in mesh.corners(x) {
+                if u != t && mesh.tri(u).contains(&y) {
+                    fold |= folded(&now, &shape_of(mesh, u));
+                }
+            }
+            if fold {
+                return Err(Reject::Fold);
+            }
         }
+        if first.is_none() {
+            first = Some((x, now));
+        }
+        prev = Some((y, now));
     }
-    let opp = &opp[..n_ab.min(2)];
-
-    // Link condition: a neighbour x of a that is not opposite a-b must not be a neighbour of
-    // b too. b's neighbours are marked first, so the check is O(valence), not O(valence²).
-    mesh.mark_fan(b, true);
-    let link = link_and_duplicates(mesh, a, b, opp);
-    mesh.mark_fan(b, false);
-    link?;
-
-    for (t, _) in mesh.corners(a) {
-        let Some(new) = moved(mesh.tri(t), a, b) else {
-            continue;
-        };
-        let u1 = mesh.unit_normal(new);
-        if on::FOLD && folds(mesh, t, new, u1, a, b) {
+    // The spoke between the last survivor and the first (a's list is a rotated cycle).
+    if let (true, Some((fx, fs)), Some((ly, ls))) = (on::FOLD, first, prev) {
+        if fx == ly && fx != o1 && fx != o2 && folded(&fs, &ls) {
             return Err(Reject::Fold);
         }
     }
     Ok(())
-}
-
-fn link_and_duplicates<L: Index, I: Index>(
-    mesh: &Mesh<'_, L, I>,
-    a: usize,
-    b: usize,
-    opp: &[usize],
-) -> Result<(), Reject> {
-    for (t, _) in mesh.corners(a) {
-        let tri = mesh.tri(t);
-        if tri.contains(&b) {
-            continue;
-        }
-        let mut both_opposite = true;
-        for &x in &tri {
-            if x == a || opp.contains(&x) {
-                continue;
-            }
-            both_opposite = false;
-            if on::LINK && mesh.has(x, flag::MARK) {
-                return Err(Reject::Link);
-            }
-        }
-        if on::DUPLICATE && both_opposite {
-            // a's triangle (a, c, d) with c and d both opposite a-b becomes (b, c, d): refuse if
-            // b already has it.
-            let others = tri.map(|v| if v == a { b } else { v });
-            if mesh
-                .corners(b)
-                .any(|(u, _)| others.iter().all(|v| mesh.tri(u).contains(v)))
-            {
-                return Err(Reject::Duplicate);
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Whether the moved triangle `t` (now `new`, unit normal `u1`) would be folded onto any of its
-/// neighbours after the collapse `a -> b`.
-fn folds<L: Index, I: Index>(
-    mesh: &Mesh<'_, L, I>,
-    t: usize,
-    new: [usize; 3],
-    u1: [f32; 3],
-    a: usize,
-    b: usize,
-) -> bool {
-    for k in 0..3 {
-        let (p, q) = (new[k], new[(k + 1) % 3]);
-        // After the collapse, b's triangles are a's and b's together.
-        let lists = if p == b || q == b { [a, b] } else { [p, NIL] };
-        for owner in lists {
-            if owner == NIL {
-                continue;
-            }
-            for (s, _) in mesh.corners(owner) {
-                if s == t {
-                    continue;
-                }
-                let tri = mesh.tri(s);
-                if is_dead(tri) {
-                    continue;
-                }
-                let Some(post) = moved(tri, a, b) else {
-                    continue;
-                };
-                if post.contains(&p) && post.contains(&q) {
-                    let us = mesh.unit_normal(post);
-                    if math::dot(u1, us) < FOLD_DOT {
-                        return true;
-                    }
-                }
-            }
-        }
-    }
-    false
 }

@@ -7,17 +7,52 @@
 //! default) or micromath (fast approximations, feature `micromath`). Only `+ - * /` are used
 //! elsewhere, which IEEE 754 defines bit for bit, and Rust never contracts them into FMA.
 
-/// Square root.
+/// `1/√x` for `x` in f32's normal range (callers guarantee it), from `+ - *` only: the
+/// bit-level first guess and two Newton steps (relative error below 5e-6). The same bits on
+/// every target, and cheap where `sqrtf` is a software routine (a Cortex-M0 has no FPU;
+/// libm's `sqrtf` costs about 60 instructions even on an M4F).
 #[inline]
-pub(crate) fn sqrt(x: f32) -> f32 {
-    #[cfg(feature = "micromath")]
-    {
-        micromath::F32(x).sqrt().0
+pub(crate) fn rsqrt(x: f32) -> f32 {
+    let y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
+    let h = 0.5 * x;
+    let y = y * (1.5 - h * y * y);
+    y * (1.5 - h * y * y)
+}
+
+/// Below this a squared length is treated as zero (no direction): well inside f32's normal
+/// range, so [`rsqrt`] never sees a subnormal.
+pub(crate) const TINY2: f32 = 1e-30;
+
+/// The power of two `k` with `m·k` in `[1, 2)`, for a positive normal `m`; zero for zero, a
+/// subnormal, infinity or NaN (no direction worth keeping). Scaling by it is exact.
+#[inline]
+pub(crate) fn pow2_inverse(m: f32) -> f32 {
+    if !(m >= f32::MIN_POSITIVE) || !m.is_finite() {
+        return 0.0;
     }
-    #[cfg(not(feature = "micromath"))]
-    {
-        libm::sqrtf(x)
+    let e = (m.to_bits() >> 23) as i32 - 127;
+    // 2^-e; for e = 127 that is 2^-127, a subnormal power of two: the product is still exact.
+    if e < 127 {
+        f32::from_bits(((127 - e) as u32) << 23)
+    } else {
+        f32::from_bits(0x0040_0000)
     }
+}
+
+/// `v` scaled by a power of two (exact) so that its largest component lies in `[1, 2)`; zero
+/// stays zero. Directions of tiny or huge vectors survive squaring this way: a cross product
+/// of edges near 1e-20 long would otherwise underflow (found by fuzzing).
+#[inline]
+pub(crate) fn pow2_normalize(v: V3) -> V3 {
+    let mut v = v;
+    let mut m = max_abs(v);
+    // A subnormal largest component: lift by 2^64 first (exact).
+    if m > 0.0 && m < f32::MIN_POSITIVE {
+        let k = f32::from_bits((127 + 64) << 23);
+        v = scale(v, k);
+        m *= k;
+    }
+    scale(v, pow2_inverse(m))
 }
 
 /// Cosine of an angle in radians.
@@ -79,30 +114,11 @@ pub(crate) fn max_abs(a: V3) -> f32 {
     }
 }
 
-/// `v / m` for `m > 0`: one reciprocal and three products, or three divisions when `1 / m`
-/// would overflow (a subnormal `m`). The branch depends only on the data, so every target
-/// takes the same one.
+/// Unit vector of a vector with squared length `l2` (zero if tiny).
 #[inline]
-pub(crate) fn div(v: V3, m: f32) -> V3 {
-    let k = 1.0 / m;
-    if k.is_finite() {
-        scale(v, k)
-    } else {
-        [v[0] / m, v[1] / m, v[2] / m]
-    }
-}
-
-/// Unit vector, or zero for a zero vector (a zero-area triangle has no direction).
-///
-/// Divided by its largest component before squaring: the squared length of a tiny but valid
-/// normal (a mesh dwarfed by one stray vertex has cross products near 1e-22) would otherwise
-/// fall below f32's normal range and lose its direction (found by fuzzing).
-#[inline]
-pub(crate) fn unit(a: V3) -> V3 {
-    let m = max_abs(a);
-    if m > 0.0 {
-        let b = div(a, m);
-        scale(b, 1.0 / sqrt(dot(b, b)))
+pub(crate) fn unit_of(v: V3, l2: f32) -> V3 {
+    if l2 > TINY2 && l2.is_finite() {
+        scale(v, rsqrt(l2))
     } else {
         [0.0; 3]
     }

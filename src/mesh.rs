@@ -10,6 +10,15 @@
 //! Removed triangles are unlinked from every list, then written as `[b, b, b]` in the caller's
 //! buffer (a degenerate triangle, which renders as nothing), so lists only hold live corners.
 //!
+//! Every list is kept in *fan order*: for a vertex `v` whose fan is a disc or half-disc, the
+//! triangle after `(v, a, b)` (in winding order from `v`) is the one across edge `v-b`, i.e.
+//! `(v, b, c)`. A boundary vertex's list starts at the triangle whose edge `v-a` has no twin
+//! and ends at the one whose `v-b` has none. So a fan walk needs no search, each corner names
+//! one new neighbour (its `a`; a boundary fan adds its last `b`), and a collapse splices `a`'s
+//! surviving run into `b`'s list where the two removed triangles were. Locked vertices
+//! (non-manifold, pinched, inconsistently wound) keep an unordered list: they never move and are
+//! never the kept end, so nothing walks their fans in order.
+//!
 //! Every access goes through `get`, so a broken invariant shows up as a refused collapse, never
 //! as a panic.
 
@@ -51,7 +60,7 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     /// lengths and cross products can neither overflow nor underflow whatever the input's scale
     /// (coordinates near `f32::MAX` included). Every cost and test is scale-free or uses these
     /// normalised units.
-    centre: V3,
+    half_centre: V3,
     inv_half: f32,
     /// Live triangles.
     pub(crate) live: usize,
@@ -107,7 +116,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             head,
             next,
             flags: Cell::from_mut(flags).as_slice_of_cells(),
-            centre,
+            half_centre: math::scale(centre, 0.5),
             inv_half,
             live: 0,
             degenerate: 0,
@@ -160,7 +169,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             let mut f = 0;
             if mesh.first(v) != NIL {
                 f |= flag::USED;
-                match mesh.fan(v) {
+                match mesh.order(v) {
                     Fan::Interior => {}
                     Fan::Boundary => f |= flag::BOUNDARY,
                     Fan::Irregular => f |= flag::LOCKED,
@@ -273,21 +282,6 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         self.flags.get(v).map_or(flag::LOCKED, Cell::get)
     }
 
-    /// Sets or clears [`flag::MARK`] on every vertex of `v`'s triangles (`v` included).
-    pub(crate) fn mark_fan(&self, v: usize, on: bool) {
-        for (t, _) in self.corners(v) {
-            for x in self.tri(t) {
-                if let Some(f) = self.flags.get(x) {
-                    f.set(if on {
-                        f.get() | flag::MARK
-                    } else {
-                        f.get() & !flag::MARK
-                    });
-                }
-            }
-        }
-    }
-
     #[inline]
     pub(crate) fn has(&self, v: usize, f: u8) -> bool {
         self.flags(v) & f != 0
@@ -312,33 +306,17 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     pub(crate) fn p(&self, v: usize) -> V3 {
         match self.pos.get(v) {
             Some(q) => [
-                (q[0] * 0.5 - self.centre[0] * 0.5) * self.inv_half,
-                (q[1] * 0.5 - self.centre[1] * 0.5) * self.inv_half,
-                (q[2] * 0.5 - self.centre[2] * 0.5) * self.inv_half,
+                (q[0] * 0.5 - self.half_centre[0]) * self.inv_half,
+                (q[1] * 0.5 - self.half_centre[1]) * self.inv_half,
+                (q[2] * 0.5 - self.half_centre[2]) * self.inv_half,
             ],
             None => [0.0; 3],
         }
     }
 
-    /// Unit normal of the triangle `[a, b, c]` (zero if it has no area). The edges are
-    /// divided by their largest component before the cross product, so that a triangle that is
-    /// tiny in normalised units (a mesh dwarfed by one stray far vertex) keeps its direction
-    /// instead of underflowing to zero (found by fuzzing).
-    #[inline]
-    pub(crate) fn unit_normal(&self, tri: [usize; 3]) -> V3 {
-        let p0 = self.p(tri[0]);
-        let e1 = math::sub(self.p(tri[1]), p0);
-        let e2 = math::sub(self.p(tri[2]), p0);
-        let m = math::max_abs(e1).max(math::max_abs(e2));
-        if m.is_nan() || m <= 0.0 {
-            return [0.0; 3];
-        }
-        math::unit(math::cross(math::div(e1, m), math::div(e2, m)))
-    }
-
     // ---- queries ----------------------------------------------------------------------
 
-    /// Iterates `v`'s corners as `(triangle, slot)`.
+    /// Iterates `v`'s corners as `(triangle, slot)`, in fan order for a regular fan.
     #[inline]
     pub(crate) fn corners(&self, v: usize) -> Corners<'_, 'a, L, I> {
         Corners {
@@ -347,117 +325,143 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Calls `f` once for each distinct neighbour of `v`, in corner-list order.
-    pub(crate) fn for_each_neighbour(&self, v: usize, mut f: impl FnMut(usize)) {
+    /// The last corner of `v`'s list (`NIL` if none).
+    pub(crate) fn last(&self, v: usize) -> usize {
         let mut c = self.first(v);
-        while c != NIL {
-            let t = c / 3;
-            let tri = self.tri(t);
-            let k = c % 3;
-            for x in [tri[(k + 1) % 3], tri[(k + 2) % 3]] {
-                if !self.seen_before(v, c, x) {
-                    f(x);
-                }
-            }
+        let mut last = NIL;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            last = c;
             c = self.after(c);
         }
+        last
     }
 
-    /// Whether `x` is in a triangle of `v`'s list before corner `c`: O(valence), so a walk
-    /// over distinct neighbours is O(valence²), and valences are small.
+    /// The two ends of a boundary vertex's fan: the `a` of its first triangle and the `b` of
+    /// its last (`NIL` if none).
+    pub(crate) fn boundary_ends(&self, v: usize) -> (usize, usize) {
+        let (f, l) = (self.first(v), self.last(v));
+        let x = if f == NIL {
+            NIL
+        } else {
+            self.tri(f / 3)[(f % 3 + 1) % 3]
+        };
+        let y = if l == NIL {
+            NIL
+        } else {
+            self.tri(l / 3)[(l % 3 + 2) % 3]
+        };
+        (x, y)
+    }
+
+    /// Calls `f` once for each neighbour of `v`, in fan order: each corner's `a`, and for a
+    /// boundary fan the last corner's `b` too. Only for regular (unlocked) fans.
+    pub(crate) fn for_each_neighbour(&self, v: usize, mut f: impl FnMut(usize)) {
+        let mut c = self.first(v);
+        let mut last = NIL;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            f(self.tri(c / 3)[(c % 3 + 1) % 3]);
+            last = c;
+            c = self.after(c);
+        }
+        if self.has(v, flag::BOUNDARY) && last != NIL {
+            f(self.tri(last / 3)[(last % 3 + 2) % 3]);
+        }
+    }
+
+    /// Sets or clears [`flag::MARK`] on `v`.
     #[inline]
-    pub(crate) fn seen_before(&self, v: usize, c: usize, x: usize) -> bool {
-        let mut e = self.first(v);
-        while e != c && e != NIL {
-            if self.tri(e / 3).contains(&x) {
-                return true;
-            }
-            e = self.after(e);
+    pub(crate) fn mark(&self, v: usize, on: bool) {
+        if let Some(f) = self.flags.get(v) {
+            f.set(if on {
+                f.get() | flag::MARK
+            } else {
+                f.get() & !flag::MARK
+            });
         }
-        false
     }
 
-    /// The other end of `v`'s boundary edges, except `not`; `NIL` if none.
-    pub(crate) fn boundary_neighbour(&self, v: usize, not: usize) -> usize {
-        for (t, k) in self.corners(v) {
-            let tri = self.tri(t);
-            for x in [tri[(k + 1) % 3], tri[(k + 2) % 3]] {
-                if x != not && self.edge_valence(v, x) == 1 {
-                    return x;
-                }
-            }
-        }
-        NIL
-    }
-
-    /// Number of live triangles on edge `u`-`w`.
-    pub(crate) fn edge_valence(&self, u: usize, w: usize) -> usize {
-        self.corners(u)
-            .filter(|&(t, _)| self.tri(t).contains(&w))
-            .count()
-    }
-
-    /// Classifies the fan of triangles around `v`.
+    /// Classifies the fan of triangles around `v` and, if it is a disc or half-disc, relinks
+    /// its list in fan order (see the module comment).
     ///
-    /// Walking around `v` from triangle `(v, a, b)` (in winding order) crosses edge `v-a` into
-    /// the triangle `(v, a', a)`. The fan is a manifold disc (interior) or half-disc (boundary)
-    /// iff every edge `v-x` is used at most once in each direction, and one walk, started at
-    /// the boundary if there is one, visits every triangle.
-    fn fan(&self, v: usize) -> Fan {
-        let k_total = self.corners(v).count();
-        let mut boundary_edges = 0;
+    /// The fan is regular iff no directed edge `v->x` or `x->v` occurs twice (that would be a
+    /// non-manifold or inconsistently wound edge), at most one triangle has no predecessor
+    /// (the start of a half-disc; two would be two fans pinched together), and the walk from
+    /// the start takes in every triangle. O(valence²), once per vertex at the start.
+    fn order(&mut self, v: usize) -> Fan {
+        let mut total = 0;
+        let mut starts = 0;
         let mut start = self.first(v);
         for (t, k) in self.corners(v) {
             let tri = self.tri(t);
             let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
-            // Edge v->a is outgoing here; count how often v->a and a->v occur.
-            let (mut out_a, mut in_a) = (0, 0);
+            total += 1;
+            let (mut same_a, mut same_b, mut pred) = (0, 0, false);
             for (u, j) in self.corners(v) {
                 let s = self.tri(u);
-                if s[(j + 1) % 3] == a {
-                    out_a += 1;
-                }
-                if s[(j + 2) % 3] == a {
-                    in_a += 1;
-                }
+                same_a += (s[(j + 1) % 3] == a) as usize;
+                same_b += (s[(j + 2) % 3] == b) as usize;
+                pred |= s[(j + 2) % 3] == a;
             }
-            if out_a > 1 || in_a > 1 {
+            if same_a > 1 || same_b > 1 {
                 return Fan::Irregular;
             }
-            if in_a == 0 {
-                boundary_edges += 1;
-            }
-            // Edge b->v with no v->b: this triangle starts the chain.
-            if !self.corners(v).any(|(u, j)| self.tri(u)[(j + 1) % 3] == b) {
-                boundary_edges += 1;
+            if !pred {
+                starts += 1;
                 start = 3 * t + k;
             }
         }
-        if boundary_edges > 2 {
+        if starts > 1 {
             return Fan::Irregular;
         }
-        // Walk from `start`, crossing v-a each time.
-        let mut visited = 1;
-        let mut c = start;
-        while visited <= k_total {
-            let tri = self.tri(c / 3);
-            let a = tri[(c % 3 + 1) % 3];
-            let mut found = NIL;
-            for (u, j) in self.corners(v) {
-                if self.tri(u)[(j + 2) % 3] == a {
-                    found = 3 * u + j;
-                    break;
-                }
+        // Move the corners from the old list `rest` to the new one, successor by successor.
+        let mut rest = self.first(v);
+        let mut prev = NIL;
+        let mut c = rest;
+        while c != NIL && c != start {
+            prev = c;
+            c = self.after(c);
+        }
+        if c == NIL {
+            return Fan::Irregular;
+        }
+        let n = self.after(start);
+        if prev == NIL {
+            rest = n;
+        } else {
+            self.set_after(prev, n);
+        }
+        let mut last = start;
+        let mut count = 1;
+        loop {
+            let b = self.tri(last / 3)[(last % 3 + 2) % 3];
+            let (mut prev, mut c) = (NIL, rest);
+            while c != NIL && self.tri(c / 3)[(c % 3 + 1) % 3] != b {
+                prev = c;
+                c = self.after(c);
             }
-            if found == NIL || found == start {
+            if c == NIL {
                 break;
             }
-            visited += 1;
-            c = found;
+            let n = self.after(c);
+            if prev == NIL {
+                rest = n;
+            } else {
+                self.set_after(prev, n);
+            }
+            self.set_after(last, c);
+            last = c;
+            count += 1;
         }
-        match (visited == k_total, boundary_edges) {
+        // Anything left over (a second fan) goes on the end; the vertex is locked then.
+        self.set_after(last, rest);
+        self.set_first(v, start);
+        match (count == total, starts) {
             (true, 0) => Fan::Interior,
-            (true, 2) => Fan::Boundary,
+            (true, _) => Fan::Boundary,
             _ => Fan::Irregular,
         }
     }
@@ -489,50 +493,154 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Moves `a` onto `b` (half-edge collapse with subset placement, seed 004 §2): triangles on
-    /// edge `a-b` are removed, `a`'s other triangles now use `b`. The caller has checked
-    /// legality. Returns the number of triangles removed.
+    /// Moves `a` onto `b` (half-edge collapse with subset placement, seed 004 §2): the (one or
+    /// two) triangles on edge `a-b` are removed, `a`'s other triangles now use `b`. The caller
+    /// has checked legality. Returns the number of triangles removed.
+    ///
+    /// Fan order is kept: in `a`'s fan the survivors run from the triangle after `(a, b, o1)`
+    /// to the one before `(a, o2, b)`; in `b`'s fan the removed `(b, o1, a)` and `(b, a, o2)`
+    /// are adjacent, and the run takes their place. `o1` and `o2` just lose one triangle.
     pub(crate) fn collapse(&mut self, a: usize, b: usize) -> usize {
-        let mut removed = 0;
-        let mut keep = NIL;
-        let mut c = self.first(a);
-        let mut guard = self.tris.len() + 1;
+        // Rotate a's list to start right after (a, b, o1), so that the survivors come out in
+        // fan order whether a's fan is a disc or a half-disc.
+        let first = self.first(a);
+        let (mut c1, mut last) = (NIL, NIL);
+        let mut c = first;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let tri = self.tri(c / 3);
+            if tri[(c % 3 + 1) % 3] == b {
+                c1 = c;
+            }
+            last = c;
+            c = self.after(c);
+        }
+        let mut c = first;
+        if c1 != NIL && c1 != last {
+            self.set_after(last, first);
+            c = self.after(c1);
+            self.set_after(c1, NIL);
+        }
+        // Walk the rotated list: survivors are re-pointed at b and chained into the run;
+        // removed triangles are noted (at most two in a regular fan).
+        let (mut run_head, mut run_tail) = (NIL, NIL);
+        let mut dead = [NIL; 2];
+        let mut n_dead = 0;
+        let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
             let t = c / 3;
-            let tri = self.tri(t);
-            if tri.contains(&b) {
-                // Dies: out of b's and the third vertex's lists while it is intact, then gone.
-                for &x in &tri {
-                    if x != a {
-                        self.unlink(x, t);
-                    }
+            if self.tri(t).contains(&b) {
+                if let Some(d) = dead.get_mut(n_dead) {
+                    *d = t;
+                    n_dead += 1;
+                } else {
+                    // Only with a switched-off rule: a third triangle on a-b.
+                    self.remove_triangle(t, a);
                 }
-                self.kill(t);
-                removed += 1;
             } else {
                 self.set_corner(c, b);
-                self.set_after(c, keep);
-                keep = c;
+                self.set_after(c, NIL);
+                if run_tail == NIL {
+                    run_head = c;
+                } else {
+                    self.set_after(run_tail, c);
+                }
+                run_tail = c;
             }
             c = n;
         }
+        let dead = dead.get(..n_dead).unwrap_or(&[]);
+        self.splice(b, dead, run_head, run_tail);
         self.set_first(a, NIL);
         self.set_flags(a, 0);
-        // Splice a's surviving corners in front of b's list.
-        let mut c = keep;
-        let mut guard = 3 * self.tris.len() + 1;
+        for &t in dead {
+            self.remove_triangle(t, b);
+        }
+        dead.len()
+    }
+
+    /// Replaces the (adjacent) corners of `b` in the `dead` triangles with the run
+    /// `head..tail`. Non-adjacent windows only arise from a switched-off rule: then the dead
+    /// corners are unlinked and the run goes in front.
+    fn splice(&mut self, b: usize, dead: &[usize], head: usize, tail: usize) {
+        let (mut w_first, mut w_pred, mut w_last, mut w_last_pred, mut w_succ) =
+            (NIL, NIL, NIL, NIL, NIL);
+        let mut adjacent = true;
+        let (mut prev, mut c) = (NIL, self.first(b));
+        let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            let h = self.first(b);
-            self.set_after(c, h);
-            self.set_first(b, c);
+            if dead.contains(&(c / 3)) {
+                if w_first == NIL {
+                    w_first = c;
+                    w_pred = prev;
+                } else if prev != w_last {
+                    adjacent = false;
+                }
+                w_last = c;
+                w_last_pred = prev;
+                w_succ = n;
+            }
+            prev = c;
             c = n;
         }
-        self.live = self.live.saturating_sub(removed);
-        removed
+        let list_last = prev;
+        // What comes after the run, and where the run hangs.
+        if w_first != NIL && adjacent {
+            // ... pred, [dead], succ ...  ->  ... pred, run, succ ...
+            self.link_run(b, w_pred, head, tail, w_succ);
+        } else if dead.len() == 2 && w_first == self.first(b) && w_last == list_last {
+            // The window wraps around the end of a disc's list: [d2, x.., y, d1]
+            // -> [x.., y, run].
+            let x = self.after(w_first);
+            if w_last_pred == w_first {
+                self.set_first(b, NIL);
+                self.link_run(b, NIL, head, tail, NIL);
+            } else {
+                self.set_first(b, x);
+                self.link_run(b, w_last_pred, head, tail, NIL);
+            }
+        } else {
+            for &t in dead {
+                self.unlink(b, t);
+            }
+            let h = self.first(b);
+            self.link_run(b, NIL, head, tail, h);
+        }
+    }
+
+    /// Links `pred -> head..tail -> succ` in `b`'s list (`pred` NIL: the run becomes the head;
+    /// an empty run links `pred -> succ`).
+    fn link_run(&mut self, b: usize, pred: usize, head: usize, tail: usize, succ: usize) {
+        let (h, t) = if head == NIL {
+            (succ, NIL)
+        } else {
+            (head, tail)
+        };
+        if pred == NIL {
+            self.set_first(b, h);
+        } else {
+            self.set_after(pred, h);
+        }
+        if t != NIL {
+            self.set_after(t, succ);
+        }
+    }
+
+    /// Takes triangle `t` (still intact) out of the lists of its vertices other than `skip`
+    /// and writes it as removed.
+    fn remove_triangle(&mut self, t: usize, skip: usize) {
+        for x in self.tri(t) {
+            if x != skip {
+                self.unlink(x, t);
+            }
+        }
+        self.kill(t);
+        self.live = self.live.saturating_sub(1);
     }
 
     /// Moves the live triangles to the front of the buffer, in their original order, and

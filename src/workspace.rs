@@ -1,10 +1,10 @@
 //! The fixed-capacity working memory, sized at compile time.
 
 use crate::collapse::Simplifier;
-use crate::cost::{Cost, NormalVariation};
+use crate::cost::{Builtin, Cost};
 use crate::index::Index;
 use crate::mesh::Mesh;
-use crate::{Config, Error, Report, Schedule};
+use crate::{Config, Error, Report};
 
 /// All working state of the simplifier, with capacity fixed by const generics.
 ///
@@ -83,12 +83,8 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         positions: &'a [[f32; 3]],
         triangles: &'a mut [[I; 3]],
         config: &Config,
-    ) -> Result<Simplifier<'a, L, I, NormalVariation>, Error> {
-        let cost = match config.schedule {
-            Schedule::Greedy => NormalVariation::greedy(config.boundary_weight),
-            Schedule::Passes => NormalVariation::paper(config.boundary_weight),
-        };
-        self.start_with_cost(positions, triangles, config, cost)
+    ) -> Result<Simplifier<'a, L, I, Builtin>, Error> {
+        self.start_with_cost(positions, triangles, config, Builtin::of(config))
     }
 
     /// Like [`Workspace::start`], with another [`Cost`].
