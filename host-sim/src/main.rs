@@ -24,7 +24,8 @@ enum Command {
     Check(check::Args),
     /// Flat-shaded PNG of a mesh, or a side-by-side comparison with an error heatmap.
     Render(render::Args),
-    /// tinydecimate (both schedules) against meshoptimizer: time, memory, error, validity.
+    /// Every tinydecimate mode (default, greedy W, paper passes) against meshoptimizer: time,
+    /// memory, error (also at the same triangle count when the library stops short), validity.
     Bench(bench::Args),
     /// The library on QEMU-emulated Cortex-M0/M3/M4F/M7/M33 boards, compared with the host;
     /// --measure for instructions, stack, image sizes and the largest mesh per board.

@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
-use tinydecimate::{Config, FeatureMode, Report, Schedule, Workspace};
+use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Workspace};
 
 use crate::io::MeshData;
 
@@ -62,13 +62,24 @@ pub enum ScheduleArg {
     Passes,
 }
 
-/// Which cost, on the command line.
+/// Which cost, on the command line (`Config::with_cost`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CostArg {
-    /// Normal variation W (seed 004), scaled by ℓ² for the greedy schedule.
+    /// `CostKind::Quadric`: memoryless quadric, squared distance to the removed vertex's
+    /// current planes plus a boundary term (the default of `Config::new()`).
+    Quadric,
+    /// `CostKind::NormalVariation`: the paper's normal variation W, scaled by ℓ² for the
+    /// greedy schedule (the cost of `Config::paper()`).
     Normal,
-    /// Memoryless quadric: area-weighted squared distance to the moving vertex's old planes.
-    Plane,
+}
+
+impl From<CostArg> for CostKind {
+    fn from(c: CostArg) -> CostKind {
+        match c {
+            CostArg::Quadric => CostKind::Quadric,
+            CostArg::Normal => CostKind::NormalVariation,
+        }
+    }
 }
 
 /// `host-sim simplify IN OUT ...`
@@ -109,9 +120,10 @@ pub struct Args {
     /// Weight of the boundary retreat in the cost.
     #[arg(long)]
     pub boundary_weight: Option<f32>,
-    /// Collapse cost: the paper's normal variation, or memoryless plane distance.
-    #[arg(long, value_enum, default_value_t = CostArg::Normal)]
-    pub cost: CostArg,
+    /// Collapse cost (default: the schedule's own, quadric for greedy as in `Config::new()`,
+    /// normal for passes as in `Config::paper()`).
+    #[arg(long, value_enum)]
+    pub cost: Option<CostArg>,
     /// Skip the validity check and the Metro measurement afterwards.
     #[arg(long)]
     pub no_measure: bool,
@@ -127,6 +139,10 @@ impl Args {
         let base = match self.schedule {
             ScheduleArg::Greedy => Config::new().with_schedule(Schedule::Greedy),
             ScheduleArg::Passes => Config::paper(),
+        };
+        let base = match self.cost {
+            Some(cost) => base.with_cost(cost.into()),
+            None => base,
         };
         let mut c = base.with_feature_mode(if self.valence_normalized {
             FeatureMode::ValenceNormalized
@@ -160,36 +176,14 @@ impl Args {
 
 /// Runs the library on `mesh`. The result keeps all of `mesh`'s positions (the library only
 /// rewrites triangles).
+/// The cost is `config.cost`; the wall time is that of `Workspace::simplify` alone.
 pub fn simplify(mesh: &MeshData, config: &Config) -> Result<(MeshData, Report, Duration)> {
-    simplify_with(mesh, config, CostArg::Normal)
-}
-
-/// [`simplify`] with a choice of cost.
-pub fn simplify_with(
-    mesh: &MeshData,
-    config: &Config,
-    cost: CostArg,
-) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
     let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let start = Instant::now();
-    let report = match cost {
-        CostArg::Normal => ws.simplify(&mesh.positions, &mut tris, config),
-        CostArg::Plane => ws
-            .start_with_cost(
-                &mesh.positions,
-                &mut tris,
-                config,
-                tinydecimate::cost::PlaneDistance {
-                    boundary_weight: config.boundary_weight,
-                },
-            )
-            .map(|mut s| {
-                while !s.step(u32::MAX) {}
-                s.finish()
-            }),
-    }
-    .map_err(|e| anyhow!("tinydecimate: {e}"))?;
+    let report = ws
+        .simplify(&mesh.positions, &mut tris, config)
+        .map_err(|e| anyhow!("tinydecimate: {e}"))?;
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     let out = MeshData {
@@ -248,7 +242,7 @@ pub fn format_report(r: &Report) -> String {
 pub fn run(args: &Args) -> Result<ExitCode> {
     let mesh = crate::io::load(&args.input)?;
     let config = args.config();
-    let (out, report, elapsed) = simplify_with(&mesh, &config, args.cost)?;
+    let (out, report, elapsed) = simplify(&mesh, &config)?;
     crate::io::save(&args.output, &out)?;
 
     println!(
@@ -353,6 +347,31 @@ mod tests {
         assert_eq!(cfg.target_ratio, 0.25);
         assert_eq!(cfg.schedule, Schedule::Greedy);
         assert_eq!(cfg.feature_mode, FeatureMode::Paper);
+        assert_eq!(cfg.cost, CostKind::Quadric);
+        assert_eq!(cfg, Config::new().with_ratio(0.25));
+        let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.1", "--cost", "normal"])
+            .unwrap();
+        assert_eq!(
+            c.args.config(),
+            Config::new().with_cost(CostKind::NormalVariation)
+        );
+        let c =
+            Cli::try_parse_from(["x", "a", "b", "--ratio", "0.1", "--schedule", "passes"]).unwrap();
+        assert_eq!(c.args.config(), Config::paper().with_ratio(0.1));
+        let c = Cli::try_parse_from([
+            "x",
+            "a",
+            "b",
+            "--ratio",
+            "0.1",
+            "--schedule",
+            "passes",
+            "--cost",
+            "quadric",
+        ])
+        .unwrap();
+        assert_eq!(c.args.config().cost, CostKind::Quadric);
+        assert!(Cli::try_parse_from(["x", "a", "b", "--ratio", "0.1", "--cost", "plane"]).is_err());
         let c = Cli::try_parse_from([
             "x",
             "a.obj",
