@@ -250,6 +250,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         args.input.display(),
         args.output.display()
     );
+    println!(
+        "  schedule, cost         {:?}, {:?}",
+        config.schedule, config.cost
+    );
     println!("{}", format_report(&report));
     println!(
         "  library call           {:.3} ms",
