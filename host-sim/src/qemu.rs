@@ -3,7 +3,8 @@
 //! compares it with the golden files ([`crate::golden`], `host-sim qemu --check`) or a fresh
 //! host run. Also measures each board (`--measure`): instructions (SysTick under
 //! `-icount shift=0`), stack high-water mark, image sizes of the firmware and of the library
-//! alone, and the largest mesh it simplifies.
+//! alone, the flash of one instantiation (the minimal firmware of `tests/flash`, as
+//! `scripts/flash.sh` builds it: [`one_instantiation`]), and the largest mesh it simplifies.
 //!
 //! `host-sim qemu` ([`Args`], [`run`]); `host-sim qemu --help` lists the modes. By hand (what
 //! [`build`] and [`run_in`] do):
@@ -183,6 +184,89 @@ pub fn build(board: &Board, backend: Backend, with_library: bool) -> Result<Path
     std::fs::copy(&built, &elf)
         .with_context(|| format!("copying {} to {}", built.display(), elf.display()))?;
     Ok(elf)
+}
+
+/// The minimal firmware that measures the flash of one instantiation (`tests/flash`, also
+/// built by `scripts/flash.sh`).
+pub fn flash_crate_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host-sim sits in the repository")
+        .join("tests/flash")
+}
+
+/// Its target directory: the one `scripts/flash.sh` uses by default, so both share builds and
+/// `images/`.
+pub fn flash_target_dir() -> PathBuf {
+    flash_crate_dir().join("target")
+}
+
+/// What [`one_instantiation`] measures, as `scripts/flash.sh` describes its first row.
+pub const ONE_INSTANTIATION: &str =
+    "Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new(); opt-level s, fat LTO";
+
+/// Builds `tests/flash` for `target` with its own release profile (opt-level "s", fat LTO, one
+/// codegen unit, panic = abort) without or with the feature `call`, on `backend`, exactly as
+/// `scripts/flash.sh` does. Returns the image, copied to
+/// `tests/flash/target/images/<target>-<without|call>[-micromath].elf` (the script's names).
+pub fn build_flash(target: &str, backend: Backend, call: bool) -> Result<PathBuf> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut features = Vec::new();
+    if call {
+        features.push("call");
+    }
+    if backend == Backend::Micromath {
+        features.push("micromath");
+    }
+    let mut cmd = Command::new(cargo);
+    cmd.current_dir(flash_crate_dir())
+        .args(["build", "--release", "--quiet", "--target", target])
+        .arg("--target-dir")
+        .arg(flash_target_dir());
+    if !features.is_empty() {
+        cmd.args(["--features", &features.join(",")]);
+    }
+    for var in [
+        "CARGO_TARGET_DIR",
+        "CARGO_BUILD_TARGET",
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "CARGO_MANIFEST_DIR",
+    ] {
+        cmd.env_remove(var);
+    }
+    let status = cmd.status().context("running cargo for tests/flash")?;
+    if !status.success() {
+        bail!("tests/flash build for {target} ({backend}) failed ({status})");
+    }
+    let built = flash_target_dir()
+        .join(target)
+        .join("release")
+        .join("tinydecimate-flash");
+    let elf = flash_target_dir().join("images").join(format!(
+        "{target}-{}{}.elf",
+        if call { "call" } else { "without" },
+        if backend == Backend::Micromath {
+            "-micromath"
+        } else {
+            ""
+        }
+    ));
+    std::fs::create_dir_all(elf.parent().expect("has a parent"))?;
+    std::fs::copy(&built, &elf)
+        .with_context(|| format!("copying {} to {}", built.display(), elf.display()))?;
+    Ok(elf)
+}
+
+/// The flash of one instantiation on `target`: `.text + .rodata` of the minimal firmware without
+/// and with the call ([`build_flash`]); the library is the difference. The same figure as
+/// `scripts/flash.sh`.
+pub fn one_instantiation(target: &str, backend: Backend) -> Result<(u64, u64)> {
+    let code = |call| -> Result<u64> {
+        let s = elf_sizes(&std::fs::read(build_flash(target, backend, call)?)?)?;
+        Ok(s.text + s.rodata)
+    };
+    Ok((code(false)?, code(true)?))
 }
 
 /// Whether `program --version` runs.
@@ -753,7 +837,6 @@ pub fn calibrate(board: &Board, elf: &Path) -> Result<f64> {
 }
 
 /// What `host-sim qemu --measure` reports for one board.
-/// What `host-sim qemu --measure` reports for one board.
 #[derive(Clone, Debug)]
 pub struct Measurement {
     /// Board.
@@ -764,6 +847,9 @@ pub struct Measurement {
     pub sizes: Sizes,
     /// Image sizes of the same firmware without the library (it echoes its input).
     pub sizes_without: Sizes,
+    /// Flash of one instantiation on the board's target ([`one_instantiation`]): `.text +
+    /// .rodata` of the minimal firmware without and with the call.
+    pub instantiation: (u64, u64),
     /// Measured instructions per SysTick tick.
     pub instructions_per_tick: f64,
     /// Workspace bytes (the library's static RAM on this board).
@@ -932,6 +1018,7 @@ pub fn measure(
     let sizes_without = elf_sizes(&std::fs::read(&without)?)?;
     let elf = build(board, backend, true)?;
     let sizes = elf_sizes(&std::fs::read(&elf)?)?;
+    let instantiation = one_instantiation(board.target, backend)?;
     // The calibration loop carries a few instructions of overhead, so it measures slightly
     // over the exact figure; it only has to confirm the board's clock.
     let measured = calibrate(board, &elf)?;
@@ -1005,6 +1092,7 @@ pub fn measure(
         backend,
         sizes,
         sizes_without,
+        instantiation,
         instructions_per_tick: measured,
         workspace_bytes,
         capacity,
@@ -1046,6 +1134,13 @@ pub fn print_measurement(m: &Measurement) {
         delta(s.static_ram, w.static_ram),
         m.workspace_bytes,
         lib_stack
+    );
+    let (without, with) = m.instantiation;
+    println!(
+        "instantiation: flash {:>8} B ({:.1} KB; text + rodata {with} with the call - {without} without) \
+         [tests/flash as scripts/flash.sh builds it: {ONE_INSTANTIATION}]",
+        delta(with, without),
+        delta(with, without) as f64 / 1024.0,
     );
     println!(
         "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per SysTick tick (calibrated)",
@@ -1109,15 +1204,18 @@ pub fn print_summary(ms: &[Measurement]) {
         return;
     }
     println!(
-        "\nsummary ({} backend); sizes in bytes; instr/collapse over the cases run (min..max)",
+        "\nsummary ({} backend); sizes in bytes; lib = firmware image with - without the library; \
+         1-inst = one instantiation ({ONE_INSTANTIATION}; scripts/flash.sh); \
+         instr/collapse over the cases run (min..max)",
         ms[0].backend
     );
     println!(
-        "{:<12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+        "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
         "board",
         "fw flash",
         "fw RAM",
         "lib flash",
+        "1-inst flash",
         "lib RAM",
         "lib stack",
         "instr/collapse",
@@ -1143,11 +1241,12 @@ pub fn print_summary(ms: &[Measurement]) {
                 .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
         };
         println!(
-            "{:<12} {:>9} {:>9} {:>9} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+            "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
             m.board.name,
             m.sizes.flash,
             m.sizes.static_ram,
             delta(m.sizes.flash, m.sizes_without.flash),
+            delta(m.instantiation.1, m.instantiation.0),
             delta(m.sizes.static_ram, m.sizes_without.static_ram),
             m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0),
             range,
@@ -1181,7 +1280,8 @@ pub struct Args {
     pub check: bool,
     /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
     /// collapse and stack; per board the image sizes of the firmware and of the library alone,
-    /// and the largest mesh it simplifies (bisection). Not pass/fail.
+    /// the flash of one instantiation (`tests/flash`, as `scripts/flash.sh` measures it) and the
+    /// largest mesh it simplifies (bisection). Not pass/fail.
     #[arg(long)]
     pub measure: bool,
     /// The golden directory (`cases.toml`, `libm/`, `micromath/`).
@@ -1363,6 +1463,25 @@ mod tests {
         }
         assert!(board("nope").is_err());
         assert_eq!(board(REFERENCE_BOARD).unwrap().core, "Cortex-M4F");
+    }
+
+    #[test]
+    fn flash_crate_has_the_features_of_the_measurement() {
+        // `one_instantiation` and scripts/flash.sh build these features of tests/flash.
+        let manifest = std::fs::read_to_string(flash_crate_dir().join("Cargo.toml")).unwrap();
+        for feature in [
+            "call = ",
+            "paper = ",
+            "u32-triangles = ",
+            "u32-links = ",
+            "micromath = ",
+        ] {
+            assert!(
+                manifest.lines().any(|l| l.starts_with(feature)),
+                "tests/flash/Cargo.toml lacks the feature {feature:?}"
+            );
+        }
+        assert!(manifest.contains("opt-level = \"s\"") && manifest.contains("lto = \"fat\""));
     }
 
     #[test]

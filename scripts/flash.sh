@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# Flash of one instantiation of tinydecimate, measured as a user would: the minimal firmware in
+# tests/flash (positions a static in flash, triangles a static RAM buffer, a static workspace)
+# is built without and with the call `Workspace<u16, 512, 1024>::simplify(.., &Config::new())`,
+# opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
+# of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
+#
+# Usage: scripts/flash.sh [--all] [--micromath] [--symbols N] [--target T]...
+#   --all         also Config::paper(), a second triangle index type (u32 triangles on the same
+#                 Workspace<u16, ..>) and a second link type (Workspace<u32, ..> over u32)
+#   --micromath   the library's micromath backend instead of libm
+#   --symbols N   how many of the largest symbols the call adds to list per target (default 15)
+#   --target T    a Rust target (repeatable; default thumbv7em-none-eabihf thumbv6m-none-eabi)
+# Needs the rustup targets and the llvm-tools component (rustup component add llvm-tools).
+# Images are kept in $CARGO_TARGET_DIR/images (default tests/flash/target).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+
+all=0
+extra=()
+nsym=15
+targets=()
+while [ $# -gt 0 ]; do
+    case $1 in
+        --all | --paper) all=1 ;;
+        --micromath) extra=(micromath) ;;
+        --symbols) nsym=$2; shift ;;
+        --target) targets+=("$2"); shift ;;
+        -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        *) echo "unknown argument: $1 (see --help)" >&2; exit 2 ;;
+    esac
+    shift
+done
+[ ${#targets[@]} -gt 0 ] || targets=(thumbv7em-none-eabihf thumbv6m-none-eabi)
+
+bin="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
+for tool in llvm-size llvm-nm; do
+    if [ ! -x "$bin/$tool" ]; then
+        echo "$bin/$tool missing: rustup component add llvm-tools" >&2
+        exit 2
+    fi
+done
+installed=$(rustup target list --installed 2>/dev/null || true)
+for t in "${targets[@]}"; do
+    grep -qx "$t" <<<"$installed" || rustup target add "$t"
+done
+
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/tests/flash/target}"
+images="$CARGO_TARGET_DIR/images"
+mkdir -p "$images"
+# Variants: name, cargo features (comma-separated, may be empty), what the row shows.
+variants=("without||-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
+if [ $all = 1 ]; then
+    variants+=(
+        "paper|paper|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::paper()"
+        "u32-triangles|u32-triangles|Config::new(), Workspace<u16, 512, 1024>: u16 triangles + u32 triangles"
+        "u32-links|u32-links|Config::new(), Workspace<u16, ..> on u16 + Workspace<u32, 512, 1024> on u32"
+    )
+fi
+
+# Builds one variant for one target and prints the image's path.
+build() { # target name features
+    local features=$3
+    if [ ${#extra[@]} -gt 0 ]; then features=${features:+$features,}${extra[0]}; fi
+    local args=(build --release --quiet --manifest-path "$root/tests/flash/Cargo.toml" --target "$1")
+    [ -z "$features" ] || args+=(--features "$features")
+    echo "  cargo ${args[*]}" >&2
+    cargo "${args[@]}" >&2
+    local elf="$images/$1-$2${extra[0]:+-${extra[0]}}.elf"
+    cp "$CARGO_TARGET_DIR/$1/release/tinydecimate-flash" "$elf"
+    echo "$elf"
+}
+
+# .text + .rodata of an image, in bytes.
+code() {
+    "$bin/llvm-size" -A "$1" | awk '$1 == ".text" || $1 == ".rodata" { s += $2 } END { print s }'
+}
+
+kb() { awk -v b="$1" 'BEGIN { printf "%.1f KB", b / 1024 }'; }
+
+# Defined symbols of an image, "address size type name", sizes in decimal, names demangled
+# (llvm-nm -C leaves Rust's legacy escapes and hashes, which also differ between builds).
+symbols() {
+    "$bin/llvm-nm" --print-size --size-sort --defined-only --radix=d -C "$1" |
+        sed -e 's/\$LT\$/</g; s/\$GT\$/>/g; s/\$C\$/,/g; s/\$u20\$/ /g; s/\$RF\$/\&/g' \
+            -e 's/\$BP\$/*/g; s/\$u7b\$/{/g; s/\$u7d\$/}/g; s/\.\./::/g; s/::h[0-9a-f]\{16\}$//'
+}
+
+# Code and read-only symbols of `with` that are new or bigger than in `without`, largest first.
+added_symbols() { # without with n
+    local tmp
+    tmp=$(mktemp)
+    symbols "$1" >"$tmp"
+    symbols "$2" |
+        awk -v old="$tmp" '
+            function name(line) { sub(/^[^ ]+ +[^ ]+ +[^ ]+ +/, "", line); return line }
+            BEGIN { while ((getline line < old) > 0) { split(line, f, " "); was[name(line)] += f[2] } }
+            $3 ~ /^[tTrR]$/ { n = name($0); d = $2 - was[n]; was[n] = 0; if (d > 0) printf "%8d  %s\n", d, n }' |
+        sort -rn | head -n "$3"
+    rm -f "$tmp"
+}
+
+echo "building tests/flash (opt-level \"s\", fat LTO, codegen-units 1, panic = abort)${extra[0]:+, ${extra[0]}}:" >&2
+declare -A size elf
+for t in "${targets[@]}"; do
+    for v in "${variants[@]}"; do
+        IFS='|' read -r name features _ <<<"$v"
+        elf[$t/$name]=$(build "$t" "$name" "$features")
+        size[$t/$name]=$(code "${elf[$t/$name]}")
+    done
+done
+
+echo
+echo "flash of the library (.text + .rodata; image with the call - image without)${extra[0]:+, ${extra[0]} backend}"
+echo
+echo "| target | instantiation | without | with | library (difference) |"
+echo "|---|---|---:|---:|---:|"
+for t in "${targets[@]}"; do
+    base=${size[$t/without]}
+    for v in "${variants[@]:1}"; do
+        IFS='|' read -r name _ what <<<"$v"
+        s=${size[$t/$name]}
+        d=$((s - base))
+        echo "| $t | $what | $base B ($(kb "$base")) | $s B ($(kb "$s")) | **$d B ($(kb "$d"))** |"
+    done
+done
+if [ $all = 1 ]; then
+    echo
+    echo "what each addition costs over the single instantiation (Config::new(), u16):"
+    for t in "${targets[@]}"; do
+        one=${size[$t/call]}
+        for v in "${variants[@]:2}"; do
+            IFS='|' read -r name _ what <<<"$v"
+            d=$((size[$t/$name] - one))
+            printf '  %-22s %-82s %+7d B (%s)\n' "$t" "$what" "$d" "$(kb "$d")"
+        done
+    done
+fi
+
+for t in "${targets[@]}"; do
+    echo
+    echo "largest symbols the call adds, $t (bytes, llvm-nm --size-sort; inlined code counts in its caller):"
+    added_symbols "${elf[$t/without]}" "${elf[$t/call]}" "$nsym"
+done

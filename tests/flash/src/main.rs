@@ -1,0 +1,111 @@
+//! Minimal firmware for the flash of one instantiation of tinydecimate, as a user would build it.
+//!
+//! Positions are a `static` in flash, the triangles a static buffer in RAM, the workspace a
+//! static in `.bss`. With the feature `call`, `main` runs
+//! `ws.simplify(&POSITIONS, tris, &Config::new())` on `Workspace<u16, 512, 1024>` and hands the
+//! resulting triangle count to `black_box`, as firmware would use it. Without it, `main` touches
+//! the same statics and nothing else, so (image with) - (image without) is the library.
+//! `paper`, `u32-triangles` and `u32-links` change or add instantiations (see Cargo.toml).
+//!
+//! Never run, only linked and measured: `scripts/flash.sh` (and `host-sim qemu --measure`).
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::entry;
+#[cfg(feature = "call")]
+use tinydecimate::Config;
+use tinydecimate::Workspace;
+
+/// The library cannot panic (tests/no-panic), so this is never reached; it only has to link.
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    loop {
+        core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
+    }
+}
+
+/// A regular octahedron: 6 vertices, in flash (the library only reads positions).
+static POSITIONS: [[f32; 3]; 6] = [
+    [1.0, 0.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, -1.0],
+];
+
+/// Its 8 triangles, wound outwards.
+const OCTAHEDRON: [[u16; 3]; 8] = [
+    [0, 2, 4],
+    [2, 1, 4],
+    [1, 3, 4],
+    [3, 0, 4],
+    [2, 0, 5],
+    [1, 2, 5],
+    [3, 1, 5],
+    [0, 3, 5],
+];
+
+/// The same triangles with u32 indices.
+const fn octahedron_u32() -> [[u32; 3]; 8] {
+    let mut out = [[0u32; 3]; 8];
+    let mut t = 0;
+    while t < 8 {
+        let mut k = 0;
+        while k < 3 {
+            out[t][k] = OCTAHEDRON[t][k] as u32;
+            k += 1;
+        }
+        t += 1;
+    }
+    out
+}
+
+/// The configuration of every call.
+#[cfg(feature = "call")]
+const CONFIG: Config = if cfg!(feature = "paper") {
+    Config::paper()
+} else {
+    Config::new()
+};
+
+#[entry]
+fn main() -> ! {
+    // cortex-m-rt turns these into `&'static mut` references (no `unsafe`): RAM statics, the
+    // workspaces zeroed in `.bss` (`Workspace::new` is const and all zero).
+    static mut WS: Workspace<u16, 512, 1024> = Workspace::new();
+    static mut WS32: Workspace<u32, 512, 1024> = Workspace::new();
+    static mut TRIS: [[u16; 3]; 8] = OCTAHEDRON;
+    static mut TRIS32: [[u32; 3]; 8] = octahedron_u32();
+
+    // The same statics with and without the call: only the library differs.
+    let (ws, ws32) = (black_box(WS), black_box(WS32));
+    let (tris, tris32) = (black_box(TRIS), black_box(TRIS32));
+    black_box(&POSITIONS);
+
+    #[cfg(feature = "call")]
+    {
+        // What firmware does with the result: use the triangle count, or the error.
+        let n = match ws.simplify(&POSITIONS, &mut *tris, &CONFIG) {
+            Ok(report) => report.triangles_out,
+            Err(_) => usize::MAX,
+        };
+        black_box(n);
+        #[cfg(feature = "u32-triangles")]
+        black_box(match ws.simplify(&POSITIONS, &mut *tris32, &CONFIG) {
+            Ok(report) => report.triangles_out,
+            Err(_) => usize::MAX,
+        });
+        #[cfg(feature = "u32-links")]
+        black_box(match ws32.simplify(&POSITIONS, &mut *tris32, &CONFIG) {
+            Ok(report) => report.triangles_out,
+            Err(_) => usize::MAX,
+        });
+    }
+    black_box((ws, ws32, tris, tris32));
+    loop {
+        core::sync::atomic::compiler_fence(core::sync::atomic::Ordering::SeqCst);
+    }
+}
