@@ -28,8 +28,8 @@ use crate::feature::{Mean, Variation};
 use crate::heap::Heap;
 use crate::index::Index;
 use crate::legality::{self, on, Rules, Shape};
-use crate::math;
-use crate::mesh::{flag, Mesh, NIL};
+use crate::math::{self, V3};
+use crate::mesh::{flag, next3, prev3, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
 
@@ -43,6 +43,26 @@ struct Walk<F> {
     variation: Variation,
     /// For a boundary vertex: the `a` of its first triangle and the `b` of its last.
     ends: (usize, usize),
+    /// The walked vertex's position.
+    p: V3,
+    /// Twice the fan's area.
+    area2: f32,
+    /// Its neighbours in fan order, with the offset to each (`p(x) − p`).
+    nb: [(usize, V3); MAX_CANDIDATES],
+    n: usize,
+}
+
+impl<F> Walk<F> {
+    fn push(&mut self, x: usize, d: V3) {
+        if let Some(slot) = self.nb.get_mut(self.n) {
+            *slot = (x, d);
+            self.n += 1;
+        }
+    }
+
+    fn neighbours(&self) -> &[(usize, V3)] {
+        self.nb.get(..self.n).unwrap_or(&[])
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -78,6 +98,8 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     v: usize,
     mean: Mean,
     threshold: f32,
+    /// Sum of twice the fan areas over a Mean sweep.
+    area2: f32,
     features: usize,
     locked: usize,
     used_in: usize,
@@ -117,6 +139,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             v: 0,
             mean: Mean::default(),
             threshold: f32::INFINITY,
+            area2: 0.0,
             features: 0,
             locked,
             used_in,
@@ -241,15 +264,23 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                         return self.done(Stop::Target);
                     }
                     self.mean = Mean::default();
+                    self.area2 = 0.0;
                 }
                 if self.v < nv {
-                    if self.config.features && self.mesh.has(self.v, flag::USED) {
+                    if self.mesh.has(self.v, flag::USED) {
                         let w = self.walk(self.v);
-                        self.mean.add(w.variation.value(self.config.feature_mode));
+                        if self.config.features {
+                            self.mean.add(w.variation.value(self.config.feature_mode));
+                        }
+                        self.area2 += w.area2;
                     }
                     self.v += 1;
                 } else {
                     self.threshold = self.mean.threshold(self.config.lambda);
+                    // Each triangle was seen from its three corners.
+                    let live = self.mesh.live as f32;
+                    self.cost
+                        .round(if live > 0.0 { self.area2 / (3.0 * live) } else { 0.0 });
                     self.v = 0;
                     self.features = 0;
                     self.passes += 1;
@@ -296,7 +327,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             .is_some_and(|d| d > self.threshold)
     }
 
-    /// One walk around `v`'s fan: the cost's summary of it, D and the boundary ends.
+    /// One walk around `v`'s fan: the cost's summary of it, D, the boundary ends and the
+    /// neighbours (each corner's `a`, and a boundary fan's last `b`).
     fn walk(&self, v: usize) -> Walk<C::Fan> {
         let mesh = &self.mesh;
         let pv = mesh.p(v);
@@ -304,14 +336,20 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             fan: self.cost.empty(),
             variation: Variation::default(),
             ends: (NIL, NIL),
+            p: pv,
+            area2: 0.0,
+            nb: [(NIL, [0.0; 3]); MAX_CANDIDATES],
+            n: 0,
         };
         let mut c = mesh.first(v);
-        let mut first = true;
+        let mut dy = [0.0; 3];
         while c != NIL {
-            let tri = mesh.tri(c / 3);
-            let (x, y) = (tri[(c % 3 + 1) % 3], tri[(c % 3 + 2) % 3]);
+            let tri = mesh.tri(c >> 2);
+            let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+            let dx = math::sub(mesh.p(x), pv);
+            dy = math::sub(mesh.p(y), pv);
             // Twice the area and the unit normal from one cross product and one 1/√.
-            let n = math::cross(math::sub(mesh.p(x), pv), math::sub(mesh.p(y), pv));
+            let n = math::cross(dx, dy);
             let l2 = math::dot(n, n);
             let (unit, area2) = if l2 > math::TINY2 && l2.is_finite() {
                 let r = math::rsqrt(l2);
@@ -321,24 +359,26 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             };
             self.cost.add(&mut w.fan, unit, area2);
             w.variation.add(unit);
-            if first {
+            w.area2 += area2;
+            if w.n == 0 {
                 w.ends.0 = x;
-                first = false;
             }
             w.ends.1 = y;
+            w.push(x, dx);
             c = mesh.after(c);
+        }
+        if mesh.has(v, flag::BOUNDARY) && w.n > 0 {
+            w.push(w.ends.1, dy);
         }
         w
     }
 
-    /// The price of moving `from` (walked as `w`) onto `to`, if the flag and boundary rules
-    /// allow it: the cheap half of legality, enough for a lower bound.
-    fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<f32> {
+    /// The price of moving `from` (walked as `w`) by `d` onto `to`, if the flag and boundary
+    /// rules allow it: the cheap half of legality, enough for a lower bound.
+    fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize, d: V3) -> Option<f32> {
         let mesh = &self.mesh;
         let ff = mesh.flags(from);
         legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
-        let pf = mesh.p(from);
-        let pt = mesh.p(to);
         let mut retreat2 = 0.0;
         if ff & flag::BOUNDARY != 0 && on::BOUNDARY {
             // Only along its own boundary edges; the boundary retreats to the segment from
@@ -351,19 +391,14 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             } else {
                 return None;
             };
-            retreat2 = math::segment_distance2(pf, mesh.p(other), pt);
+            retreat2 = math::segment_distance2(w.p, mesh.p(other), mesh.p(to));
         }
         let turn = if self.cost.needs_turn() {
             self.turn(from, to)
         } else {
             0.0
         };
-        let m = Move {
-            d: math::sub(pt, pf),
-            retreat2,
-            turn,
-        };
-        let c = self.cost.price(&w.fan, &m);
+        let c = self.cost.price(&w.fan, &Move { d, retreat2, turn });
         if c.is_finite() {
             Some(if c > 0.0 { c } else { 0.0 })
         } else {
@@ -401,14 +436,14 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         out: &mut [(f32, usize); MAX_CANDIDATES],
     ) -> usize {
         let mut n = 0;
-        self.mesh.for_each_neighbour(v, |x| {
-            if let Some(p) = self.price(v, w, x) {
+        for &(x, d) in w.neighbours() {
+            if let Some(p) = self.price(v, w, x, d) {
                 if let Some(slot) = out.get_mut(n) {
                     *slot = (p, x);
                     n += 1;
                 }
             }
-        });
+        }
         n
     }
 
@@ -503,13 +538,13 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let mut c = self.mesh.first(b);
         let mut last = NIL;
         while c != NIL {
-            let x = self.mesh.tri(c / 3)[(c % 3 + 1) % 3];
+            let x = self.mesh.tri(c >> 2)[next3(c & 3)];
             self.refresh(x);
             last = c;
             c = self.mesh.after(c);
         }
         if last != NIL {
-            let y = self.mesh.tri(last / 3)[(last % 3 + 2) % 3];
+            let y = self.mesh.tri(last >> 2)[prev3(last & 3)];
             self.refresh(y);
         }
     }
@@ -564,20 +599,21 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
         let mut n = 0;
         let wv = self.walk(v);
-        self.mesh.for_each_neighbour(v, |y| {
+        for &(y, d) in wv.neighbours() {
             if self.mesh.has(y, flag::DONE) {
-                return;
+                continue;
             }
             let wy = self.walk(y);
-            for (from, to, w) in [(v, y, &wv), (y, v, &wy)] {
-                if let Some(p) = self.price(from, w, to) {
+            let back = math::scale(d, -1.0);
+            for (from, to, w, d) in [(v, y, &wv, d), (y, v, &wy, back)] {
+                if let Some(p) = self.price(from, w, to, d) {
                     if let Some(slot) = cand.get_mut(n) {
                         *slot = (p, from, to);
                         n += 1;
                     }
                 }
             }
-        });
+        }
         let cand = cand.get_mut(..n).unwrap_or(&mut []);
         loop {
             let mut min: Option<usize> = None;

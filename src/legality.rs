@@ -25,7 +25,7 @@
 
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::mesh::{flag, Mesh, NIL};
+use crate::mesh::{flag, next3, prev3, Mesh, NIL};
 use crate::report::Reject;
 use crate::{Config, Schedule};
 
@@ -80,7 +80,7 @@ pub(crate) struct Rules {
 impl Rules {
     pub(crate) fn new(config: &Config) -> Self {
         let q = config.min_quality;
-        let c = math::cos(config.max_normal_turn_deg * (core::f32::consts::PI / 180.0));
+        let c = math::cos_deg(config.max_normal_turn_deg);
         Rules {
             cos_turn: c,
             cos_turn2: c * c,
@@ -197,7 +197,7 @@ pub(crate) fn check<L: Index, I: Index>(
     let (mut o1, mut o2, mut n_ab) = (NIL, NIL, 0);
     for (t, k) in mesh.corners(a) {
         let tri = mesh.tri(t);
-        let (x, y) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let (x, y) = (tri[next3(k)], tri[prev3(k)]);
         if x == b {
             o1 = y;
             n_ab += 1;
@@ -234,13 +234,13 @@ pub(crate) fn check<L: Index, I: Index>(
     let (mut across_o1, mut across_o2) = (NIL, NIL);
     let mut c = mesh.first(b);
     while c != NIL {
-        let tri = mesh.tri(c / 3);
-        let (x, y) = (tri[(c % 3 + 1) % 3], tri[(c % 3 + 2) % 3]);
+        let tri = mesh.tri(c >> 2);
+        let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
         if y == o1 && x != a {
-            across_o1 = c / 3;
+            across_o1 = c >> 2;
         }
         if x == o2 && y != a {
-            across_o2 = c / 3;
+            across_o2 = c >> 2;
         }
         c = mesh.after(c);
     }
@@ -265,7 +265,7 @@ pub(crate) fn check<L: Index, I: Index>(
         if old.contains(&b) {
             continue;
         }
-        let (x, y) = (old[(k + 1) % 3], old[(k + 2) % 3]);
+        let (x, y) = (old[next3(k)], old[prev3(k)]);
         if on::DUPLICATE
             && ((x == o1 && y == o2) || (x == o2 && y == o1))
             && mesh.corners(b).any(|(u, _)| {

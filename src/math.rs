@@ -3,20 +3,51 @@
 //! Determinism across x86-64 and every Cortex-M core depends on this: `f32` methods such as
 //! `x.sqrt()` resolve to std's functions when std is linked (host tests) and to something else
 //! on a device, and micromath's extension traits do the same. Here each function is called by
-//! path, so the host and the device run the same code: libm (correctly rounded `sqrtf`, the
-//! default) or micromath (fast approximations, feature `micromath`). Only `+ - * /` are used
-//! elsewhere, which IEEE 754 defines bit for bit, and Rust never contracts them into FMA.
+//! path, so the host and the device run the same code. Only `+ - * /` and bit operations are
+//! used, which IEEE 754 and Rust define bit for bit (Rust never contracts them into FMA).
+//!
+//! Two backends: the default one here (1/√ from the bit-level guess and two Newton steps,
+//! cosine from a polynomial: no library, no software `f64`, cheap on a Cortex-M0) and the
+//! `micromath` feature (micromath's guess with one Newton step, and its cosine: faster, less
+//! exact). The engine needs no square root at all otherwise.
 
-/// `1/√x` for `x` in f32's normal range (callers guarantee it), from `+ - *` only: the
-/// bit-level first guess and two Newton steps (relative error below 5e-6). The same bits on
-/// every target, and cheap where `sqrtf` is a software routine (a Cortex-M0 has no FPU;
-/// libm's `sqrtf` costs about 60 instructions even on an M4F).
+/// `1/√x` for `x` in f32's normal range (callers guarantee it). Default backend: the
+/// bit-level first guess and two Newton steps (relative error below 5e-6).
 #[inline]
 pub(crate) fn rsqrt(x: f32) -> f32 {
-    let y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
     let h = 0.5 * x;
-    let y = y * (1.5 - h * y * y);
-    y * (1.5 - h * y * y)
+    #[cfg(not(feature = "micromath"))]
+    {
+        let y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
+        let y = y * (1.5 - h * y * y);
+        y * (1.5 - h * y * y)
+    }
+    #[cfg(feature = "micromath")]
+    {
+        let y = micromath::F32(x).invsqrt().0;
+        y * (1.5 - h * y * y)
+    }
+}
+
+/// Cosine of an angle in degrees in `[0, 180]` (configuration only).
+pub(crate) fn cos_deg(deg: f32) -> f32 {
+    let x = deg * (core::f32::consts::PI / 180.0);
+    #[cfg(not(feature = "micromath"))]
+    {
+        // cos x = 1 − 2 sin²(x/2), with sin on [0, π/2] from its Taylor series to x¹¹
+        // (error below 1e-7 there).
+        let h = 0.5 * x;
+        let h2 = h * h;
+        let s = h
+            * (1.0
+                - h2 / 6.0
+                    * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0 * (1.0 - h2 / 110.0)))));
+        1.0 - 2.0 * s * s
+    }
+    #[cfg(feature = "micromath")]
+    {
+        micromath::F32(x).cos().0
+    }
 }
 
 /// Below this a squared length is treated as zero (no direction): well inside f32's normal
@@ -53,19 +84,6 @@ pub(crate) fn pow2_normalize(v: V3) -> V3 {
         m *= k;
     }
     scale(v, pow2_inverse(m))
-}
-
-/// Cosine of an angle in radians.
-#[inline]
-pub(crate) fn cos(x: f32) -> f32 {
-    #[cfg(feature = "micromath")]
-    {
-        micromath::F32(x).cos().0
-    }
-    #[cfg(not(feature = "micromath"))]
-    {
-        libm::cosf(x)
-    }
 }
 
 pub(crate) type V3 = [f32; 3];
@@ -144,4 +162,27 @@ pub(crate) fn segment_distance2(p: V3, a: V3, b: V3) -> f32 {
     };
     let d = sub(ap, scale(ab, t));
     dot(d, d)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cosine_of_degrees_matches_f64() {
+        for d in 0..=180 {
+            let c = super::cos_deg(d as f32);
+            let want = (d as f64).to_radians().cos();
+            let tol = if cfg!(feature = "micromath") { 2e-3 } else { 2e-5 };
+            assert!((c as f64 - want).abs() < tol, "{d}: {c} vs {want}");
+        }
+    }
+
+    #[test]
+    fn rsqrt_is_close() {
+        for i in 1..1000 {
+            let x = i as f32 * 0.37;
+            let r = super::rsqrt(x) as f64;
+            let want = 1.0 / (x as f64).sqrt();
+            assert!((r / want - 1.0).abs() < 2e-3, "{x}");
+        }
+    }
 }

@@ -44,6 +44,33 @@ pub(crate) mod flag {
     pub const MARK: u8 = 32;
 }
 
+/// Corner `k` of triangle `t`: `4t + k`, so that taking it apart is a shift and a mask (a
+/// Cortex-M0 has no divider; `3t + k` would cost a library call per step of every walk).
+#[inline]
+pub(crate) const fn corner(t: usize, k: usize) -> usize {
+    t << 2 | k
+}
+
+/// The slot after `k` in winding order (a corner's `a`).
+#[inline]
+pub(crate) const fn next3(k: usize) -> usize {
+    if k >= 2 {
+        0
+    } else {
+        k + 1
+    }
+}
+
+/// The slot before `k` in winding order (a corner's `b`).
+#[inline]
+pub(crate) const fn prev3(k: usize) -> usize {
+    if k == 0 {
+        2
+    } else {
+        k - 1
+    }
+}
+
 /// Marks the end of a corner list.
 pub(crate) const NIL: usize = usize::MAX;
 
@@ -146,7 +173,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             let mut c = mesh.first(tri[0]);
             let mut dup = false;
             while c != NIL {
-                let u = c / 3;
+                let u = c >> 2;
                 if u < t && same_set(mesh.tri(u), tri) {
                     dup = true;
                     break;
@@ -193,7 +220,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             }
             self.live += 1;
             for (k, &v) in tri.iter().enumerate() {
-                let c = 3 * t + k;
+                let c = corner(t, k);
                 let h = self.first(v);
                 self.set_after(c, h);
                 self.set_first(v, c);
@@ -222,7 +249,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     #[inline]
     fn set_corner(&mut self, c: usize, v: usize) {
-        if let Some(x) = self.tris.get_mut(c / 3).and_then(|t| t.get_mut(c % 3)) {
+        if let Some(x) = self.tris.get_mut(c >> 2).and_then(|t| t.get_mut(c & 3)) {
             *x = I::narrow(v);
         }
     }
@@ -238,7 +265,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     #[inline]
     fn corner_of(&self, t: usize, v: usize) -> usize {
         match self.tri(t).iter().position(|&x| x == v) {
-            Some(k) => 3 * t + k,
+            Some(k) => corner(t, k),
             None => NIL,
         }
     }
@@ -255,16 +282,16 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     #[inline]
     fn set_first(&mut self, v: usize, c: usize) {
         if let Some(h) = self.head.get_mut(v) {
-            *h = if c == NIL { L::NIL } else { L::narrow(c / 3) };
+            *h = if c == NIL { L::NIL } else { L::narrow(c >> 2) };
         }
     }
 
     /// The corner after `c` in its vertex's list (`c`'s triangle must still hold the vertex in
-    /// slot `c % 3`).
+    /// slot `(c & 3)`).
     #[inline]
     pub(crate) fn after(&self, c: usize) -> usize {
-        let v = self.tri(c / 3).get(c % 3).copied().unwrap_or(NIL);
-        match self.next.get(c / 3).and_then(|n| n.get(c % 3)) {
+        let v = self.tri(c >> 2).get(c & 3).copied().unwrap_or(NIL);
+        match self.next.get(c >> 2).and_then(|n| n.get(c & 3)) {
             Some(&t) if t != L::NIL => self.corner_of(t.to_usize(), v),
             _ => NIL,
         }
@@ -272,8 +299,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     #[inline]
     fn set_after(&mut self, c: usize, n: usize) {
-        if let Some(x) = self.next.get_mut(c / 3).and_then(|t| t.get_mut(c % 3)) {
-            *x = if n == NIL { L::NIL } else { L::narrow(n / 3) };
+        if let Some(x) = self.next.get_mut(c >> 2).and_then(|t| t.get_mut(c & 3)) {
+            *x = if n == NIL { L::NIL } else { L::narrow(n >> 2) };
         }
     }
 
@@ -345,12 +372,12 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let x = if f == NIL {
             NIL
         } else {
-            self.tri(f / 3)[(f % 3 + 1) % 3]
+            self.tri(f >> 2)[next3(f & 3)]
         };
         let y = if l == NIL {
             NIL
         } else {
-            self.tri(l / 3)[(l % 3 + 2) % 3]
+            self.tri(l >> 2)[prev3(l & 3)]
         };
         (x, y)
     }
@@ -363,12 +390,12 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            f(self.tri(c / 3)[(c % 3 + 1) % 3]);
+            f(self.tri(c >> 2)[next3(c & 3)]);
             last = c;
             c = self.after(c);
         }
         if self.has(v, flag::BOUNDARY) && last != NIL {
-            f(self.tri(last / 3)[(last % 3 + 2) % 3]);
+            f(self.tri(last >> 2)[prev3(last & 3)]);
         }
     }
 
@@ -397,21 +424,21 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut start = self.first(v);
         for (t, k) in self.corners(v) {
             let tri = self.tri(t);
-            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            let (a, b) = (tri[next3(k)], tri[prev3(k)]);
             total += 1;
             let (mut same_a, mut same_b, mut pred) = (0, 0, false);
             for (u, j) in self.corners(v) {
                 let s = self.tri(u);
-                same_a += (s[(j + 1) % 3] == a) as usize;
-                same_b += (s[(j + 2) % 3] == b) as usize;
-                pred |= s[(j + 2) % 3] == a;
+                same_a += (s[next3(j)] == a) as usize;
+                same_b += (s[prev3(j)] == b) as usize;
+                pred |= s[prev3(j)] == a;
             }
             if same_a > 1 || same_b > 1 {
                 return Fan::Irregular;
             }
             if !pred {
                 starts += 1;
-                start = 3 * t + k;
+                start = corner(t, k);
             }
         }
         if starts > 1 {
@@ -437,9 +464,9 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut last = start;
         let mut count = 1;
         loop {
-            let b = self.tri(last / 3)[(last % 3 + 2) % 3];
+            let b = self.tri(last >> 2)[prev3(last & 3)];
             let (mut prev, mut c) = (NIL, rest);
-            while c != NIL && self.tri(c / 3)[(c % 3 + 1) % 3] != b {
+            while c != NIL && self.tri(c >> 2)[next3(c & 3)] != b {
                 prev = c;
                 c = self.after(c);
             }
@@ -477,7 +504,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            if c / 3 == t {
+            if (c >> 2) == t {
                 if prev == NIL {
                     self.set_first(v, n);
                 } else {
@@ -509,8 +536,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            let tri = self.tri(c / 3);
-            if tri[(c % 3 + 1) % 3] == b {
+            let tri = self.tri(c >> 2);
+            if tri[next3(c & 3)] == b {
                 c1 = c;
             }
             last = c;
@@ -531,7 +558,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            let t = c / 3;
+            let t = c >> 2;
             if self.tri(t).contains(&b) {
                 if let Some(d) = dead.get_mut(n_dead) {
                     *d = t;
@@ -574,7 +601,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            if dead.contains(&(c / 3)) {
+            if dead.contains(&((c >> 2))) {
                 if w_first == NIL {
                     w_first = c;
                     w_pred = prev;
@@ -693,6 +720,6 @@ impl<L: Index, I: Index> Iterator for Corners<'_, '_, L, I> {
         }
         let c = self.c;
         self.c = self.mesh.after(c);
-        Some((c / 3, c % 3))
+        Some(((c >> 2), (c & 3)))
     }
 }
