@@ -47,21 +47,21 @@ struct Walk<F> {
     p: V3,
     /// Twice the fan's area.
     area2: f32,
-    /// Its neighbours in fan order, with the offset to each (`p(x) − p`).
-    nb: [(usize, V3); MAX_CANDIDATES],
+    /// Its neighbours in fan order.
+    nb: [u32; MAX_CANDIDATES],
     n: usize,
 }
 
 impl<F> Walk<F> {
-    fn push(&mut self, x: usize, d: V3) {
+    fn push(&mut self, x: usize) {
         if let Some(slot) = self.nb.get_mut(self.n) {
-            *slot = (x, d);
+            *slot = x as u32;
             self.n += 1;
         }
     }
 
-    fn neighbours(&self) -> &[(usize, V3)] {
-        self.nb.get(..self.n).unwrap_or(&[])
+    fn neighbours(&self) -> impl Iterator<Item = usize> + '_ {
+        self.nb.iter().take(self.n).map(|&x| x as usize)
     }
 }
 
@@ -110,6 +110,8 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     over_cost: bool,
     /// Greedy: refresh the feature threshold when the mesh is down to this many triangles.
     refresh_at: usize,
+    /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
+    refresh_only: bool,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
 }
@@ -148,6 +150,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             pass_collapses: 0,
             over_cost: false,
             refresh_at: 0,
+            refresh_only: false,
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
         }
@@ -282,6 +285,13 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     self.cost
                         .round(if live > 0.0 { self.area2 / (3.0 * live) } else { 0.0 });
                     self.v = 0;
+                    if self.refresh_only {
+                        // Vertices meet the new threshold as they are re-keyed.
+                        self.refresh_only = false;
+                        self.refresh_at = self.mesh.live / 2;
+                        self.phase = Phase::Queue;
+                        return;
+                    }
                     self.features = 0;
                     self.passes += 1;
                     self.pass_collapses = 0;
@@ -338,16 +348,15 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             ends: (NIL, NIL),
             p: pv,
             area2: 0.0,
-            nb: [(NIL, [0.0; 3]); MAX_CANDIDATES],
+            nb: [0; MAX_CANDIDATES],
             n: 0,
         };
         let mut c = mesh.first(v);
-        let mut dy = [0.0; 3];
         while c != NIL {
             let tri = mesh.tri(c >> 2);
             let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
             let dx = math::sub(mesh.p(x), pv);
-            dy = math::sub(mesh.p(y), pv);
+            let dy = math::sub(mesh.p(y), pv);
             // Twice the area and the unit normal from one cross product and one 1/√.
             let n = math::cross(dx, dy);
             let l2 = math::dot(n, n);
@@ -364,18 +373,18 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                 w.ends.0 = x;
             }
             w.ends.1 = y;
-            w.push(x, dx);
+            w.push(x);
             c = mesh.after(c);
         }
         if mesh.has(v, flag::BOUNDARY) && w.n > 0 {
-            w.push(w.ends.1, dy);
+            w.push(w.ends.1);
         }
         w
     }
 
-    /// The price of moving `from` (walked as `w`) by `d` onto `to`, if the flag and boundary
-    /// rules allow it: the cheap half of legality, enough for a lower bound.
-    fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize, d: V3) -> Option<f32> {
+    /// The price of moving `from` (walked as `w`) onto `to`, if the flag and boundary rules
+    /// allow it: the cheap half of legality, enough for a lower bound.
+    fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<f32> {
         let mesh = &self.mesh;
         let ff = mesh.flags(from);
         legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
@@ -398,6 +407,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         } else {
             0.0
         };
+        let d = math::sub(mesh.p(to), w.p);
         let c = self.cost.price(&w.fan, &Move { d, retreat2, turn });
         if c.is_finite() {
             Some(if c > 0.0 { c } else { 0.0 })
@@ -436,8 +446,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         out: &mut [(f32, usize); MAX_CANDIDATES],
     ) -> usize {
         let mut n = 0;
-        for &(x, d) in w.neighbours() {
-            if let Some(p) = self.price(v, w, x, d) {
+        for x in w.neighbours() {
+            if let Some(p) = self.price(v, w, x) {
                 if let Some(slot) = out.get_mut(n) {
                     *slot = (p, x);
                     n += 1;
@@ -489,9 +499,13 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             }
             return self.new_round();
         };
-        if self.mesh.live <= self.refresh_at && self.passes < self.config.max_passes {
-            // The mesh has halved since the threshold was taken: take it afresh.
-            return self.new_round();
+        if self.mesh.live <= self.refresh_at {
+            // The mesh has halved since the threshold was taken: take it afresh (one sweep;
+            // the keys stand, and vertices meet the new threshold as they are re-keyed).
+            self.refresh_only = true;
+            self.phase = Phase::Mean;
+            self.v = 0;
+            return;
         }
         if key > self.config.max_cost {
             return self.done(Stop::MaxCost);
@@ -599,14 +613,13 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
         let mut n = 0;
         let wv = self.walk(v);
-        for &(y, d) in wv.neighbours() {
+        for y in wv.neighbours() {
             if self.mesh.has(y, flag::DONE) {
                 continue;
             }
             let wy = self.walk(y);
-            let back = math::scale(d, -1.0);
-            for (from, to, w, d) in [(v, y, &wv, d), (y, v, &wy, back)] {
-                if let Some(p) = self.price(from, w, to, d) {
+            for (from, to, w) in [(v, y, &wv), (y, v, &wy)] {
+                if let Some(p) = self.price(from, w, to) {
                     if let Some(slot) = cand.get_mut(n) {
                         *slot = (p, from, to);
                         n += 1;

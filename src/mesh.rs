@@ -42,6 +42,10 @@ pub(crate) mod flag {
     pub const DONE: u8 = 16;
     /// Scratch mark for one legality check (neighbours of the kept vertex); always cleared.
     pub const MARK: u8 = 32;
+    /// Build only: the vertex is some corner's `a` in the fan being ordered.
+    pub const SEEN_A: u8 = 64;
+    /// Build only: the vertex is some corner's `b` in the fan being ordered.
+    pub const SEEN_B: u8 = 128;
 }
 
 /// Corner `k` of triangle `t`: `4t + k`, so that taking it apart is a shift and a mask (a
@@ -106,6 +110,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         head: &'a mut [L],
         next: &'a mut [[L; 3]],
         flags: &'a mut [u8],
+        scratch: (&mut [L], &mut [L]),
     ) -> Result<Self, Error> {
         // 1. Validate before touching anything: indices in range, used positions finite.
         let mut lo = [f32::INFINITY; 3];
@@ -196,7 +201,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             let mut f = 0;
             if mesh.first(v) != NIL {
                 f |= flag::USED;
-                match mesh.order(v) {
+                match mesh.order(v, &mut *scratch.0, &mut *scratch.1) {
                     Fan::Interior => {}
                     Fan::Boundary => f |= flag::BOUNDARY,
                     Fan::Irregular => f |= flag::LOCKED,
@@ -322,7 +327,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     }
 
     #[inline]
-    pub(crate) fn set_flag(&mut self, v: usize, f: u8, on: bool) {
+    pub(crate) fn set_flag(&self, v: usize, f: u8, on: bool) {
         if let Some(x) = self.flags.get(v) {
             x.set(if on { x.get() | f } else { x.get() & !f });
         }
@@ -417,80 +422,83 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// The fan is regular iff no directed edge `v->x` or `x->v` occurs twice (that would be a
     /// non-manifold or inconsistently wound edge), at most one triangle has no predecessor
     /// (the start of a half-disc; two would be two fans pinched together), and the walk from
-    /// the start takes in every triangle. O(valence²), once per vertex at the start.
-    fn order(&mut self, v: usize) -> Fan {
+    /// the start takes in every triangle. O(valence): `by_a[x]` notes the triangle whose `a`
+    /// is `x` (flag `SEEN_A` says it is set), so each successor is one look-up; `by_b` and
+    /// `SEEN_B` the same for `b`. Both are the queue's arrays, unused until the queue starts.
+    fn order(&mut self, v: usize, by_a: &mut [L], by_b: &mut [L]) -> Fan {
         let mut total = 0;
-        let mut starts = 0;
-        let mut start = self.first(v);
+        let mut twice = false;
         for (t, k) in self.corners(v) {
             let tri = self.tri(t);
-            let (a, b) = (tri[next3(k)], tri[prev3(k)]);
+            for (x, f, map) in [
+                (tri[next3(k)], flag::SEEN_A, &mut *by_a),
+                (tri[prev3(k)], flag::SEEN_B, &mut *by_b),
+            ] {
+                twice |= self.has(x, f);
+                self.set_flag(x, f, true);
+                if let Some(m) = map.get_mut(x) {
+                    *m = L::narrow(t);
+                }
+            }
             total += 1;
-            let (mut same_a, mut same_b, mut pred) = (0, 0, false);
-            for (u, j) in self.corners(v) {
-                let s = self.tri(u);
-                same_a += (s[next3(j)] == a) as usize;
-                same_b += (s[prev3(j)] == b) as usize;
-                pred |= s[prev3(j)] == a;
+        }
+        let mut fan = Fan::Irregular;
+        if !twice {
+            // The start: a triangle whose `a` is no triangle's `b` (none: a disc, start
+            // anywhere).
+            let mut starts = 0;
+            let mut start = self.first(v);
+            for (t, k) in self.corners(v) {
+                if !self.has(self.tri(t)[next3(k)], flag::SEEN_B) {
+                    starts += 1;
+                    start = corner(t, k);
+                }
             }
-            if same_a > 1 || same_b > 1 {
-                return Fan::Irregular;
+            if starts <= 1 && self.fan_walk(v, start, by_a, false) == total {
+                self.fan_walk(v, start, by_a, true);
+                fan = if starts == 0 {
+                    Fan::Interior
+                } else {
+                    Fan::Boundary
+                };
             }
-            if !pred {
-                starts += 1;
-                start = corner(t, k);
-            }
         }
-        if starts > 1 {
-            return Fan::Irregular;
+        for (t, k) in self.corners(v) {
+            let tri = self.tri(t);
+            self.set_flag(tri[next3(k)], flag::SEEN_A, false);
+            self.set_flag(tri[prev3(k)], flag::SEEN_B, false);
         }
-        // Move the corners from the old list `rest` to the new one, successor by successor.
-        let mut rest = self.first(v);
-        let mut prev = NIL;
-        let mut c = rest;
-        while c != NIL && c != start {
-            prev = c;
-            c = self.after(c);
-        }
-        if c == NIL {
-            return Fan::Irregular;
-        }
-        let n = self.after(start);
-        if prev == NIL {
-            rest = n;
-        } else {
-            self.set_after(prev, n);
-        }
-        let mut last = start;
+        fan
+    }
+
+    /// Follows `v`'s fan from `start`, successor by successor, until it closes or ends;
+    /// returns how many triangles it met. With `relink`, makes that the list's order.
+    fn fan_walk(&mut self, v: usize, start: usize, by_a: &[L], relink: bool) -> usize {
+        let mut c = start;
         let mut count = 1;
+        let limit = self.tris.len();
+        if relink {
+            self.set_first(v, start);
+        }
         loop {
-            let b = self.tri(last >> 2)[prev3(last & 3)];
-            let (mut prev, mut c) = (NIL, rest);
-            while c != NIL && self.tri(c >> 2)[next3(c & 3)] != b {
-                prev = c;
-                c = self.after(c);
-            }
-            if c == NIL {
+            let b = self.tri(c >> 2)[prev3(c & 3)];
+            let n = match by_a.get(b) {
+                Some(&t) if self.has(b, flag::SEEN_A) => self.corner_of(t.to_usize(), v),
+                _ => NIL,
+            };
+            if n == NIL || n == start || count > limit {
                 break;
             }
-            let n = self.after(c);
-            if prev == NIL {
-                rest = n;
-            } else {
-                self.set_after(prev, n);
+            if relink {
+                self.set_after(c, n);
             }
-            self.set_after(last, c);
-            last = c;
+            c = n;
             count += 1;
         }
-        // Anything left over (a second fan) goes on the end; the vertex is locked then.
-        self.set_after(last, rest);
-        self.set_first(v, start);
-        match (count == total, starts) {
-            (true, 0) => Fan::Interior,
-            (true, _) => Fan::Boundary,
-            _ => Fan::Irregular,
+        if relink {
+            self.set_after(c, NIL);
         }
+        count
     }
 
     // ---- changes ------------------------------------------------------------------------

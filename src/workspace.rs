@@ -138,7 +138,14 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
                 available: MAX_VERTICES,
             });
         };
-        let mesh = Mesh::build(positions, triangles, head, next, flags)?;
+        let mesh = Mesh::build(
+            positions,
+            triangles,
+            head,
+            next,
+            flags,
+            (&mut *heap, &mut *heap_pos),
+        )?;
         Ok(Simplifier::new(
             mesh,
             crate::heap::Heap::new(heap, heap_pos, key),
