@@ -1,7 +1,8 @@
-//! Shared code of the fuzz targets: the `simplify` case generator and an invariant checker
-//! written independently of the library (std collections, f64 geometry).
+//! Shared code of the fuzz targets: the `simplify` case generator and its run, checked after
+//! every run with the shared validity checker (`meshcheck`, host-sim/meshcheck: written
+//! independently of the library, std collections and f64 geometry).
 
-use std::collections::{BTreeSet, HashMap, HashSet};
+use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
 use tinydecimate::cost::{NormalVariation, PlaneDistance};
@@ -720,88 +721,31 @@ fn check_output<I: Idx>(
             "{what}: stop Target but target not reached"
         );
     }
-    let a = analyse(pos, &inp);
-    let b = analyse(pos, &out);
-    // Folds count only if the true geometry (f64) and the engine's own f32 view of it agree:
-    // where they disagree, the input has detail below f32 resolution at its scale.
-    let view = engine_view(pos, &inp);
-    let av = analyse_view(pos, &view, &inp);
-    let bv = analyse_view(pos, &view, &out);
-    let new_in_view: BTreeSet<_> = bv.folded.difference(&av.folded).collect();
-    assert_eq!(b.out_of_range, 0, "{what}: output index out of range");
-    assert_eq!(b.degenerate, 0, "{what}: degenerate output triangle");
-    assert_eq!(b.duplicates, 0, "{what}: duplicate output triangle");
+    let a = meshcheck::analyse(pos, &inp).topology;
     assert_eq!(
-        report.degenerate_dropped, a.degenerate,
+        report.degenerate_dropped, a.degenerate_triangles,
         "{what}: degenerate_dropped"
     );
     assert_eq!(
-        report.duplicates_dropped, a.duplicates,
+        report.duplicates_dropped, a.duplicate_triangles,
         "{what}: duplicates_dropped"
     );
-    assert!(
-        b.vertices.is_subset(&a.vertices),
-        "{what}: output uses a vertex the input did not"
-    );
-    assert!(
-        b.non_manifold_edges <= a.non_manifold_edges,
-        "{what}: non-manifold edges {} -> {}",
-        a.non_manifold_edges,
-        b.non_manifold_edges
-    );
-    let new_folds: Vec<_> = b
-        .folded
-        .difference(&a.folded)
-        .filter(|p| new_in_view.contains(p))
-        .collect();
-    assert!(
-        new_folds.is_empty(),
-        "{what}: new folded pairs {new_folds:?}"
-    );
-    if a.non_manifold_edges == 0 && a.duplicates == 0 && a.degenerate == 0 {
-        assert_eq!(b.boundary_loops, a.boundary_loops, "{what}: boundary loops");
-        assert_eq!(b.euler(), a.euler(), "{what}: Euler characteristic");
-    }
-}
-
-#[derive(Debug, Default)]
-pub struct Topology {
-    pub vertices: BTreeSet<u32>,
-    pub edges: usize,
-    pub faces: usize,
-    pub boundary_loops: usize,
-    pub non_manifold_edges: usize,
-    pub degenerate: usize,
-    pub duplicates: usize,
-    pub out_of_range: usize,
-    pub folded: BTreeSet<([u32; 3], [u32; 3])>,
-}
-
-impl Topology {
-    pub fn euler(&self) -> i64 {
-        self.vertices.len() as i64 - self.edges as i64 + self.faces as i64
-    }
-}
-
-/// Unit normals of adjacent triangles with a dot product below this are folded.
-pub const FOLD_DOT: f64 = -0.9;
-
-fn normal(pos: &[[f32; 3]], t: [u32; 3]) -> [f64; 3] {
-    let p = |i: u32| pos[i as usize].map(f64::from);
-    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if l > 0.0 && l.is_finite() {
-        n.map(|x| x / l)
-    } else {
-        [0.0; 3]
-    }
+    // The shared checker. Folds and new zero-area triangles count only if the true geometry
+    // (f64) and the engine's own f32 view of it agree: where they disagree, the input has
+    // detail below f32 resolution at its scale.
+    let view = engine_view(pos, &inp);
+    let opts = meshcheck::Options {
+        view: Some(meshcheck::View {
+            positions: &view,
+            margin: FOLD_MARGIN,
+            min_quality: MIN_Q,
+        }),
+    };
+    let mesh = |triangles| meshcheck::MeshRef {
+        positions: pos,
+        triangles,
+    };
+    meshcheck::check_with(mesh(&inp), mesh(&out), &opts).assert_valid(what);
 }
 
 /// The engine tests `dot < -0.9` in f32; pairs within this of the limit may go either way.
@@ -809,31 +753,6 @@ pub const FOLD_MARGIN: f64 = 1e-4;
 
 /// Below this quality (`4√3·area / Σ edge²`, f64) a triangle's f32 normal may point anywhere.
 pub const MIN_Q: f64 = 1e-3;
-
-fn quality(pos: &[[f32; 3]], t: [u32; 3]) -> f64 {
-    let p = |i: u32| pos[i as usize].map(f64::from);
-    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-    let d = |x: [f64; 3], y: [f64; 3]| [y[0] - x[0], y[1] - x[1], y[2] - x[2]];
-    let (u, v, w) = (d(a, b), d(a, c), d(b, c));
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let l2 = |x: [f64; 3]| x[0] * x[0] + x[1] * x[1] + x[2] * x[2];
-    let s = l2(u) + l2(v) + l2(w);
-    if s > 0.0 && s.is_finite() {
-        2.0 * 3f64.sqrt() * l2(n).sqrt() / s
-    } else {
-        0.0
-    }
-}
-
-fn sorted(t: [u32; 3]) -> [u32; 3] {
-    let mut s = t;
-    s.sort_unstable();
-    s
-}
 
 /// The positions as the engine sees them: its affine map of the input's bounding box (over
 /// the vertices the triangles use) into about `[-1, 1]³`, in f32 (src/mesh.rs, `Mesh::build`).
@@ -865,86 +784,6 @@ pub fn engine_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
     pos.iter()
         .map(|q| [0, 1, 2].map(|a| (q[a] * 0.5 - centre[a] * 0.5) * inv))
         .collect()
-}
-
-/// Pairs on a common edge whose unit normals (f64, from `view`) have a dot product below
-/// `FOLD_DOT`; pairs with a triangle too thin for f32 normals to mean anything are left out.
-pub fn analyse(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Topology {
-    analyse_view(pos, pos, tris)
-}
-
-pub fn analyse_view(pos: &[[f32; 3]], view: &[[f32; 3]], tris: &[[u32; 3]]) -> Topology {
-    let mut top = Topology::default();
-    let mut edges: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    let mut seen = HashSet::new();
-    for (i, &t) in tris.iter().enumerate() {
-        if t.iter().any(|&v| v as usize >= pos.len()) {
-            top.out_of_range += 1;
-            continue;
-        }
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            top.degenerate += 1;
-            continue;
-        }
-        if !seen.insert(sorted(t)) {
-            top.duplicates += 1;
-        }
-        top.faces += 1;
-        for k in 0..3 {
-            top.vertices.insert(t[k]);
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edges.entry((a.min(b), a.max(b))).or_default().push(i);
-        }
-    }
-    top.edges = edges.len();
-    top.non_manifold_edges = edges.values().filter(|f| f.len() > 2).count();
-    // Boundary loops: connected components of the boundary-edge graph.
-    let mut parent: HashMap<u32, u32> = HashMap::new();
-    fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
-        let mut r = x;
-        while let Some(&q) = p.get(&r) {
-            if q == r {
-                break;
-            }
-            r = q;
-        }
-        p.insert(x, r);
-        r
-    }
-    for (&(a, b), f) in &edges {
-        if f.len() == 1 {
-            parent.entry(a).or_insert(a);
-            parent.entry(b).or_insert(b);
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb {
-                parent.insert(ra, rb);
-            }
-        }
-    }
-    let keys: Vec<u32> = parent.keys().copied().collect();
-    let roots: HashSet<u32> = keys.into_iter().map(|k| find(&mut parent, k)).collect();
-    top.boundary_loops = roots.len();
-    // Folded pairs: any two triangles with different vertex sets on a common edge (on a
-    // non-manifold edge too, so that dropping a duplicate does not make an old pair "new").
-    for f in edges.values() {
-        for (i, &ti) in f.iter().enumerate() {
-            for &tj in &f[i + 1..] {
-                let (t, u) = (tris[ti], tris[tj]);
-                let (x, y) = (sorted(t), sorted(u));
-                if x == y {
-                    continue;
-                }
-                let (a, b) = (normal(view, t), normal(view, u));
-                if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < FOLD_DOT - FOLD_MARGIN
-                    && quality(view, t) > MIN_Q
-                    && quality(view, u) > MIN_Q
-                {
-                    top.folded.insert((x.min(y), x.max(y)));
-                }
-            }
-        }
-    }
-    top
 }
 
 /// What `host_sim::io` promises of a loaded mesh.

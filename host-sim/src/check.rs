@@ -1,397 +1,33 @@
-//! Mesh validity: topology counts of one mesh ([`analyse`]) and whether a simplification is a
-//! valid one of its input ([`compare`]).
+//! Mesh validity for host-sim: [`analyse`] (topology counts of one mesh) and [`compare`]
+//! (whether a simplification is a valid one of its input), on [`MeshData`].
 //!
-//! Definitions (they match `/work/shared/meshes/SOURCES.md`):
-//!
-//! * A triangle is **out of range** if an index is `>= positions.len()`, **degenerate** if two
-//!   of its indices are equal, a **duplicate** if an earlier non-degenerate triangle has the
-//!   same vertex set. Out-of-range and degenerate triangles take no part in the edge-based
-//!   counts below; duplicates do.
-//! * Edges are undirected vertex pairs of the remaining triangles. A **boundary edge** has
-//!   exactly one triangle, a **non-manifold edge** more than two. An **inconsistent edge** has
-//!   two triangles that traverse it in the same direction.
-//! * **Boundary loops** are counted as the cycle rank of the graph of boundary edges,
-//!   `E_b - V_b + C_b` (C_b its connected components). This is the number of loops when every
-//!   boundary vertex has two boundary edges, and it still counts two loops that touch at a
-//!   pinched (non-manifold) boundary vertex as two, where walking by vertex could not tell.
-//! * A **non-manifold vertex** has incident triangles that form more than one fan connected
-//!   through edges at that vertex (a pinch).
-//! * A **folded pair** is two triangles sharing an edge whose unit normals (f64) have a dot
-//!   product below [`FOLD_DOT`]; zero-area triangles have no normal and are never folded. Every
-//!   pair around a non-manifold edge is tested.
-//! * `euler` is `V - E + F` with V the referenced vertices, E the edges, F the triangles that
-//!   are neither out of range nor degenerate. **Components** are groups of triangles connected
-//!   through shared vertices.
-
-use std::collections::HashSet;
-use std::fmt;
-
-use serde::Serialize;
+//! The checker itself is the `meshcheck` crate (`host-sim/meshcheck`), shared with the
+//! library's tests and the fuzz targets; its documentation has the definitions, which match
+//! `/work/shared/meshes/SOURCES.md`. This module only adapts it to host-sim's mesh type.
 
 use crate::io::MeshData;
 
-/// Two triangles sharing an edge are folded when their unit normals' dot product is below this.
-pub const FOLD_DOT: f64 = -0.9;
-
-/// Topology and defect counts of a mesh. See the module documentation for the definitions.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct Topology {
-    /// All triangles, whatever their state.
-    pub triangles: usize,
-    /// Vertices used by at least one in-range triangle.
-    pub referenced_vertices: usize,
-    /// Distinct undirected edges.
-    pub edges: usize,
-    /// Edges with exactly one triangle.
-    pub boundary_edges: usize,
-    /// Cycle rank of the boundary-edge graph.
-    pub boundary_loops: usize,
-    /// Edges with more than two triangles.
-    pub non_manifold_edges: usize,
-    /// Vertices whose triangles form more than one edge-connected fan.
-    pub non_manifold_vertices: usize,
-    /// Triangles with a repeated index.
-    pub degenerate_triangles: usize,
-    /// Triangles with the same vertex set as an earlier one.
-    pub duplicate_triangles: usize,
-    /// Triangles with an index past the last position.
-    pub out_of_range_triangles: usize,
-    /// Two-triangle edges traversed in the same direction by both.
-    pub inconsistent_edges: usize,
-    /// Edge-adjacent triangle pairs with normals' dot below [`FOLD_DOT`].
-    pub folded_pairs: usize,
-    /// V - E + F.
-    pub euler: i64,
-    /// Vertex-connected components of triangles.
-    pub components: usize,
-}
-
-/// Whether an output mesh is a valid simplification of an input mesh.
-#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct Validity {
-    /// Output non-manifold edges minus input ones, floored at 0.
-    pub new_non_manifold_edges: usize,
-    /// Duplicate triangles in the output.
-    pub duplicate_triangles: usize,
-    /// Degenerate triangles in the output.
-    pub degenerate_triangles: usize,
-    /// Folded pairs of the output that are not folded pairs of the input (compared as vertex
-    /// sets of the two triangles).
-    pub new_folded_pairs: usize,
-    /// Output triangles with an index past the end of the output's positions.
-    pub out_of_range_triangles: usize,
-    /// Boundary loops of the input and the output.
-    pub boundary_loops: (usize, usize),
-    /// Euler characteristic of the input and the output.
-    pub euler: (i64, i64),
-}
-
-impl Validity {
-    /// Whether the boundary-loop count is unchanged.
-    pub fn boundary_loops_unchanged(&self) -> bool {
-        self.boundary_loops.0 == self.boundary_loops.1
-    }
-
-    /// Whether the Euler characteristic is unchanged.
-    pub fn euler_unchanged(&self) -> bool {
-        self.euler.0 == self.euler.1
-    }
-
-    /// No new defect and the same boundary-loop count and Euler characteristic.
-    pub fn is_valid(&self) -> bool {
-        self.new_non_manifold_edges == 0
-            && self.duplicate_triangles == 0
-            && self.degenerate_triangles == 0
-            && self.new_folded_pairs == 0
-            && self.out_of_range_triangles == 0
-            && self.boundary_loops_unchanged()
-            && self.euler_unchanged()
-    }
-}
-
-/// Sorted vertex triple of a triangle.
-type TriKey = [u32; 3];
-
-fn sorted(t: [u32; 3]) -> TriKey {
-    let mut k = t;
-    k.sort_unstable();
-    k
-}
-
-/// Minimal union-find.
-struct Dsu(Vec<u32>);
-
-impl Dsu {
-    fn new(n: usize) -> Self {
-        Dsu((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[x as usize];
-            self.0[x as usize] = self.0[p as usize];
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) -> bool {
-        let (a, b) = (self.find(a), self.find(b));
-        if a != b {
-            self.0[a.max(b) as usize] = a.min(b);
-        }
-        a != b
-    }
-}
-
-fn unit_normal(m: &MeshData, t: [u32; 3]) -> Option<[f64; 3]> {
-    let p = t.map(|i| m.positions[i as usize].map(f64::from));
-    let u = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
-    let v = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    (len > 0.0 && len.is_finite()).then(|| n.map(|c| c / len))
-}
+pub use meshcheck::{Defect, Topology, Verdict as Validity, FOLD_DOT};
 
 /// Counts everything in [`Topology`].
 pub fn analyse(mesh: &MeshData) -> Topology {
-    analyse_full(mesh).0
+    meshcheck::analyse(&mesh.positions, &mesh.triangles).topology
 }
 
-/// [`analyse`], plus the folded pairs as (smaller, larger) sorted vertex triples.
-fn analyse_full(mesh: &MeshData) -> (Topology, HashSet<(TriKey, TriKey)>) {
-    let nv = mesh.positions.len();
-    let mut topo = Topology {
-        triangles: mesh.triangles.len(),
-        ..Topology::default()
-    };
-    // Triangles taking part in edge counts: in range and not degenerate.
-    let mut good: Vec<[u32; 3]> = Vec::with_capacity(mesh.triangles.len());
-    let mut referenced = vec![false; nv];
-    let mut vertex_sets = HashSet::with_capacity(mesh.triangles.len());
-    let mut comp = Dsu::new(nv);
-    for &t in &mesh.triangles {
-        if t.iter().any(|&i| i as usize >= nv) {
-            topo.out_of_range_triangles += 1;
-            continue;
-        }
-        for &i in &t {
-            referenced[i as usize] = true;
-        }
-        comp.union(t[0], t[1]);
-        comp.union(t[1], t[2]);
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            topo.degenerate_triangles += 1;
-            continue;
-        }
-        if !vertex_sets.insert(sorted(t)) {
-            topo.duplicate_triangles += 1;
-        }
-        good.push(t);
-    }
-    topo.referenced_vertices = referenced.iter().filter(|&&r| r).count();
-    topo.components = (0..nv as u32)
-        .filter(|&v| referenced[v as usize] && comp.find(v) == v)
-        .count();
-
-    // Half-edges (lo, hi, triangle, forward), sorted so each edge's triangles are adjacent.
-    let mut half: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(good.len() * 3);
-    for (ti, t) in good.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            half.push((a.min(b), a.max(b), ti as u32, a < b));
-        }
-    }
-    half.sort_unstable();
-    let normals: Vec<Option<[f64; 3]>> = good.iter().map(|&t| unit_normal(mesh, t)).collect();
-    let mut folded: HashSet<(TriKey, TriKey)> = HashSet::new();
-    let mut boundary_graph: Vec<(u32, u32)> = Vec::new();
-    for group in half.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-        topo.edges += 1;
-        match group.len() {
-            1 => {
-                topo.boundary_edges += 1;
-                boundary_graph.push((group[0].0, group[0].1));
-            }
-            2 => {
-                if group[0].3 == group[1].3 {
-                    topo.inconsistent_edges += 1;
-                }
-            }
-            _ => topo.non_manifold_edges += 1,
-        }
-        for (i, x) in group.iter().enumerate() {
-            for y in &group[i + 1..] {
-                let (Some(a), Some(b)) = (normals[x.2 as usize], normals[y.2 as usize]) else {
-                    continue;
-                };
-                if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < FOLD_DOT {
-                    let (ka, kb) = (sorted(good[x.2 as usize]), sorted(good[y.2 as usize]));
-                    folded.insert((ka.min(kb), ka.max(kb)));
-                }
-            }
-        }
-    }
-    topo.folded_pairs = folded.len();
-
-    // Boundary loops: cycle rank E - V + C of the boundary-edge graph.
-    let mut bdsu = Dsu::new(nv);
-    let mut merges = 0usize;
-    for &(a, b) in &boundary_graph {
-        if bdsu.union(a, b) {
-            merges += 1;
-        }
-    }
-    // C = V - merges, so E - V + C = E - merges.
-    topo.boundary_loops = boundary_graph.len() - merges;
-
-    topo.non_manifold_vertices = count_pinched_vertices(nv, &good);
-    topo.euler = topo.referenced_vertices as i64 - topo.edges as i64 + good.len() as i64;
-    (topo, folded)
-}
-
-/// Vertices whose incident triangles form more than one fan connected through edges at the
-/// vertex.
-fn count_pinched_vertices(nv: usize, good: &[[u32; 3]]) -> usize {
-    // Vertex -> incident triangles, CSR.
-    let mut start = vec![0u32; nv + 1];
-    for t in good {
-        for &i in t {
-            start[i as usize + 1] += 1;
-        }
-    }
-    for v in 0..nv {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut inc = vec![0u32; good.len() * 3];
-    for (ti, t) in good.iter().enumerate() {
-        for &i in t {
-            inc[fill[i as usize] as usize] = ti as u32;
-            fill[i as usize] += 1;
-        }
-    }
-    let mut pinched = 0;
-    let mut first_at: Vec<(u32, u32)> = Vec::new();
-    for v in 0..nv {
-        let tris = &inc[start[v] as usize..start[v + 1] as usize];
-        if tris.len() < 2 {
-            continue;
-        }
-        // Local union-find over the fan; triangles sharing another vertex w share edge v-w.
-        let mut dsu = Dsu::new(tris.len());
-        first_at.clear();
-        for (li, &ti) in tris.iter().enumerate() {
-            for &w in &good[ti as usize] {
-                if w as usize != v {
-                    first_at.push((w, li as u32));
-                }
-            }
-        }
-        first_at.sort_unstable();
-        for pair in first_at.windows(2) {
-            if pair[0].0 == pair[1].0 {
-                dsu.union(pair[0].1, pair[1].1);
-            }
-        }
-        let fans = (0..tris.len() as u32).filter(|&i| dsu.find(i) == i).count();
-        if fans > 1 {
-            pinched += 1;
-        }
-    }
-    pinched
-}
-
-/// Whether `output` is a valid simplification of `input` (same vertex numbering).
+/// Whether `output` is a valid simplification of `input` (same vertex numbering; the output's
+/// positions of the vertices it uses must be the input's).
 pub fn compare(input: &MeshData, output: &MeshData) -> Validity {
-    let (ti, fi) = analyse_full(input);
-    let (to, fo) = analyse_full(output);
-    Validity {
-        new_non_manifold_edges: to.non_manifold_edges.saturating_sub(ti.non_manifold_edges),
-        duplicate_triangles: to.duplicate_triangles,
-        degenerate_triangles: to.degenerate_triangles,
-        new_folded_pairs: fo.difference(&fi).count(),
-        out_of_range_triangles: to.out_of_range_triangles,
-        boundary_loops: (ti.boundary_loops, to.boundary_loops),
-        euler: (ti.euler, to.euler),
-    }
-}
-
-impl fmt::Display for Topology {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let t = self;
-        writeln!(f, "  triangles              {}", t.triangles)?;
-        writeln!(f, "  referenced vertices    {}", t.referenced_vertices)?;
-        writeln!(f, "  edges                  {}", t.edges)?;
-        writeln!(
-            f,
-            "  boundary edges         {} in {} loop(s)",
-            t.boundary_edges, t.boundary_loops
-        )?;
-        writeln!(f, "  non-manifold edges     {}", t.non_manifold_edges)?;
-        writeln!(f, "  non-manifold vertices  {}", t.non_manifold_vertices)?;
-        writeln!(f, "  degenerate triangles   {}", t.degenerate_triangles)?;
-        writeln!(f, "  duplicate triangles    {}", t.duplicate_triangles)?;
-        writeln!(f, "  out-of-range triangles {}", t.out_of_range_triangles)?;
-        writeln!(f, "  inconsistent edges     {}", t.inconsistent_edges)?;
-        writeln!(f, "  folded pairs           {}", t.folded_pairs)?;
-        writeln!(f, "  euler (V-E+F)          {}", t.euler)?;
-        write!(f, "  components             {}", t.components)
-    }
-}
-
-impl fmt::Display for Validity {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let v = self;
-        let mark = |ok: bool| if ok { "ok" } else { "FAIL" };
-        writeln!(
-            f,
-            "  new non-manifold edges {:<6} {}",
-            v.new_non_manifold_edges,
-            mark(v.new_non_manifold_edges == 0)
-        )?;
-        writeln!(
-            f,
-            "  duplicate triangles    {:<6} {}",
-            v.duplicate_triangles,
-            mark(v.duplicate_triangles == 0)
-        )?;
-        writeln!(
-            f,
-            "  degenerate triangles   {:<6} {}",
-            v.degenerate_triangles,
-            mark(v.degenerate_triangles == 0)
-        )?;
-        writeln!(
-            f,
-            "  new folded pairs       {:<6} {}",
-            v.new_folded_pairs,
-            mark(v.new_folded_pairs == 0)
-        )?;
-        writeln!(
-            f,
-            "  out-of-range triangles {:<6} {}",
-            v.out_of_range_triangles,
-            mark(v.out_of_range_triangles == 0)
-        )?;
-        writeln!(
-            f,
-            "  boundary loops         {} -> {} {}",
-            v.boundary_loops.0,
-            v.boundary_loops.1,
-            mark(v.boundary_loops_unchanged())
-        )?;
-        writeln!(
-            f,
-            "  euler characteristic   {} -> {} {}",
-            v.euler.0,
-            v.euler.1,
-            mark(v.euler_unchanged())
-        )?;
-        write!(f, "  => {}", if v.is_valid() { "VALID" } else { "INVALID" })
-    }
+    meshcheck::check_with(
+        meshcheck::MeshRef {
+            positions: &input.positions,
+            triangles: &input.triangles,
+        },
+        meshcheck::MeshRef {
+            positions: &output.positions,
+            triangles: &output.triangles,
+        },
+        &meshcheck::Options::default(),
+    )
 }
 
 /// `host-sim check ORIGINAL SIMPLIFIED`
@@ -416,6 +52,7 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
             "original": ta,
             "simplified": tb,
             "validity": v,
+            "defects": v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
             "valid": v.is_valid(),
         });
         println!("{}", serde_json::to_string_pretty(&j)?);
@@ -563,6 +200,34 @@ mod tests {
         let v = compare(&g, &o);
         assert_eq!(v.out_of_range_triangles, 1);
         assert!(!v.is_valid());
+    }
+
+    #[test]
+    fn compare_flags_a_new_pinch_but_not_an_old_one() {
+        // A 4 x 4 grid; removing the two triangles around the middle of two opposite quads
+        // that touch only at vertex 12 leaves a pinch there.
+        let g = grid(4);
+        let mut p = g.clone();
+        // Quads (1,1) and (2,2) share only vertex 12 (= 2 * 5 + 2). Keep everything except
+        // the quads (2,1) and (1,2), which join them through edges at 12.
+        p.triangles.retain(|t| {
+            let quad = |x: u32, y: u32| {
+                let v = y * 5 + x;
+                [v, v + 1, v + 6, v + 5]
+                    .iter()
+                    .filter(|i| t.contains(i))
+                    .count()
+                    == 3
+            };
+            !(quad(2, 1) || quad(1, 2))
+        });
+        assert_eq!(analyse(&p).non_manifold_vertices, 1);
+        let v = compare(&g, &p);
+        assert_eq!(v.new_pinched_vertices, 1, "{v}");
+        assert!(v.defects.contains(&Defect::NewPinchedVertex { vertex: 12 }));
+        // Already pinched in the input: may stay.
+        let v = compare(&p, &p);
+        assert!(v.is_valid(), "{v}");
     }
 
     #[test]

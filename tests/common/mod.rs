@@ -2,7 +2,7 @@
 //! written independently of the library (plain std collections, f64 math).
 #![allow(dead_code)]
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Mutex;
 
@@ -241,161 +241,44 @@ pub fn cube(n: u32) -> MeshData {
 }
 
 // ---- invariants ------------------------------------------------------------------------
+// The checker is the `meshcheck` crate (host-sim/meshcheck), shared with the fuzz targets and
+// host-sim: written independently of the library, f64 geometry.
 
-/// Unit normals of adjacent triangles with a dot product below this are "folded".
-pub const FOLD_DOT: f64 = -0.9;
+#[allow(unused_imports)]
+pub use meshcheck::{Defect, Topology, Verdict, FOLD_DOT};
 
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Topology {
-    pub vertices: usize,
-    pub edges: usize,
-    pub faces: usize,
-    pub boundary_edges: usize,
-    pub boundary_loops: usize,
-    pub non_manifold_edges: usize,
-    pub degenerate: usize,
-    pub duplicates: usize,
-    pub out_of_range: usize,
-    /// Folded adjacent pairs, as sorted pairs of sorted vertex triples.
-    pub folded: BTreeSet<([u32; 3], [u32; 3])>,
-}
-
-impl Topology {
-    pub fn euler(&self) -> i64 {
-        self.vertices as i64 - self.edges as i64 + self.faces as i64
-    }
-}
-
-fn normal(m: &MeshData, t: Tri) -> [f64; 3] {
-    let p = |i: u32| m.positions[i as usize].map(|x| x as f64);
-    let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
-    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if l > 0.0 {
-        n.map(|x| x / l)
-    } else {
-        [0.0; 3]
-    }
-}
-
-fn sorted(t: Tri) -> [u32; 3] {
-    let mut s = t;
-    s.sort();
-    s
-}
-
+/// Topology and defect counts of one mesh.
 pub fn analyse(m: &MeshData) -> Topology {
-    let mut edges: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
-    let mut verts = BTreeSet::new();
-    let mut seen = BTreeSet::new();
-    let (mut degenerate, mut duplicates, mut out_of_range) = (0, 0, 0);
-    for (i, &t) in m.triangles.iter().enumerate() {
-        if t.iter().any(|&v| v as usize >= m.positions.len()) {
-            out_of_range += 1;
-            continue;
-        }
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-            degenerate += 1;
-            continue;
-        }
-        if !seen.insert(sorted(t)) {
-            duplicates += 1;
-        }
-        for k in 0..3 {
-            verts.insert(t[k]);
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edges.entry((a.min(b), a.max(b))).or_default().push(i);
-        }
-    }
-    let boundary: Vec<(u32, u32)> = edges
-        .iter()
-        .filter(|(_, f)| f.len() == 1)
-        .map(|(e, _)| *e)
-        .collect();
-    // Boundary loops: connected components of the boundary-edge graph.
-    let mut parent: HashMap<u32, u32> = HashMap::new();
-    fn find(p: &mut HashMap<u32, u32>, x: u32) -> u32 {
-        let mut r = x;
-        while let Some(&q) = p.get(&r) {
-            if q == r {
-                break;
-            }
-            r = q;
-        }
-        p.insert(x, r);
-        r
-    }
-    for &(a, b) in &boundary {
-        parent.entry(a).or_insert(a);
-        parent.entry(b).or_insert(b);
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        if ra != rb {
-            parent.insert(ra, rb);
-        }
-    }
-    let keys: Vec<u32> = parent.keys().copied().collect();
-    let roots: BTreeSet<u32> = keys.into_iter().map(|k| find(&mut parent, k)).collect();
-    let mut folded = BTreeSet::new();
-    for f in edges.values() {
-        if f.len() == 2 {
-            let (t, u) = (m.triangles[f[0]], m.triangles[f[1]]);
-            let (a, b) = (normal(m, t), normal(m, u));
-            if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] < FOLD_DOT {
-                let (x, y) = (sorted(t), sorted(u));
-                folded.insert((x.min(y), x.max(y)));
-            }
-        }
-    }
-    Topology {
-        vertices: verts.len(),
-        edges: edges.len(),
-        faces: m.triangles.len() - degenerate - out_of_range,
-        boundary_edges: boundary.len(),
-        boundary_loops: roots.len(),
-        non_manifold_edges: edges.values().filter(|f| f.len() > 2).count(),
-        degenerate,
-        duplicates,
-        out_of_range,
-        folded,
-    }
+    meshcheck::analyse(&m.positions, &m.triangles).topology
 }
 
-/// Asserts that `output` is a valid simplification of `input`, with the library's report.
+/// [`analyse`] with the sets behind the counts (pinched vertices, boundary vertices, ...).
+pub fn analysis(m: &MeshData) -> meshcheck::Analysis {
+    meshcheck::analyse(&m.positions, &m.triangles)
+}
+
+/// The shared checker's verdict on `output` as a simplification of `input` (same positions).
+pub fn verdict(input: &MeshData, output: &MeshData) -> Verdict {
+    meshcheck::check_with(
+        meshcheck::MeshRef {
+            positions: &input.positions,
+            triangles: &input.triangles,
+        },
+        meshcheck::MeshRef {
+            positions: &output.positions,
+            triangles: &output.triangles,
+        },
+        &meshcheck::Options::default(),
+    )
+}
+
+/// Asserts that `output` is a valid simplification of `input` (the shared checker), and that
+/// the library's report agrees with the output.
 pub fn assert_valid(name: &str, input: &MeshData, output: &MeshData, report: &Report) {
-    let a = analyse(input);
-    let b = analyse(output);
     assert_eq!(
         report.triangles_out,
         output.triangles.len(),
         "{name}: count"
     );
-    assert_eq!(b.out_of_range, 0, "{name}: index out of range");
-    assert_eq!(b.degenerate, 0, "{name}: degenerate triangle");
-    assert_eq!(b.duplicates, 0, "{name}: duplicate triangle");
-    assert!(
-        b.non_manifold_edges <= a.non_manifold_edges,
-        "{name}: new non-manifold edges {} > {}",
-        b.non_manifold_edges,
-        a.non_manifold_edges
-    );
-    let new_folds: Vec<_> = b.folded.difference(&a.folded).collect();
-    assert!(
-        new_folds.is_empty(),
-        "{name}: new folded pairs {new_folds:?}"
-    );
-    if a.non_manifold_edges == 0 && a.duplicates == 0 && a.degenerate == 0 {
-        assert_eq!(b.boundary_loops, a.boundary_loops, "{name}: boundary loops");
-        if a.boundary_edges == 0 {
-            assert_eq!(b.boundary_edges, 0, "{name}: closed stays closed");
-        }
-        // Euler characteristic, unless vertices were pinched (then V counts differ only by
-        // the locked pinch points, which never collapse).
-        assert_eq!(b.euler(), a.euler(), "{name}: Euler characteristic");
-    }
+    verdict(input, output).assert_valid(name);
 }

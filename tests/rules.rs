@@ -1,0 +1,470 @@
+//! One test per legality rule (`src/legality.rs`), each asserting a property of real output
+//! that the rule exists to keep. `scripts/rules-off.sh` builds the library with each rule
+//! switched off in turn (`TINYDECIMATE_RULE_OFF`) and checks that these tests then fail.
+//!
+//! | rule          | property                                                                  | test |
+//! |---------------|---------------------------------------------------------------------------|------|
+//! | `locked`      | non-manifold, pinched and inconsistently wound parts stay as they were     | `locked_parts_stay_untouched` |
+//! | `feature`     | a vertex that is a feature before an operation is still used after it       | `features_survive_every_operation` |
+//! | `boundary`    | boundaries only shrink along themselves: loops, vertices, no longer length  | `boundaries_keep_loops_vertices_and_length` |
+//! | `link`        | no new pinched vertex or non-manifold edge (shared checker)                 | `no_new_pinch_or_non_manifold_edge` |
+//! | `duplicate`   | no duplicate output triangle (shared checker); redundant with `fold` on output, so also: the tetrahedra's collapses are refused as duplicates (`Report::rejected`) | `no_duplicate_triangles_on_tetrahedral_parts`, `tetrahedra_are_kept_whole_by_the_duplicate_rule` |
+//! | `sliver`      | no operation leaves a zero-area triangle, or one below `min_quality` that got worse | `no_operation_makes_a_sliver` |
+//! | `normal_turn` | no live triangle slot turns by more than `max_normal_turn_deg` in one operation | `no_operation_turns_a_triangle_too_far` |
+//! | `fold`        | no new folded pair, even with the turn limit at 179° (shared checker)       | `no_new_folds_when_only_the_fold_rule_guards` |
+
+mod common;
+use std::collections::BTreeSet;
+
+use common::*;
+use tinydecimate::{Config, Report, Schedule};
+
+/// A mesh of `tests/fixtures`.
+fn fixture(name: &str) -> MeshData {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name);
+    parse_obj(&std::fs::read_to_string(&path).unwrap())
+}
+
+/// Deterministic jitter of about `amount`, so that ties and symmetric cases vary.
+fn jitter(mut m: MeshData, seed: u64, amount: f32) -> MeshData {
+    let mut s = seed | 1;
+    for p in &mut m.positions {
+        for x in p.iter_mut() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            *x += ((s % 1000) as f32 / 1000.0 - 0.5) * amount;
+        }
+    }
+    m
+}
+
+/// What happened between two operations.
+#[derive(Default)]
+struct Steps {
+    /// (operation, vertex): a feature before the operation, unused after it.
+    removed_features: Vec<(usize, usize)>,
+    /// (operation, slot, degrees): a live slot whose normal turned beyond the limit.
+    turned: Vec<(usize, usize, f64)>,
+    /// (operation, slot, quality before, after): a live slot that became a sliver.
+    slivers: Vec<(usize, usize, f64, f64)>,
+    operations: usize,
+}
+
+/// Drives `Workspace::start` with `step(1)` to the end and records, for every operation, the
+/// features it removed and the live triangle slots whose shape it spoiled.
+fn step_by_step(m: &MeshData, config: &Config) -> (MeshData, Report, Steps) {
+    let mut tris = m.triangles.clone();
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut s = ws.start(&m.positions, &mut tris, config).expect("start");
+    let mut steps = Steps::default();
+    let nv = m.positions.len();
+    let limit = config.max_normal_turn_deg as f64 + 0.5;
+    let min_q = config.min_quality as f64 * (1.0 - 1e-3);
+    loop {
+        let before: Vec<[u32; 3]> = s.buffer().to_vec();
+        let features: Vec<usize> = (0..nv)
+            .filter(|&v| s.is_feature(v) && s.is_used(v))
+            .collect();
+        let finished = s.step(1);
+        let op = steps.operations;
+        steps.operations += 1;
+        for &v in &features {
+            if !s.is_used(v) {
+                steps.removed_features.push((op, v));
+            }
+        }
+        for (slot, (old, new)) in before.iter().zip(s.buffer()).enumerate() {
+            let live = |t: &[u32; 3]| !(t[0] == t[1] && t[1] == t[2]);
+            if old == new || !live(old) || !live(new) {
+                continue;
+            }
+            let (q0, q1) = (
+                meshcheck::quality(&m.positions, *old),
+                meshcheck::quality(&m.positions, *new),
+            );
+            if q1 <= 0.0 || (q1 < min_q && q1 < q0 * (1.0 - 1e-3)) {
+                steps.slivers.push((op, slot, q0, q1));
+            }
+            if let Some(a) = meshcheck::normal_angle_deg(&m.positions, *old, *new) {
+                if a > limit {
+                    steps.turned.push((op, slot, a));
+                }
+            }
+        }
+        assert!(steps.operations < 10_000_000, "no termination");
+        if finished {
+            break;
+        }
+    }
+    let report = s.finish();
+    tris.truncate(report.triangles_out);
+    let out = MeshData {
+        positions: m.positions.clone(),
+        triangles: tris,
+    };
+    (out, report, steps)
+}
+
+/// `Config::new()` and `Config::paper()` at `ratio`.
+fn both_configs(ratio: f32) -> [(&'static str, Config); 2] {
+    [
+        ("new", Config::new().with_ratio(ratio)),
+        ("paper", Config::paper().with_ratio(ratio)),
+    ]
+}
+
+/// A grid with a fin (a third triangle on an interior edge), a cone pinched onto a corner and
+/// one triangle wound the other way.
+fn messy_grid(n: u32, seed: u64) -> MeshData {
+    let mut m = grid(n, n, 0.1);
+    let [a, b, _] = m.triangles[m.triangles.len() / 2];
+    m.positions.push([0.5, 0.5, 1.0]);
+    let top = (m.positions.len() - 1) as u32;
+    m.triangles.push([a, b, top]);
+    let base = m.positions.len() as u32;
+    for i in 0..5 {
+        let t = i as f32 / 5.0 * std::f32::consts::TAU;
+        m.positions
+            .push([-0.2 + 0.1 * t.cos(), -0.2 + 0.1 * t.sin(), -0.3]);
+    }
+    for i in 0..5 {
+        m.triangles.push([0, base + (i + 1) % 5, base + i]);
+    }
+    let k = m.triangles.len() / 4;
+    m.triangles[k].swap(0, 1);
+    jitter(m, seed, 1e-3)
+}
+
+#[test]
+fn locked_parts_stay_untouched() {
+    let mut cases = vec![
+        ("messy grid 10".to_string(), messy_grid(10, 1)),
+        ("messy grid 16".to_string(), messy_grid(16, 7)),
+        // The cow has one pinched vertex.
+        ("cow".to_string(), fixture("cow.obj")),
+    ];
+    // Two closed spheres sharing one vertex (a pinch on a closed surface).
+    let mut two = icosphere(2);
+    let b = icosphere(2);
+    let off = two.positions.len() as u32;
+    let apex = (0..b.positions.len())
+        .max_by(|&i, &j| b.positions[i][0].total_cmp(&b.positions[j][0]))
+        .unwrap() as u32;
+    let far = (0..two.positions.len())
+        .min_by(|&i, &j| two.positions[i][0].total_cmp(&two.positions[j][0]))
+        .unwrap() as u32;
+    let shift = two.positions[far as usize][0] - b.positions[apex as usize][0];
+    two.positions
+        .extend(b.positions.iter().map(|p| [p[0] + shift, p[1], p[2]]));
+    two.triangles.extend(
+        b.triangles
+            .iter()
+            .map(|t| t.map(|i| if i == apex { far } else { i + off })),
+    );
+    cases.push(("two pinched spheres".to_string(), two));
+
+    for (name, m) in &cases {
+        let before = analysis(m);
+        let locked = before.locked_vertices();
+        assert!(!locked.is_empty(), "{name}: the case has no locked part");
+        for (cname, config) in both_configs(0.1) {
+            let what = format!("{name} {cname}");
+            let (out, report) = simplify(m, &config);
+            assert_valid(&what, m, &out, &report);
+            assert!(
+                report.triangles_out < m.triangles.len() * 2 / 3,
+                "{what}: the rest is simplified: {report:?}"
+            );
+            let after = analysis(&out);
+            for &v in &locked {
+                assert!(
+                    after.vertices.contains(&v),
+                    "{what}: locked vertex {v} removed"
+                );
+            }
+            for e in &before.non_manifold_edges {
+                assert!(
+                    after.non_manifold_edges.contains(e),
+                    "{what}: non-manifold edge {e:?} changed"
+                );
+            }
+            for v in &before.pinched_vertices {
+                assert!(
+                    after.pinched_vertices.contains(v),
+                    "{what}: pinched vertex {v} changed"
+                );
+            }
+            for e in &before.inconsistent_edges {
+                let has = |t: &[u32; 3]| t.contains(&e.0) && t.contains(&e.1);
+                assert_eq!(
+                    out.triangles.iter().filter(|t| has(t)).count(),
+                    2,
+                    "{what}: inconsistent edge {e:?} changed"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn features_survive_every_operation() {
+    let meshes = [
+        ("box", jitter(cube(6), 3, 1e-4)),
+        ("fandisk", load_obj("fandisk.obj")),
+    ];
+    for (name, m) in &meshes {
+        for (cname, config) in both_configs(0.1) {
+            let what = format!("{name} {cname}");
+            let (out, report, steps) = step_by_step(m, &config);
+            assert!(report.feature_vertices > 0, "{what}: no features");
+            assert!(
+                steps.removed_features.is_empty(),
+                "{what}: {} feature vertices removed, first (operation, vertex) {:?}",
+                steps.removed_features.len(),
+                &steps.removed_features[..steps.removed_features.len().min(5)]
+            );
+            assert_valid(&what, m, &out, &report);
+        }
+    }
+}
+
+/// Boundary vertices, number of loops and total length of the boundary edges.
+fn boundary(m: &MeshData) -> (BTreeSet<u32>, usize, f64) {
+    let a = analysis(m);
+    let mut count = std::collections::HashMap::new();
+    for t in &m.triangles {
+        for k in 0..3 {
+            let (x, y) = (t[k], t[(k + 1) % 3]);
+            *count.entry((x.min(y), x.max(y))).or_insert(0) += 1;
+        }
+    }
+    let length = count
+        .iter()
+        .filter(|(_, &c)| c == 1)
+        .map(|(&(x, y), _)| {
+            let (p, q) = (m.positions[x as usize], m.positions[y as usize]);
+            (0..3)
+                .map(|i| (p[i] as f64 - q[i] as f64).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .sum();
+    (a.boundary_vertices, a.topology.boundary_loops, length)
+}
+
+#[test]
+fn boundaries_keep_loops_vertices_and_length() {
+    let mut holes = grid(24, 24, 0.2);
+    // Two square holes.
+    let w = 25;
+    holes.triangles.retain(|t| {
+        let inside = |v: u32, x0: u32, y0: u32| {
+            let (x, y) = (v % w, v / w);
+            (x0..x0 + 4).contains(&x) && (y0..y0 + 4).contains(&y)
+        };
+        !(t.iter().all(|&v| inside(v, 4, 4)) || t.iter().all(|&v| inside(v, 14, 12)))
+    });
+    let meshes = [
+        ("grid", jitter(grid(20, 14, 0.15), 5, 1e-3)),
+        ("grid with holes", holes),
+        ("camelhead", load_obj("camelhead.obj")),
+    ];
+    for (name, m) in &meshes {
+        let (bv, loops, len) = boundary(m);
+        assert!(loops > 0, "{name}: not open");
+        for (cname, config) in both_configs(0.1) {
+            let what = format!("{name} {cname}");
+            let (out, report) = simplify(m, &config);
+            assert_valid(&what, m, &out, &report);
+            let (bv2, loops2, len2) = boundary(&out);
+            assert_eq!(loops2, loops, "{what}: boundary loops");
+            let new: Vec<_> = bv2.difference(&bv).collect();
+            assert!(new.is_empty(), "{what}: new boundary vertices {new:?}");
+            assert!(
+                len2 <= len * (1.0 + 1e-9),
+                "{what}: boundary longer {len} -> {len2}"
+            );
+        }
+    }
+}
+
+/// Geometry barely constrains: the topological rules must hold on their own.
+fn loose(config: Config) -> Config {
+    let mut c = config;
+    c.max_normal_turn_deg = 179.0;
+    c.min_quality = 0.0;
+    c
+}
+
+#[test]
+fn no_new_pinch_or_non_manifold_edge() {
+    let meshes = [
+        ("icosphere", jitter(icosphere(3), 11, 1e-3)),
+        ("grid", jitter(grid(16, 16, 0.15), 12, 1e-3)),
+        ("box", jitter(cube(5), 13, 1e-3)),
+        ("cow", fixture("cow.obj")),
+    ];
+    for (name, m) in &meshes {
+        for (cname, config) in both_configs(0.05) {
+            for (lname, config) in [("", config), (" loose", loose(config))] {
+                let what = format!("{name} {cname}{lname}");
+                let (out, report) = simplify(m, &config);
+                assert_valid(&what, m, &out, &report);
+                let v = verdict(m, &out);
+                assert_eq!(v.new_pinched_vertices + v.new_non_manifold_edges, 0);
+            }
+        }
+    }
+}
+
+/// Six separate closed tetrahedra: every vertex has valence 3, so collapsing any edge a-b
+/// would turn a's third triangle into a copy of one of b's.
+fn tetrahedra() -> MeshData {
+    let mut m = MeshData::default();
+    for i in 0..6u32 {
+        let o = [i as f32 * 3.0, (i % 2) as f32, 0.0];
+        let base = m.positions.len() as u32;
+        for p in [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ] {
+            m.positions.push([o[0] + p[0], o[1] + p[1], o[2] + p[2]]);
+        }
+        for t in [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]] {
+            m.triangles.push(t.map(|k: u32| base + k));
+        }
+    }
+    m
+}
+
+#[test]
+fn no_duplicate_triangles_on_tetrahedral_parts() {
+    // Closed surfaces with valence-3 vertices, with loose geometry so that only the
+    // connectivity rules decide.
+    // An icosahedron with a low pyramid on every face: 20 valence-3 vertices.
+    let mut bumpy = icosphere(0);
+    let faces = bumpy.triangles.clone();
+    bumpy.triangles.clear();
+    for t in faces {
+        let c = (0..3).fold([0.0f32; 3], |acc, k| {
+            let p = bumpy.positions[t[k] as usize];
+            [
+                acc[0] + p[0] * 0.36,
+                acc[1] + p[1] * 0.36,
+                acc[2] + p[2] * 0.36,
+            ]
+        });
+        let v = bumpy.positions.len() as u32;
+        bumpy.positions.push(c);
+        for k in 0..3 {
+            bumpy.triangles.push([t[k], t[(k + 1) % 3], v]);
+        }
+    }
+    for (name, m) in [("tetrahedra", tetrahedra()), ("bumpy icosahedron", bumpy)] {
+        for (cname, config) in both_configs(0.0) {
+            for (lname, config) in [("", config), (" loose", loose(config))] {
+                let what = format!("{name} {cname}{lname}");
+                let (out, report) = simplify(&m, &config);
+                assert_valid(&what, &m, &out, &report);
+                assert_eq!(verdict(&m, &out).duplicate_triangles, 0, "{what}");
+            }
+        }
+    }
+}
+
+/// In a consistently wound manifold, the copy a collapse would make always has the opposite
+/// winding of the triangle it copies, so the fold rule refuses it too, and an inconsistent
+/// winding locks b. With every other rule on, the output is the same without the duplicate
+/// rule; what shows the rule at work is the report's count of the collapses it refused
+/// (`Report::rejected`, by the first rule that refuses, in the order of `src/legality.rs`).
+#[test]
+fn tetrahedra_are_kept_whole_by_the_duplicate_rule() {
+    let m = tetrahedra();
+    for schedule in [Schedule::Greedy, Schedule::Passes] {
+        // Features off: on a regular shape they would refuse every collapse first.
+        let mut config = loose(Config::new().with_schedule(schedule).with_ratio(0.0));
+        config.features = false;
+        let what = format!("tetrahedra {schedule:?} loose");
+        let (out, report) = simplify(&m, &config);
+        assert_valid(&what, &m, &out, &report);
+        assert_eq!(
+            out.triangles, m.triangles,
+            "{what}: every tetrahedron stays"
+        );
+        assert!(
+            report.rejected.duplicate > 0,
+            "{what}: no collapse refused as a duplicate: {:?}",
+            report.rejected
+        );
+    }
+}
+
+/// Meshes for the per-operation shape tests.
+fn shape_meshes() -> Vec<(&'static str, MeshData)> {
+    vec![
+        ("wavy grid", jitter(grid(18, 18, 0.3), 21, 1e-3)),
+        ("flat grid", grid(16, 12, 0.0)),
+        ("icosphere", jitter(icosphere(3), 22, 1e-3)),
+        ("box", jitter(cube(5), 23, 1e-4)),
+        ("cow", fixture("cow.obj")),
+    ]
+}
+
+#[test]
+fn no_operation_makes_a_sliver() {
+    for (name, m) in shape_meshes() {
+        for (cname, config) in both_configs(0.05) {
+            let what = format!("{name} {cname}");
+            let (out, report, steps) = step_by_step(&m, &config);
+            assert!(
+                steps.slivers.is_empty(),
+                "{what}: {} slivers made, first (operation, slot, quality before, after) {:?}",
+                steps.slivers.len(),
+                &steps.slivers[..steps.slivers.len().min(5)]
+            );
+            assert_valid(&what, &m, &out, &report);
+            assert_eq!(verdict(&m, &out).new_zero_area_triangles, 0, "{what}");
+        }
+    }
+}
+
+#[test]
+fn no_operation_turns_a_triangle_too_far() {
+    for (name, m) in shape_meshes() {
+        for (cname, config) in both_configs(0.05) {
+            let what = format!("{name} {cname}");
+            let (out, report, steps) = step_by_step(&m, &config);
+            assert!(
+                steps.turned.is_empty(),
+                "{what}: {} triangles turned beyond {}°, first (operation, slot, degrees) {:?}",
+                steps.turned.len(),
+                config.max_normal_turn_deg,
+                &steps.turned[..steps.turned.len().min(5)]
+            );
+            assert_valid(&what, &m, &out, &report);
+        }
+    }
+}
+
+#[test]
+fn no_new_folds_when_only_the_fold_rule_guards() {
+    let meshes = [
+        ("wavy grid", jitter(grid(18, 18, 0.3), 31, 1e-3)),
+        ("icosphere", jitter(icosphere(3), 32, 1e-3)),
+        ("box", jitter(cube(5), 33, 1e-3)),
+        ("cow", fixture("cow.obj")),
+    ];
+    for (name, m) in &meshes {
+        for (cname, config) in both_configs(0.02) {
+            let what = format!("{name} {cname} loose");
+            let (out, report) = simplify(m, &loose(config));
+            assert_valid(&what, m, &out, &report);
+            assert_eq!(verdict(m, &out).new_folded_pairs, 0, "{what}");
+        }
+    }
+}
