@@ -86,7 +86,11 @@ enum Phase {
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
 /// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
-pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
+///
+/// `S` fixes the schedule at compile time (`0`: whatever [`Config::schedule`] says at run time,
+/// `1`: greedy, `2`: passes). [`Workspace::simplify`](crate::Workspace::simplify) fixes it, so
+/// that a firmware with a constant configuration links one schedule and one cost only.
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost, const S: u8 = 0> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
@@ -116,7 +120,12 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     rejected: Rejections,
 }
 
-impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
+/// [`Simplifier`]'s `S`: the greedy schedule, fixed.
+pub(crate) const GREEDY: u8 = 1;
+/// [`Simplifier`]'s `S`: the paper's passes, fixed.
+pub(crate) const PASSES: u8 = 2;
+
+impl<'a, L: Index, I: Index, C: Cost, const S: u8> Simplifier<'a, L, I, C, S> {
     pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
         // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
@@ -282,8 +291,11 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     self.threshold = self.mean.threshold(self.config.lambda);
                     // Each triangle was seen from its three corners.
                     let live = self.mesh.live as f32;
-                    self.cost
-                        .round(if live > 0.0 { self.area2 / (3.0 * live) } else { 0.0 });
+                    self.cost.round(if live > 0.0 {
+                        self.area2 / (3.0 * live)
+                    } else {
+                        0.0
+                    });
                     self.v = 0;
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.
@@ -295,10 +307,12 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     self.features = 0;
                     self.passes += 1;
                     self.pass_collapses = 0;
-                    self.phase = match self.config.schedule {
-                        Schedule::Greedy => Phase::Keys,
-                        Schedule::Passes => Phase::Flags,
+                    let passes = match S {
+                        GREEDY => false,
+                        PASSES => true,
+                        _ => self.config.schedule == Schedule::Passes,
                     };
+                    self.phase = if passes { Phase::Flags } else { Phase::Keys };
                 }
             }
             Phase::Flags => {

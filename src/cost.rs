@@ -15,7 +15,6 @@
 use crate::math::{self, V3};
 use crate::CostKind;
 
-
 /// One candidate collapse `from -> to`, as a cost sees it.
 #[derive(Clone, Copy, Debug)]
 pub struct Move {

@@ -41,7 +41,8 @@ pub(crate) fn cos_deg(deg: f32) -> f32 {
         let s = h
             * (1.0
                 - h2 / 6.0
-                    * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0 * (1.0 - h2 / 110.0)))));
+                    * (1.0
+                        - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0 * (1.0 - h2 / 110.0)))));
         1.0 - 2.0 * s * s
     }
     #[cfg(feature = "micromath")]
@@ -171,7 +172,11 @@ mod tests {
         for d in 0..=180 {
             let c = super::cos_deg(d as f32);
             let want = (d as f64).to_radians().cos();
-            let tol = if cfg!(feature = "micromath") { 2e-3 } else { 2e-5 };
+            let tol = if cfg!(feature = "micromath") {
+                2e-3
+            } else {
+                2e-5
+            };
             assert!((c as f64 - want).abs() < tol, "{d}: {c} vs {want}");
         }
     }

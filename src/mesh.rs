@@ -609,7 +609,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         while c != NIL && guard > 0 {
             guard -= 1;
             let n = self.after(c);
-            if dead.contains(&((c >> 2))) {
+            if dead.contains(&(c >> 2)) {
                 if w_first == NIL {
                     w_first = c;
                     w_pred = prev;
