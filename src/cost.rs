@@ -48,7 +48,8 @@ pub trait Cost {
 }
 
 /// Memoryless quadric error (Lindstrom and Turk's "memoryless" simplification, 1998; the
-/// plane quadrics of seed 000 §3 (Cheng/Pan/Shi) and seed 003 (Garland-Heckbert QEM) without
+/// plane quadrics of seed 000 §2.3 (Cheng/Pan/Shi, eq. for K_p and Q_s) and of seed 003 (an
+/// implementation of Garland's edge collapse) without
 /// the per-vertex matrix): the area-weighted squared distance from the kept vertex to the
 /// planes of the removed vertex's current triangles,
 ///

@@ -4,13 +4,15 @@
 //! byte of working memory fixed at compile time.
 //!
 //! It follows the mobile-terminal method of Lin Mouguang (seed 004, "A Geometry Compression
-//! Method for Mobile Computing Terminal", 2007): edge collapse where the vertex whose removal
-//! turns its triangles' unit normals least moves onto its neighbour (eq. 1-2, Algorithm 1),
-//! and *feature vertices*, whose triangles' normals differ most from each other (eq. 3-5),
-//! are never collapsed. Collapses keep one endpoint (subset placement, §2), so the positions
-//! are only ever read and may stay in flash; RAM holds indices and working state. Legality
-//! follows Hoppe's progressive meshes and Garland-Heckbert (seeds 000, 001): link condition,
-//! boundary preservation, no flipped, folded, sliver or duplicate triangles.
+//! Method for Mobile Computing Terminal", 2007): edge collapse with subset placement (§2), so
+//! the positions are only ever read and may stay in flash, and *feature vertices*, whose
+//! triangles' normals differ most from each other (§3, eq. 3-5), are never removed. The
+//! default cost is a memoryless quadric (Lindstrom-Turk style; the plane quadrics of seed 000
+//! §2.3 without per-vertex storage); the paper's own normal variation W (eq. 1-2, Algorithm 1)
+//! and its passes are [`Config::paper`]. Legality follows Cheng, Pan and Shi's progressive
+//! meshes (seed 000 §3.1-3.3): irregular vertices locked, the link condition, boundary edges
+//! only between boundary vertices, a dihedral (normal-turn and fold) threshold; plus no
+//! sliver or duplicate triangles.
 //!
 //! Data flows one way:
 //!
@@ -18,7 +20,7 @@
 //! positions (read-only) + caller's triangles
 //!   -> mesh      validate, drop degenerate/duplicate triangles, build adjacency, lock non-manifold vertices
 //!   -> feature   feature flags (eq. 3-5)
-//!   -> cost      normal variation W (eq. 1-2), or any other `Cost`
+//!   -> cost      memoryless quadric, the paper's W (eq. 1-2), or any other `Cost`
 //!   -> collapse  schedule (greedy heap or the paper's passes), legality, apply
 //!   -> the compacted triangles in the caller's buffer, and a `Report`
 //! ```
