@@ -32,7 +32,6 @@ use crate::math::{self, V3};
 use crate::mesh::{flag, next3, prev3, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
-use core::marker::PhantomData;
 
 /// Candidates priced per vertex: its first `MAX_CANDIDATES` neighbours in fan order (a vertex
 /// of higher valence never moves onto the others).
@@ -90,70 +89,9 @@ enum Phase {
 ///
 /// `S` fixes the schedule at compile time (`0`: whatever [`Config::schedule`] says at run time,
 /// `1`: greedy, `2`: passes). [`Workspace::simplify`](crate::Workspace::simplify) fixes it, so
-/// that a firmware with a constant configuration links one schedule and one cost only. The
-/// index type `I` only shapes this wrapper: the engine inside is the same for `u16` and `u32`.
+/// that a firmware with a constant configuration links one schedule and one cost only.
 pub struct Simplifier<'a, L: Index, I: Index, C: Cost, const S: u8 = 0> {
-    engine: Engine<'a, L, C, S>,
-    _index: PhantomData<I>,
-}
-
-impl<'a, L: Index, I: Index, C: Cost, const S: u8> Simplifier<'a, L, I, C, S> {
-    pub(crate) fn new(mesh: Mesh<'a, L>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
-        Simplifier {
-            engine: Engine::new(mesh, heap, config, cost),
-            _index: PhantomData,
-        }
-    }
-
-    /// Runs at most `budget` operations and returns `true` once the run is finished.
-    ///
-    /// An operation is one vertex visited by a sweep, one queue pop, or one collapse with the
-    /// updates around it; each is bounded by the valences involved. A budget of 0 does nothing.
-    pub fn step(&mut self, budget: u32) -> bool {
-        self.engine.step(budget)
-    }
-
-    /// Live triangles now.
-    pub fn live_triangles(&self) -> usize {
-        self.engine.mesh.live
-    }
-
-    /// The live triangles now, in buffer order (the order [`Simplifier::finish`] keeps).
-    pub fn triangles(&self) -> impl Iterator<Item = [I; 3]> + '_ {
-        self.buffer().iter().copied().filter(|t| t[0] != t[1])
-    }
-
-    /// The caller's buffer as it is now: live triangles in their original slots, removed ones
-    /// written as `[i, i, i]`.
-    pub fn buffer(&self) -> &[[I; 3]] {
-        I::slice(&self.engine.mesh.tris)
-    }
-
-    /// Whether vertex `v` is currently a feature vertex (never removed while it is one).
-    pub fn is_feature(&self, v: usize) -> bool {
-        self.engine.mesh.has(v, flag::FEATURE)
-    }
-
-    /// Whether vertex `v` currently has triangles.
-    pub fn is_used(&self, v: usize) -> bool {
-        self.engine.mesh.first(v) != NIL
-    }
-
-    /// The report so far (`stop` is [`Stop::Running`] until the run is finished).
-    pub fn report(&self) -> Report {
-        self.engine.report()
-    }
-
-    /// Compacts the result into the front of the caller's buffer and returns the report.
-    /// Finishing early (before `step` returned `true`) keeps the valid mesh reached so far.
-    pub fn finish(self) -> Report {
-        self.engine.finish()
-    }
-}
-
-/// The engine behind a [`Simplifier`], compiled once for both index types.
-pub(crate) struct Engine<'a, L: Index, C: Cost, const S: u8> {
-    mesh: Mesh<'a, L>,
+    mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
     rules: Rules,
@@ -187,8 +125,8 @@ pub(crate) const GREEDY: u8 = 1;
 /// [`Simplifier`]'s `S`: the paper's passes, fixed.
 pub(crate) const PASSES: u8 = 2;
 
-impl<'a, L: Index, C: Cost, const S: u8> Engine<'a, L, C, S> {
-    fn new(mesh: Mesh<'a, L>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
+impl<'a, L: Index, I: Index, C: Cost, const S: u8> Simplifier<'a, L, I, C, S> {
+    pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
         // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
@@ -201,7 +139,7 @@ impl<'a, L: Index, C: Cost, const S: u8> Engine<'a, L, C, S> {
             locked += mesh.has(v, flag::LOCKED) as usize;
             used_in += mesh.has(v, flag::USED) as usize;
         }
-        Engine {
+        Simplifier {
             mesh,
             heap,
             rules: Rules::new(&config),
@@ -227,7 +165,11 @@ impl<'a, L: Index, C: Cost, const S: u8> Engine<'a, L, C, S> {
         }
     }
 
-    fn step(&mut self, budget: u32) -> bool {
+    /// Runs at most `budget` operations and returns `true` once the run is finished.
+    ///
+    /// An operation is one vertex visited by a sweep, one queue pop, or one collapse with the
+    /// updates around it; each is bounded by the valences involved. A budget of 0 does nothing.
+    pub fn step(&mut self, budget: u32) -> bool {
         let mut ops = 0;
         while ops < budget {
             if let Phase::Done(_) = self.phase {
@@ -239,7 +181,34 @@ impl<'a, L: Index, C: Cost, const S: u8> Engine<'a, L, C, S> {
         matches!(self.phase, Phase::Done(_))
     }
 
-    fn report(&self) -> Report {
+    /// Live triangles now.
+    pub fn live_triangles(&self) -> usize {
+        self.mesh.live
+    }
+
+    /// The live triangles now, in buffer order (the order [`Simplifier::finish`] keeps).
+    pub fn triangles(&self) -> impl Iterator<Item = [I; 3]> + '_ {
+        self.mesh.tris.iter().copied().filter(|t| t[0] != t[1])
+    }
+
+    /// The caller's buffer as it is now: live triangles in their original slots, removed ones
+    /// written as `[i, i, i]`.
+    pub fn buffer(&self) -> &[[I; 3]] {
+        self.mesh.tris
+    }
+
+    /// Whether vertex `v` is currently a feature vertex (never removed while it is one).
+    pub fn is_feature(&self, v: usize) -> bool {
+        self.mesh.has(v, flag::FEATURE)
+    }
+
+    /// Whether vertex `v` currently has triangles.
+    pub fn is_used(&self, v: usize) -> bool {
+        self.mesh.first(v) != NIL
+    }
+
+    /// The report so far (`stop` is [`Stop::Running`] until the run is finished).
+    pub fn report(&self) -> Report {
         let stop = match self.phase {
             Phase::Done(s) => s,
             _ => Stop::Running,
@@ -266,7 +235,9 @@ impl<'a, L: Index, C: Cost, const S: u8> Engine<'a, L, C, S> {
         }
     }
 
-    fn finish(mut self) -> Report {
+    /// Compacts the result into the front of the caller's buffer and returns the report.
+    /// Finishing early (before `step` returned `true`) keeps the valid mesh reached so far.
+    pub fn finish(mut self) -> Report {
         let report = self.report();
         let n = self.mesh.compact();
         #[cfg(feature = "defmt")]

@@ -165,7 +165,7 @@ fn folded(u: &Shape, v: &Shape) -> bool {
 
 /// The shape of live triangle `t`.
 #[inline]
-fn shape_of<L: Index>(mesh: &Mesh<'_, L>, t: usize) -> Shape {
+fn shape_of<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, t: usize) -> Shape {
     Shape::of(mesh.tri(t).map(|v| mesh.p(v)))
 }
 
@@ -184,8 +184,8 @@ pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
 }
 
 /// Checks every rule for `a -> b`.
-pub(crate) fn check<L: Index>(
-    mesh: &Mesh<'_, L>,
+pub(crate) fn check<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
     rules: &Rules,
     a: usize,
     b: usize,

@@ -24,7 +24,7 @@
 
 use core::cell::Cell;
 
-use crate::index::{Index, Tris};
+use crate::index::Index;
 use crate::math::{self, V3};
 use crate::Error;
 
@@ -79,9 +79,9 @@ pub(crate) const fn prev3(k: usize) -> usize {
 pub(crate) const NIL: usize = usize::MAX;
 
 /// The mesh under simplification.
-pub(crate) struct Mesh<'a, L: Index> {
+pub(crate) struct Mesh<'a, L: Index, I: Index> {
     pos: &'a [[f32; 3]],
-    pub(crate) tris: Tris<'a>,
+    pub(crate) tris: &'a mut [[I; 3]],
     head: &'a mut [L],
     next: &'a mut [[L; 3]],
     /// Flags behind `Cell`s, so that a legality check (which only reads the mesh) can mark
@@ -101,12 +101,12 @@ pub(crate) struct Mesh<'a, L: Index> {
     pub(crate) valid_in: usize,
 }
 
-impl<'a, L: Index> Mesh<'a, L> {
+impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// Validates the input (reading only), then drops degenerate and duplicate triangles,
     /// builds the corner lists and classifies vertices.
     pub(crate) fn build(
         pos: &'a [[f32; 3]],
-        tris: Tris<'a>,
+        tris: &'a mut [[I; 3]],
         head: &'a mut [L],
         next: &'a mut [[L; 3]],
         flags: &'a mut [u8],
@@ -115,8 +115,9 @@ impl<'a, L: Index> Mesh<'a, L> {
         // 1. Validate before touching anything: indices in range, used positions finite.
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
-        for t in 0..tris.len() {
-            for index in tris.get(t).unwrap_or([0; 3]) {
+        for (t, tri) in tris.iter().enumerate() {
+            for &i in tri {
+                let index = i.to_usize();
                 let Some(p) = pos.get(index) else {
                     return Err(Error::IndexOutOfRange { triangle: t, index });
                 };
@@ -132,7 +133,7 @@ impl<'a, L: Index> Mesh<'a, L> {
         // Halves first, so that `hi - lo` cannot overflow for coordinates near f32::MAX.
         let mut centre = [0.0; 3];
         let mut half = 0.0f32;
-        if tris.len() > 0 {
+        if !tris.is_empty() {
             for a in 0..3 {
                 centre[a] = lo[a] * 0.5 + hi[a] * 0.5;
                 half = half.max(hi[a] * 0.5 - lo[a] * 0.5);
@@ -245,17 +246,24 @@ impl<'a, L: Index> Mesh<'a, L> {
     /// The vertices of triangle `t` (all `NIL` if out of range).
     #[inline]
     pub(crate) fn tri(&self, t: usize) -> [usize; 3] {
-        self.tris.get(t).unwrap_or([NIL; 3])
+        match self.tris.get(t) {
+            Some(x) => [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()],
+            None => [NIL; 3],
+        }
     }
 
     #[inline]
     fn set_corner(&mut self, c: usize, v: usize) {
-        self.tris.set(c >> 2, c & 3, v);
+        if let Some(x) = self.tris.get_mut(c >> 2).and_then(|t| t.get_mut(c & 3)) {
+            *x = I::narrow(v);
+        }
     }
 
     /// Writes `t` as removed: `[v, v, v]` with its first vertex.
     fn kill(&mut self, t: usize) {
-        self.tris.kill(t);
+        if let Some(x) = self.tris.get_mut(t) {
+            *x = [x[0]; 3];
+        }
     }
 
     /// The corner of `v` in triangle `t`, or `NIL` if `t` does not hold `v`.
@@ -342,7 +350,7 @@ impl<'a, L: Index> Mesh<'a, L> {
 
     /// Iterates `v`'s corners as `(triangle, slot)`, in fan order for a regular fan.
     #[inline]
-    pub(crate) fn corners(&self, v: usize) -> Corners<'_, 'a, L> {
+    pub(crate) fn corners(&self, v: usize) -> Corners<'_, 'a, L, I> {
         Corners {
             mesh: self,
             c: self.first(v),
@@ -675,9 +683,11 @@ impl<'a, L: Index> Mesh<'a, L> {
     pub(crate) fn compact(&mut self) -> usize {
         let mut n = 0;
         for t in 0..self.tris.len() {
-            let Some(tri) = self.tris.get(t) else { break };
-            if !is_dead(tri) {
-                self.tris.copy(t, n);
+            let Some(&tri) = self.tris.get(t) else { break };
+            if tri[0] != tri[1] {
+                if let Some(slot) = self.tris.get_mut(n) {
+                    *slot = tri;
+                }
                 n += 1;
             }
         }
@@ -704,12 +714,12 @@ fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
 }
 
 /// Iterator over a vertex's corners.
-pub(crate) struct Corners<'m, 'a, L: Index> {
-    mesh: &'m Mesh<'a, L>,
+pub(crate) struct Corners<'m, 'a, L: Index, I: Index> {
+    mesh: &'m Mesh<'a, L, I>,
     c: usize,
 }
 
-impl<L: Index> Iterator for Corners<'_, '_, L> {
+impl<L: Index, I: Index> Iterator for Corners<'_, '_, L, I> {
     type Item = (usize, usize);
     #[inline]
     fn next(&mut self) -> Option<(usize, usize)> {

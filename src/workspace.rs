@@ -176,7 +176,7 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         };
         let mesh = Mesh::build(
             positions,
-            I::tris(triangles),
+            triangles,
             head,
             next,
             flags,
