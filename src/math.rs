@@ -59,7 +59,7 @@ pub(crate) const TINY2: f32 = 1e-30;
 /// subnormal, infinity or NaN (no direction worth keeping). Scaling by it is exact.
 #[inline]
 pub(crate) fn pow2_inverse(m: f32) -> f32 {
-    if !(m >= f32::MIN_POSITIVE) || !m.is_finite() {
+    if m.is_nan() || m < f32::MIN_POSITIVE || !m.is_finite() {
         return 0.0;
     }
     let e = (m.to_bits() >> 23) as i32 - 127;
