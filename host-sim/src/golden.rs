@@ -522,11 +522,16 @@ fn config_line(c: &Config) -> String {
         (true, FeatureMode::ValenceNormalized) => "valence",
     };
     format!(
-        "schedule {}, ratio {}, target {}, lambda {}, features {features}, feature_targets {}, \
-         max_passes {}, max_cost {}, max_normal_turn_deg {}, min_quality {}, boundary_weight {}",
+        "schedule {}, cost {}, ratio {}, target {}, lambda {}, features {features}, \
+         feature_targets {}, max_passes {}, max_cost {}, max_normal_turn_deg {}, min_quality {}, \
+         boundary_weight {}",
         match c.schedule {
             Schedule::Greedy => "greedy",
             Schedule::Passes => "passes",
+        },
+        match c.cost {
+            tinydecimate::CostKind::Quadric => "quadric",
+            tinydecimate::CostKind::NormalVariation => "normal",
         },
         c.target_ratio,
         c.target_triangles,

@@ -338,6 +338,7 @@ fn selftest(
     let h = CaseHeader {
         index_type: IndexType::U16,
         schedule: meshfmt::ScheduleCode::Greedy,
+        cost: meshfmt::CostCode::Quadric,
         vertices: nv as u32,
         triangles: nt as u32,
         target_ratio: 0.25,

@@ -20,7 +20,8 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u16     | reserved, 0                                                  |
+//! |     30 | u8      | cost: 0 = memoryless quadric, 1 = normal variation W (version 2) |
+//! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
 //! |     40 | f32     | max normal turn, degrees                                     |
@@ -73,7 +74,7 @@ pub const CASE_MAGIC: [u8; 4] = *b"TDCS";
 /// Result file magic.
 pub const RESULT_MAGIC: [u8; 4] = *b"TDRS";
 /// Format version of both files.
-pub const VERSION: u16 = 1;
+pub const VERSION: u16 = 2;
 /// Size of the case header.
 pub const CASE_HEADER_LEN: usize = 64;
 /// Size of the result header.
@@ -119,6 +120,15 @@ pub enum ScheduleCode {
     Passes = 1,
 }
 
+/// Cost code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CostCode {
+    /// `CostKind::Quadric`.
+    Quadric = 0,
+    /// `CostKind::NormalVariation`.
+    NormalVariation = 1,
+}
+
 /// Feature mode code.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FeatureCode {
@@ -148,6 +158,7 @@ pub enum FormatError {
 pub struct CaseHeader {
     pub index_type: IndexType,
     pub schedule: ScheduleCode,
+    pub cost: CostCode,
     pub vertices: u32,
     pub triangles: u32,
     pub target_ratio: f32,
@@ -243,7 +254,8 @@ impl CaseHeader {
         w.f32(self.lambda);
         w.u8(self.feature_mode as u8);
         w.u8(self.feature_targets as u8);
-        w.u16(0);
+        w.u8(self.cost as u8);
+        w.u8(0);
         w.u32(self.max_passes);
         w.f32(self.max_cost);
         w.f32(self.max_normal_turn_deg);
@@ -279,10 +291,16 @@ impl CaseHeader {
             _ => return Err(FormatError::Code),
         };
         let feature_targets = r.u8() != 0;
-        r.skip(2);
+        let cost = match r.u8() {
+            0 => CostCode::Quadric,
+            1 => CostCode::NormalVariation,
+            _ => return Err(FormatError::Code),
+        };
+        r.skip(1);
         Ok(CaseHeader {
             index_type,
             schedule,
+            cost,
             vertices,
             triangles,
             target_ratio,
@@ -555,7 +573,7 @@ pub fn narrow(v: usize) -> u32 {
 #[cfg(feature = "tinydecimate")]
 pub mod lib {
     use super::*;
-    use tinydecimate::{Config, Error, FeatureMode, Report, Schedule, Stop};
+    use tinydecimate::{Config, CostKind, Error, FeatureMode, Report, Schedule, Stop};
 
     /// The configuration a case asks for.
     pub fn config(h: &CaseHeader) -> Config {
@@ -568,7 +586,11 @@ pub mod lib {
             .with_target_triangles(h.target_triangles as usize)
             .with_lambda(h.lambda)
             .with_max_passes(h.max_passes)
-            .with_max_cost(h.max_cost);
+            .with_max_cost(h.max_cost)
+            .with_cost(match h.cost {
+                CostCode::Quadric => CostKind::Quadric,
+                CostCode::NormalVariation => CostKind::NormalVariation,
+            });
         c.features = h.feature_mode != FeatureCode::Off;
         if h.feature_mode == FeatureCode::ValenceNormalized {
             c.feature_mode = FeatureMode::ValenceNormalized;
@@ -589,6 +611,10 @@ pub mod lib {
             schedule: match config.schedule {
                 Schedule::Greedy => ScheduleCode::Greedy,
                 Schedule::Passes => ScheduleCode::Passes,
+            },
+            cost: match config.cost {
+                CostKind::Quadric => CostCode::Quadric,
+                CostKind::NormalVariation => CostCode::NormalVariation,
             },
             vertices: 0,
             triangles: 0,
@@ -805,6 +831,7 @@ mod tests {
         CaseHeader {
             index_type: IndexType::U16,
             schedule: ScheduleCode::Passes,
+            cost: CostCode::NormalVariation,
             vertices: 0,
             triangles: 0,
             target_ratio: 0.25,
@@ -837,6 +864,7 @@ mod tests {
             assert_eq!(h2.vertices, 3);
             assert_eq!(h2.triangles, 2);
             assert_eq!(h2.schedule, ScheduleCode::Passes);
+            assert_eq!(h2.cost, CostCode::NormalVariation);
             assert_eq!(h2.max_cost, f32::INFINITY);
             assert_eq!(h2.feature_mode, FeatureCode::ValenceNormalized);
             assert!(h2.feature_targets);
