@@ -17,41 +17,14 @@ enum Kind {
 }
 
 fn build(kind: &Kind, jitter: u64) -> MeshData {
-    let mut m = match *kind {
+    let m = match *kind {
         Kind::Sphere(n) => icosphere(n),
         Kind::Grid(n, k) => grid(n, k, 0.15),
         Kind::Cube(n) => cube(n),
-        Kind::NonManifold(n) => {
-            let mut m = grid(n, n, 0.1);
-            // Fin on the edge of the first triangle.
-            let [a, b, _] = m.triangles[m.triangles.len() / 2];
-            m.positions.push([0.5, 0.5, 1.0]);
-            let top = (m.positions.len() - 1) as u32;
-            m.triangles.push([a, b, top]);
-            // A small cone pinched onto a grid corner vertex 0.
-            let base = m.positions.len() as u32;
-            for i in 0..5 {
-                let t = i as f32 / 5.0 * std::f32::consts::TAU;
-                m.positions
-                    .push([-0.2 + 0.1 * t.cos(), -0.2 + 0.1 * t.sin(), -0.3]);
-            }
-            for i in 0..5 {
-                m.triangles.push([0, base + (i + 1) % 5, base + i]);
-            }
-            m
-        }
+        Kind::NonManifold(n) => fin_and_pinch(n),
     };
     // Deterministic jitter so that ties and symmetric cases vary.
-    let mut s = jitter | 1;
-    for p in &mut m.positions {
-        for x in p.iter_mut() {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            *x += ((s % 1000) as f32 / 1000.0 - 0.5) * 1e-3;
-        }
-    }
-    m
+    common::jitter(m, jitter, 1e-3)
 }
 
 fn kind() -> impl Strategy<Value = Kind> {

@@ -27,20 +27,6 @@ fn fixture(name: &str) -> MeshData {
     parse_obj(&std::fs::read_to_string(&path).unwrap())
 }
 
-/// Deterministic jitter of about `amount`, so that ties and symmetric cases vary.
-fn jitter(mut m: MeshData, seed: u64, amount: f32) -> MeshData {
-    let mut s = seed | 1;
-    for p in &mut m.positions {
-        for x in p.iter_mut() {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            *x += ((s % 1000) as f32 / 1000.0 - 0.5) * amount;
-        }
-    }
-    m
-}
-
 /// What happened between two operations.
 #[derive(Default)]
 struct Steps {
@@ -119,20 +105,7 @@ fn both_configs(ratio: f32) -> [(&'static str, Config); 2] {
 /// A grid with a fin (a third triangle on an interior edge), a cone pinched onto a corner and
 /// one triangle wound the other way.
 fn messy_grid(n: u32, seed: u64) -> MeshData {
-    let mut m = grid(n, n, 0.1);
-    let [a, b, _] = m.triangles[m.triangles.len() / 2];
-    m.positions.push([0.5, 0.5, 1.0]);
-    let top = (m.positions.len() - 1) as u32;
-    m.triangles.push([a, b, top]);
-    let base = m.positions.len() as u32;
-    for i in 0..5 {
-        let t = i as f32 / 5.0 * std::f32::consts::TAU;
-        m.positions
-            .push([-0.2 + 0.1 * t.cos(), -0.2 + 0.1 * t.sin(), -0.3]);
-    }
-    for i in 0..5 {
-        m.triangles.push([0, base + (i + 1) % 5, base + i]);
-    }
+    let mut m = fin_and_pinch(n);
     let k = m.triangles.len() / 4;
     m.triangles[k].swap(0, 1);
     jitter(m, seed, 1e-3)

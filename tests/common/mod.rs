@@ -282,3 +282,39 @@ pub fn assert_valid(name: &str, input: &MeshData, output: &MeshData, report: &Re
     );
     verdict(input, output).assert_valid(name);
 }
+
+/// A grid with a fin (a third triangle on an interior edge) and a small cone pinched onto
+/// corner vertex 0: a non-manifold edge and a pinched vertex.
+pub fn fin_and_pinch(n: u32) -> MeshData {
+    let mut m = grid(n, n, 0.1);
+    // Fin on the edge of the middle triangle.
+    let [a, b, _] = m.triangles[m.triangles.len() / 2];
+    m.positions.push([0.5, 0.5, 1.0]);
+    let top = (m.positions.len() - 1) as u32;
+    m.triangles.push([a, b, top]);
+    // A small cone pinched onto grid corner vertex 0.
+    let base = m.positions.len() as u32;
+    for i in 0..5 {
+        let t = i as f32 / 5.0 * std::f32::consts::TAU;
+        m.positions
+            .push([-0.2 + 0.1 * t.cos(), -0.2 + 0.1 * t.sin(), -0.3]);
+    }
+    for i in 0..5 {
+        m.triangles.push([0, base + (i + 1) % 5, base + i]);
+    }
+    m
+}
+
+/// Deterministic xorshift jitter of every coordinate, in `±amount / 2`.
+pub fn jitter(mut m: MeshData, seed: u64, amount: f32) -> MeshData {
+    let mut s = seed | 1;
+    for p in &mut m.positions {
+        for x in p.iter_mut() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            *x += ((s % 1000) as f32 / 1000.0 - 0.5) * amount;
+        }
+    }
+    m
+}
