@@ -86,11 +86,7 @@ enum Phase {
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
 /// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
-///
-/// `S` fixes the schedule at compile time (`0`: whatever [`Config::schedule`] says at run time,
-/// `1`: greedy, `2`: passes). [`Workspace::simplify`](crate::Workspace::simplify) fixes it, so
-/// that a firmware with a constant configuration links one schedule and one cost only.
-pub struct Simplifier<'a, L: Index, I: Index, C: Cost, const S: u8 = 0> {
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
@@ -120,12 +116,7 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost, const S: u8 = 0> {
     rejected: Rejections,
 }
 
-/// [`Simplifier`]'s `S`: the greedy schedule, fixed.
-pub(crate) const GREEDY: u8 = 1;
-/// [`Simplifier`]'s `S`: the paper's passes, fixed.
-pub(crate) const PASSES: u8 = 2;
-
-impl<'a, L: Index, I: Index, C: Cost, const S: u8> Simplifier<'a, L, I, C, S> {
+impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
         // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
@@ -307,11 +298,7 @@ impl<'a, L: Index, I: Index, C: Cost, const S: u8> Simplifier<'a, L, I, C, S> {
                     self.features = 0;
                     self.passes += 1;
                     self.pass_collapses = 0;
-                    let passes = match S {
-                        GREEDY => false,
-                        PASSES => true,
-                        _ => self.config.schedule == Schedule::Passes,
-                    };
+                    let passes = self.config.schedule == Schedule::Passes;
                     self.phase = if passes { Phase::Flags } else { Phase::Keys };
                 }
             }

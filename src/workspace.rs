@@ -4,7 +4,7 @@ use crate::collapse::Simplifier;
 use crate::cost::{Builtin, Cost};
 use crate::index::Index;
 use crate::mesh::Mesh;
-use crate::{Config, Error, Report, Schedule};
+use crate::{Config, Error, Report};
 
 /// All working state of the simplifier, with capacity fixed by const generics.
 ///
@@ -66,33 +66,10 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
-        // Schedule and cost become types here: with a constant configuration (the usual
-        // firmware) the compiler keeps one arm, and the other schedule and cost are not linked.
-        use crate::collapse::{GREEDY, PASSES};
-        match (config.schedule, Builtin::of(config)) {
-            (Schedule::Greedy, Builtin::Quadric(c)) => {
-                self.run::<I, _, GREEDY>(positions, triangles, config, c)
-            }
-            (Schedule::Greedy, Builtin::NormalVariation(c)) => {
-                self.run::<I, _, GREEDY>(positions, triangles, config, c)
-            }
-            (Schedule::Passes, Builtin::Quadric(c)) => {
-                self.run::<I, _, PASSES>(positions, triangles, config, c)
-            }
-            (Schedule::Passes, Builtin::NormalVariation(c)) => {
-                self.run::<I, _, PASSES>(positions, triangles, config, c)
-            }
-        }
-    }
-
-    fn run<I: Index, C: Cost, const S: u8>(
-        &mut self,
-        positions: &[[f32; 3]],
-        triangles: &mut [[I; 3]],
-        config: &Config,
-        cost: C,
-    ) -> Result<Report, Error> {
-        let mut s = self.start_fixed::<I, C, S>(positions, triangles, config, cost)?;
+        // One engine for every configuration (the schedule and the built-in cost are chosen
+        // at run time, so a configuration received at run time costs no extra flash). For
+        // the least flash with one known cost, drive `start_with_cost` with that cost.
+        let mut s = self.start(positions, triangles, config)?;
         while !s.step(u32::MAX) {}
         Ok(s.finish())
     }
@@ -121,16 +98,6 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         config: &Config,
         cost: C,
     ) -> Result<Simplifier<'a, L, I, C>, Error> {
-        self.start_fixed(positions, triangles, config, cost)
-    }
-
-    fn start_fixed<'a, I: Index, C: Cost, const S: u8>(
-        &'a mut self,
-        positions: &'a [[f32; 3]],
-        triangles: &'a mut [[I; 3]],
-        config: &Config,
-        cost: C,
-    ) -> Result<Simplifier<'a, L, I, C, S>, Error> {
         config.validate()?;
         if positions.len() > MAX_VERTICES || positions.len() > L::COUNT {
             return Err(Error::Capacity {
