@@ -630,16 +630,16 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
         let cand = cand.get_mut(..n).unwrap_or(&mut []);
         loop {
-            let mut min: Option<usize> = None;
-            for (i, c) in cand.iter().enumerate() {
-                if c.1 != NIL && min.is_none_or(|m| cand_less(*c, cand[m])) {
-                    min = Some(i);
+            let mut min: Option<(usize, (f32, usize, usize))> = None;
+            for (i, &c) in cand.iter().enumerate() {
+                if c.1 != NIL && min.is_none_or(|(_, m)| cand_less(c, m)) {
+                    min = Some((i, c));
                 }
             }
-            let Some((c, from, to)) = min.and_then(|i| cand.get(i).copied()) else {
+            let Some((i, (c, from, to))) = min else {
                 return;
             };
-            if let Some(slot) = min.and_then(|i| cand.get_mut(i)) {
+            if let Some(slot) = cand.get_mut(i) {
                 slot.1 = NIL;
             }
             match legality::check(&self.mesh, &self.rules, from, to) {

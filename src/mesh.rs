@@ -58,20 +58,21 @@ pub(crate) const fn corner(t: usize, k: usize) -> usize {
 /// The slot after `k` in winding order (a corner's `a`).
 #[inline]
 pub(crate) const fn next3(k: usize) -> usize {
-    if k >= 2 {
-        0
-    } else {
-        k + 1
+    // Written so that the result is below 3 for any `k`: indexing with it needs no check.
+    match k {
+        0 => 1,
+        1 => 2,
+        _ => 0,
     }
 }
 
 /// The slot before `k` in winding order (a corner's `b`).
 #[inline]
 pub(crate) const fn prev3(k: usize) -> usize {
-    if k == 0 {
-        2
-    } else {
-        k - 1
+    match k {
+        1 => 0,
+        2 => 1,
+        _ => 2,
     }
 }
 

@@ -14,8 +14,10 @@ use core::fmt::Write;
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use tinydecimate::cost::{Cost, EdgeChange, NormalVariation, PlaneDistance, TriangleChange};
-use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Simplifier, Workspace};
+use tinydecimate::cost::{Builtin, Cost, Move, NormalVariation, Quadric};
+use tinydecimate::{
+    Config, CostKind, Error, FeatureMode, Index, Report, Schedule, Simplifier, Workspace,
+};
 
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
@@ -47,6 +49,11 @@ fn opaque_config() -> Config {
         } else {
             Schedule::Passes
         },
+        cost: if input(0) & 2 == 0 {
+            CostKind::Quadric
+        } else {
+            CostKind::NormalVariation
+        },
         target_triangles: input(1) as usize,
         target_ratio: opaque_f32(2),
         max_cost: opaque_f32(3),
@@ -71,7 +78,8 @@ fn opaque_config() -> Config {
         .with_lambda(opaque_f32(12))
         .with_feature_mode(c.feature_mode)
         .with_max_passes(input(13))
-        .with_max_cost(opaque_f32(14));
+        .with_max_cost(opaque_f32(14))
+        .with_cost(c.cost);
     black_box(Config::default());
     black_box(Config::new());
     if input(15) & 1 == 0 {
@@ -174,8 +182,9 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
-    let pd = PlaneDistance {
+    let pd = Quadric {
         boundary_weight: opaque_f32(8),
+        reference: opaque_f32(9),
     };
     match ws.start_with_cost(p, t, &config, pd) {
         Ok(s) => drive(s),
@@ -184,18 +193,25 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     black_box(&tris);
 
     // The cost trait's methods by themselves.
-    let change = TriangleChange {
-        old_normal: [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
-        new_normal: [opaque_f32(4), opaque_f32(5), opaque_f32(6)],
-        old_area2: opaque_f32(7),
-        moved: [opaque_f32(8), opaque_f32(9), opaque_f32(10)],
+    let m = Move {
+        d: [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
+        retreat2: opaque_f32(4),
+        turn: opaque_f32(5),
     };
-    let edge = EdgeChange {
-        length2: opaque_f32(11),
-        boundary_retreat2: opaque_f32(12),
-    };
-    black_box(nv.total(nv.triangle(&change), &edge));
-    black_box(pd.total(pd.triangle(&change), &edge));
+    let n = [opaque_f32(6), opaque_f32(7), opaque_f32(10)];
+    let mut pd = pd;
+    pd.round(opaque_f32(11));
+    let mut fan = pd.empty();
+    pd.add(&mut fan, n, opaque_f32(12));
+    black_box(pd.price(&fan, &m));
+    let mut unit = nv.empty();
+    nv.add(&mut unit, n, opaque_f32(12));
+    black_box(nv.price(&unit, &m));
+    let mut b = Builtin::of(&config);
+    b.round(opaque_f32(13));
+    let mut bf = b.empty();
+    b.add(&mut bf, n, opaque_f32(14));
+    black_box((b.price(&bf, &m), b.needs_turn(), pd.needs_turn(), nv.needs_turn()));
 
     // Index.
     let i = I::from_usize(input(9) as usize);
