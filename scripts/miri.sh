@@ -2,8 +2,8 @@
 # Miri on the tests that fit in a few minutes (about 2 min on one core after the first build;
 # the first run also builds Miri's sysroot). Needs: rustup +nightly component add miri rust-src.
 #
-# * `--features libm/force-soft-floats`: libm's x86-64 `sqrtf` is `sqrtss` inline assembly,
-#   which Miri cannot run. The soft-float `sqrtf` is also correctly rounded: same results.
+# * No features needed: the library no longer links libm (whose x86-64 `sqrtf` was inline
+#   assembly that Miri cannot run); its math is `+ - *` and bit operations.
 # * tests/errors.rs: only its small cases. The others each take 140 s to over 4 min under Miri
 #   (icosphere(3), 8x8+ grids); run them with `MIRI_ALL=1` (an hour or more).
 # * tests/properties.rs: out of reach (96 cases per property; its `ProptestConfig { cases: 96 }`
@@ -11,7 +11,7 @@
 # * `MIRI_BIG_ENDIAN=1`: the same on s390x-unknown-linux-gnu as well (big-endian).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-features=(--features libm/force-soft-floats)
+features=()
 fast_errors=(
     too_many_vertices_or_triangles_is_a_capacity_error
     u16_links_cap_the_triangle_count

@@ -621,7 +621,10 @@ fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
             &case.positions,
             tris,
             &case.config,
-            PlaneDistance { boundary_weight: w }
+            PlaneDistance {
+                boundary_weight: w,
+                reference: 0.0,
+            }
         )),
         CostKind::Normal {
             length_weighted,
