@@ -116,6 +116,14 @@ impl Shape {
         let m = math::max_abs(e[0])
             .max(math::max_abs(e[1]))
             .max(math::max_abs(e[2]));
+        // Subnormal edges (coordinates near zero): lift them by 2^64 first (exact), so that
+        // their triangles keep a direction and folds against them are still seen.
+        let (e, m) = if m > 0.0 && m < f32::MIN_POSITIVE {
+            let lift = f32::from_bits((127 + 64) << 23);
+            (e.map(|v| math::scale(v, lift)), m * lift)
+        } else {
+            (e, m)
+        };
         let k = math::pow2_inverse(m);
         if k == 0.0 {
             return Shape {
