@@ -157,15 +157,7 @@ pub fn build(board: &Board, backend: Backend, with_library: bool) -> Result<Path
         cmd.arg("--no-default-features");
     }
     // When host-sim itself runs under cargo, these would leak into the firmware build.
-    for var in [
-        "CARGO_TARGET_DIR",
-        "CARGO_BUILD_TARGET",
-        "RUSTFLAGS",
-        "CARGO_ENCODED_RUSTFLAGS",
-        "CARGO_MANIFEST_DIR",
-    ] {
-        cmd.env_remove(var);
-    }
+    isolate(&mut cmd);
     let status = cmd
         .status()
         .context("running cargo for the firmware (is the target installed? `rustup target add`)")?;
@@ -226,15 +218,7 @@ pub fn build_flash(target: &str, backend: Backend, call: bool) -> Result<PathBuf
     if !features.is_empty() {
         cmd.args(["--features", &features.join(",")]);
     }
-    for var in [
-        "CARGO_TARGET_DIR",
-        "CARGO_BUILD_TARGET",
-        "RUSTFLAGS",
-        "CARGO_ENCODED_RUSTFLAGS",
-        "CARGO_MANIFEST_DIR",
-    ] {
-        cmd.env_remove(var);
-    }
+    isolate(&mut cmd);
     let status = cmd.status().context("running cargo for tests/flash")?;
     if !status.success() {
         bail!("tests/flash build for {target} ({backend}) failed ({status})");
@@ -1449,6 +1433,20 @@ pub fn mesh_case(path: &Path, ratio: f32, passes: bool, u32: bool) -> Result<Cas
         index_type: if u32 { IndexType::U32 } else { IndexType::U16 },
         config,
     })
+}
+
+/// Removes the variables that would leak from a cargo that runs host-sim into a nested firmware
+/// build (its own target directory, target and flags).
+fn isolate(cmd: &mut std::process::Command) {
+    for var in [
+        "CARGO_TARGET_DIR",
+        "CARGO_BUILD_TARGET",
+        "RUSTFLAGS",
+        "CARGO_ENCODED_RUSTFLAGS",
+        "CARGO_MANIFEST_DIR",
+    ] {
+        cmd.env_remove(var);
+    }
 }
 
 #[cfg(test)]
