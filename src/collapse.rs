@@ -114,6 +114,10 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     refresh_only: bool,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
+    /// Collapse log (`[removed, kept]`), written only once `record_into` gave one.
+    log: &'a mut [[I; 2]],
+    logging: bool,
+    logged: usize,
 }
 
 impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
@@ -153,6 +157,9 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             refresh_only: false,
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
+            log: &mut [],
+            logging: false,
+            logged: 0,
         }
     }
 
@@ -170,6 +177,41 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             ops += 1;
         }
         matches!(self.phase, Phase::Done(_))
+    }
+
+    /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
+    /// vertex numbers: the history that [`progressive::Layout`](crate::progressive::Layout)
+    /// turns into vertex splits (call it before the first step to have the whole history).
+    /// When `log` is full the run stops with [`Stop::LogFull`] before the next collapse, so
+    /// the log always holds every collapse made and the mesh stays valid.
+    pub fn record_into(mut self, log: &'a mut [[I; 2]]) -> Self {
+        self.log = log;
+        self.logging = true;
+        self.logged = 0;
+        self
+    }
+
+    /// The collapses logged so far (see [`Simplifier::record_into`]).
+    pub fn records(&self) -> &[[I; 2]] {
+        self.log.get(..self.logged).unwrap_or(&[])
+    }
+
+    /// Appends `[a, b]` to the log; `false` (and the run stops) if the log is full.
+    fn note(&mut self, a: usize, b: usize) -> bool {
+        if !self.logging {
+            return true;
+        }
+        match self.log.get_mut(self.logged) {
+            Some(slot) => {
+                *slot = [I::narrow(a), I::narrow(b)];
+                self.logged += 1;
+                true
+            }
+            None => {
+                self.done(Stop::LogFull);
+                false
+            }
+        }
     }
 
     /// Live triangles now.
@@ -543,6 +585,9 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// other neighbours (marked before the collapse). Nothing else changes: the other
     /// neighbours of `b` keep their fans, so their prices stand.
     fn collapse_greedy(&mut self, a: usize, b: usize) {
+        if !self.note(a, b) {
+            return;
+        }
         let mesh = &self.mesh;
         mesh.for_each_neighbour(a, |x| mesh.mark(x, true));
         self.mesh.collapse(a, b);
@@ -646,6 +691,9 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                 Ok(()) => {
                     if c > self.config.max_cost {
                         self.over_cost = true;
+                        return;
+                    }
+                    if !self.note(from, to) {
                         return;
                     }
                     self.mesh.collapse(from, to);

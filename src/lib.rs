@@ -67,12 +67,14 @@ mod index;
 mod legality;
 mod math;
 mod mesh;
+pub mod progressive;
 mod report;
 mod workspace;
 
 pub use collapse::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Schedule};
 pub use index::Index;
+pub use progressive::Progressive;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
 pub use workspace::Workspace;
 

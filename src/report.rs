@@ -90,6 +90,9 @@ pub enum Stop {
     MaxCost,
     /// `max_passes` passes were run ([`Schedule::Passes`](crate::Schedule::Passes)).
     MaxPasses,
+    /// The collapse log given to [`Simplifier::record_into`](crate::Simplifier::record_into)
+    /// is full: the mesh is valid and every collapse made is in the log.
+    LogFull,
 }
 
 /// The outcome of a simplification.

@@ -656,6 +656,7 @@ pub mod lib {
                     Stop::NoLegalCollapse => 2,
                     Stop::MaxCost => 3,
                     Stop::MaxPasses => 4,
+                    Stop::LogFull => 5,
                 };
                 h.pass_log_len = r.pass_triangles.len().min(PASS_LOG) as u8;
                 for (d, s) in h.pass_triangles.iter_mut().zip(r.pass_triangles.iter()) {
