@@ -69,6 +69,7 @@ mod math;
 mod mesh;
 pub mod progressive;
 mod report;
+pub mod stream;
 mod workspace;
 
 pub use collapse::Simplifier;

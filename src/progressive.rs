@@ -532,11 +532,8 @@ impl<'a, I: Index> Progressive<'a, I> {
         tris.copy_from_slice(input);
         for i in 0..nt {
             let mut guard = 0;
-            loop {
-                let j = match rank.get(i) {
-                    Some(&j) => j.to_usize(),
-                    None => break,
-                };
+            while let Some(&j) = rank.get(i) {
+                let j = j.to_usize();
                 if j == i || j >= nt || guard > nt {
                     break;
                 }
@@ -687,6 +684,100 @@ impl<'a, I: Index> Progressive<'a, I> {
             restored: on_edge as u8,
             moved,
         })
+    }
+
+    /// An empty progressive mesh (for the stream decoder to fill).
+    pub(crate) fn empty(storage: Storage<'a, I>) -> Self {
+        let Storage {
+            triangles,
+            links,
+            heads,
+            splits,
+        } = storage;
+        heads.fill(I::NIL);
+        let n = triangles.len().min(links.len()).min(I::COUNT);
+        let (tris, _) = triangles.split_at_mut(n);
+        let (next, _) = links.split_at_mut(n);
+        Progressive {
+            lists: Lists::new(tris, next, heads),
+            splits,
+            base_vertices: 0,
+            base_triangles: 0,
+            known: 0,
+            top_triangles: 0,
+            level: 0,
+            live: 0,
+        }
+    }
+
+    /// Vertices the storage can number.
+    pub(crate) fn vertex_capacity(&self) -> usize {
+        self.lists.head.len().min(I::COUNT)
+    }
+
+    /// Triangles the storage holds.
+    pub(crate) fn triangle_capacity(&self) -> usize {
+        self.lists.tris.len()
+    }
+
+    /// Vertex splits the storage holds.
+    pub(crate) fn split_capacity(&self) -> usize {
+        self.splits.len()
+    }
+
+    /// Starts an empty base mesh over `base_vertices` vertices.
+    pub(crate) fn start(&mut self, base_vertices: usize) {
+        self.base_vertices = base_vertices;
+    }
+
+    /// Appends a base triangle; `false` if it does not fit or is not a triangle of the base
+    /// vertices.
+    pub(crate) fn push_base(&mut self, tri: [I; 3]) -> bool {
+        let [a, b, c] = tri.map(|i| i.to_usize());
+        if self.known > 0
+            || a == b
+            || b == c
+            || a == c
+            || a.max(b).max(c) >= self.base_vertices
+            || self.live >= self.lists.tris.len()
+        {
+            return false;
+        }
+        if let Some(slot) = self.lists.tris.get_mut(self.live) {
+            *slot = tri;
+        }
+        self.lists.link(self.live);
+        self.live += 1;
+        self.base_triangles += 1;
+        self.top_triangles += 1;
+        true
+    }
+
+    /// Appends a vertex split (creating vertex `base + levels`) with the triangles it
+    /// restores, and applies it; `false` if it does not fit the storage.
+    pub(crate) fn push_split(&mut self, split: Split<I>, restored: &[[I; 3]]) -> bool {
+        self.refine(usize::MAX);
+        let t = self.base_vertices + self.known;
+        let top = self.top_triangles;
+        if t >= self.vertex_capacity()
+            || self.known >= self.splits.len()
+            || top + restored.len() > self.lists.tris.len()
+            || restored.len() != split.restored as usize
+            || split.kept.to_usize() >= t
+        {
+            return false;
+        }
+        for (u, tri) in restored.iter().enumerate() {
+            if let Some(slot) = self.lists.tris.get_mut(top + u) {
+                *slot = *tri;
+            }
+        }
+        if let Some(slot) = self.splits.get_mut(self.known) {
+            *slot = split;
+        }
+        self.known += 1;
+        self.top_triangles += restored.len();
+        self.refine(1) == 1
     }
 
     /// Applies up to `n` vertex splits (finer); returns how many it applied.

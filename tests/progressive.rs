@@ -131,7 +131,7 @@ fn levels_match(name: &str, m: &MeshData, config: Config) {
             continue;
         }
         pm.set_level(n);
-        let (out, r) = simplify(m, &config.clone().with_target_triangles(n).with_ratio(0.0));
+        let (out, r) = simplify(m, &config.with_target_triangles(n).with_ratio(0.0));
         assert_eq!(r.triangles_out, pm.triangles().len(), "{name} at {n}");
         same(
             canonical(pm.triangles(), Some(&order)),

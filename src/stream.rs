@@ -1,0 +1,929 @@
+//! The progressive transmission stream: a base mesh, then vertex splits with the positions of
+//! their new vertices, in checksummed chunks, decoded incrementally as bytes arrive.
+//!
+//! Why (seed 004 §1-2): a small screen at the end of a slow link must show something at once
+//! and refine as bytes arrive. The splits are those of [`Progressive`] (seed 000 §2.1-2.2);
+//! a split names its corners by their places in the kept vertex's list, so its connectivity
+//! costs a few bits per neighbour, and it is only applied once its whole chunk has arrived and
+//! its checksum matches, so a bad stream never leaves a broken mesh behind.
+//!
+//! # Format (version 1, little-endian)
+//! Header, 56 bytes:
+//!
+//! | offset | field |
+//! |---:|---|
+//! | 0 | magic `TDPM` |
+//! | 4 | version, `1` |
+//! | 5 | index width in bytes the decoder needs (2: all vertex numbers fit `u16`; else 4) |
+//! | 6 | flags: bit 0, positions quantised to 16 bits per coordinate over the bounding box |
+//! | 7 | 0 |
+//! | 8 | vertices of the full mesh (u32) |
+//! | 12 | vertices of the base mesh `m₀` (u32) |
+//! | 16 | triangles of the base mesh (u32) |
+//! | 20 | triangles of the full mesh (u32) |
+//! | 24 | largest chunk payload in bytes (u16), then 2 bytes 0 |
+//! | 28 | bounding box: min x, y, z, max x, y, z (6 × f32) |
+//! | 52 | CRC-32 (IEEE) of bytes 0..52 |
+//!
+//! Then chunks: `len` (u16, payload bytes), `kind` (u8), `count` (u16, items), the payload,
+//! and the CRC-32 of all of that. Kinds, in this order: 1 base positions, 2 base triangles,
+//! 3 vertex splits. Payloads are bit-packed, least significant bit first; `bits(n)` is the
+//! width of a number below `n`.
+//! - **Position**: 3 × f32, or 3 × 16-bit `q` with `p = min + q·(max − min)/65535`.
+//! - **Base triangle**: 3 vertex numbers, `bits(m₀)` each.
+//! - **Vertex split** creating vertex `t = m₀ + j`: kept vertex `s` (`bits(t)`); restored
+//!   triangles − 1 (1 bit); the moved mask, one bit per triangle in `s`'s list (its length `L`
+//!   is known to the decoder, at most 64); per restored triangle: the slot of `s` (2 bits),
+//!   whether `t` follows `s` in winding order (1 bit), and the third vertex `w`: a 0 bit, then
+//!   `w`'s place among `s`'s triangles (`bits(L)`) and whether it follows `s` there (1 bit), or
+//!   a 1 bit and `w` itself (`bits(t)`); then `t`'s position.
+
+use crate::index::Index;
+use crate::progressive::{Progressive, Split, Storage};
+
+/// Header length in bytes.
+pub const HEADER: usize = 56;
+/// Chunk header (`len`, `kind`, `count`) plus checksum: bytes around each payload.
+pub const CHUNK_OVERHEAD: usize = 9;
+const MAGIC: [u8; 4] = *b"TDPM";
+const VERSION: u8 = 1;
+const KIND_POSITIONS: u8 = 1;
+const KIND_TRIANGLES: u8 = 2;
+const KIND_SPLITS: u8 = 3;
+
+/// What is wrong with a stream, or with the storage given to decode it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StreamError {
+    /// Not a tinydecimate progressive stream.
+    BadMagic,
+    /// A version this decoder does not read.
+    BadVersion(u8),
+    /// The header's or a chunk's checksum does not match (chunk `0` is the header).
+    Checksum {
+        /// 0 for the header, then chunks counted from 1.
+        chunk: u32,
+    },
+    /// A count in the header exceeds the decoder's storage.
+    Capacity {
+        /// Which storage (`"vertices"`, `"triangles"`, `"splits"`, `"chunk buffer"`).
+        what: &'static str,
+        /// Needed.
+        needed: usize,
+        /// Given.
+        available: usize,
+    },
+    /// The header's counts contradict each other.
+    BadHeader,
+    /// A chunk of the wrong kind or count at this point, or whose payload ends early.
+    BadChunk {
+        /// Chunks counted from 1.
+        chunk: u32,
+    },
+    /// A vertex split refers to a vertex that does not exist yet, or does not fit the kept
+    /// vertex's current fan.
+    BadSplit {
+        /// The split (its new vertex is `m₀ + split`).
+        split: usize,
+    },
+    /// Bytes after the last chunk.
+    TrailingData,
+    /// The stream ended before the full mesh ([`Decoder::finish`]).
+    Truncated,
+    /// The encoder's output buffer is too small.
+    OutputFull,
+}
+
+impl core::fmt::Display for StreamError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            StreamError::BadMagic => write!(f, "not a progressive mesh stream (bad magic)"),
+            StreamError::BadVersion(v) => write!(f, "stream version {v} is not supported"),
+            StreamError::Checksum { chunk: 0 } => write!(f, "header checksum mismatch"),
+            StreamError::Checksum { chunk } => write!(f, "chunk {chunk}: checksum mismatch"),
+            StreamError::Capacity {
+                what,
+                needed,
+                available,
+            } => write!(
+                f,
+                "{what}: stream needs {needed}, storage holds {available}"
+            ),
+            StreamError::BadHeader => write!(f, "header counts are inconsistent"),
+            StreamError::BadChunk { chunk } => write!(f, "chunk {chunk} is malformed"),
+            StreamError::BadSplit { split } => {
+                write!(f, "vertex split {split} does not fit the mesh")
+            }
+            StreamError::TrailingData => write!(f, "bytes after the end of the stream"),
+            StreamError::Truncated => write!(f, "stream ends before the full mesh"),
+            StreamError::OutputFull => write!(f, "output buffer too small"),
+        }
+    }
+}
+
+/// CRC-32 (IEEE 802.3, reflected), bit by bit: no table in flash.
+pub fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = (c >> 1) ^ (0xEDB8_8320 & (c & 1).wrapping_neg());
+        }
+    }
+    !c
+}
+
+/// Bits needed for a number below `n`.
+fn bits(n: usize) -> u32 {
+    if n <= 1 {
+        0
+    } else {
+        usize::BITS - (n - 1).leading_zeros()
+    }
+}
+
+/// The slot after / before `k` in winding order.
+fn next3(k: usize) -> usize {
+    match k {
+        0 => 1,
+        1 => 2,
+        _ => 0,
+    }
+}
+fn prev3(k: usize) -> usize {
+    match k {
+        1 => 0,
+        2 => 1,
+        _ => 2,
+    }
+}
+
+/// The stream's header.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Header {
+    /// Vertex numbers fit `u16` (2) or need `u32` (4).
+    pub index_width: u8,
+    /// Positions quantised to 16 bits per coordinate.
+    pub quantised: bool,
+    /// Vertices of the full mesh.
+    pub vertices: u32,
+    /// Vertices of the base mesh.
+    pub base_vertices: u32,
+    /// Triangles of the base mesh.
+    pub base_triangles: u32,
+    /// Triangles of the full mesh.
+    pub triangles: u32,
+    /// Largest chunk payload.
+    pub max_payload: u16,
+    /// Bounding box of the positions.
+    pub min: [f32; 3],
+    /// Bounding box of the positions.
+    pub max: [f32; 3],
+}
+
+impl Header {
+    fn write(&self, out: &mut [u8; HEADER]) {
+        out.fill(0);
+        out[0..4].copy_from_slice(&MAGIC);
+        out[4] = VERSION;
+        out[5] = self.index_width;
+        out[6] = self.quantised as u8;
+        out[8..12].copy_from_slice(&self.vertices.to_le_bytes());
+        out[12..16].copy_from_slice(&self.base_vertices.to_le_bytes());
+        out[16..20].copy_from_slice(&self.base_triangles.to_le_bytes());
+        out[20..24].copy_from_slice(&self.triangles.to_le_bytes());
+        out[24..26].copy_from_slice(&self.max_payload.to_le_bytes());
+        for a in 0..3 {
+            out[28 + 4 * a..32 + 4 * a].copy_from_slice(&self.min[a].to_le_bytes());
+            out[40 + 4 * a..44 + 4 * a].copy_from_slice(&self.max[a].to_le_bytes());
+        }
+        let c = crc32(&out[..52]);
+        out[52..56].copy_from_slice(&c.to_le_bytes());
+    }
+
+    fn read(b: &[u8; HEADER]) -> Result<Self, StreamError> {
+        if b[0..4] != MAGIC {
+            return Err(StreamError::BadMagic);
+        }
+        if b[4] != VERSION {
+            return Err(StreamError::BadVersion(b[4]));
+        }
+        let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+        if crc32(&b[..52]) != u32_at(52) {
+            return Err(StreamError::Checksum { chunk: 0 });
+        }
+        let f32_at = |o: usize| f32::from_bits(u32_at(o));
+        let h = Header {
+            index_width: b[5],
+            quantised: b[6] & 1 != 0,
+            vertices: u32_at(8),
+            base_vertices: u32_at(12),
+            base_triangles: u32_at(16),
+            triangles: u32_at(20),
+            max_payload: u16::from_le_bytes([b[24], b[25]]),
+            min: [f32_at(28), f32_at(32), f32_at(36)],
+            max: [f32_at(40), f32_at(44), f32_at(48)],
+        };
+        let ok = (h.index_width == 2 || h.index_width == 4)
+            && b[6] & !1 == 0
+            && h.base_vertices <= h.vertices
+            && h.base_triangles <= h.triangles
+            && h.max_payload >= 16
+            && h.min.iter().chain(h.max.iter()).all(|x| x.is_finite());
+        if ok {
+            Ok(h)
+        } else {
+            Err(StreamError::BadHeader)
+        }
+    }
+
+    /// Bytes of one position.
+    fn position_bits(&self) -> u32 {
+        if self.quantised {
+            48
+        } else {
+            96
+        }
+    }
+
+    fn quantise(&self, p: [f32; 3]) -> [u32; 3] {
+        let mut q = [0; 3];
+        for a in 0..3 {
+            let span = self.max[a] - self.min[a];
+            if span > 0.0 {
+                let x = (p[a] - self.min[a]) / span * 65535.0 + 0.5;
+                q[a] = if x >= 65535.0 {
+                    65535
+                } else if x > 0.0 {
+                    x as u32
+                } else {
+                    0
+                };
+            }
+        }
+        q
+    }
+
+    /// The position a decoder sees for quantised `q`.
+    fn dequantise(&self, q: [u32; 3]) -> [f32; 3] {
+        let mut p = [0.0; 3];
+        for a in 0..3 {
+            p[a] = self.min[a] + q[a] as f32 * ((self.max[a] - self.min[a]) / 65535.0);
+        }
+        p
+    }
+}
+
+/// Bit writer into a fixed buffer.
+struct BitWriter<'a> {
+    out: &'a mut [u8],
+    bit: usize,
+    full: bool,
+}
+
+impl BitWriter<'_> {
+    fn put(&mut self, v: u64, n: u32) {
+        for i in 0..n {
+            let byte = self.bit >> 3;
+            match self.out.get_mut(byte) {
+                Some(b) => {
+                    if self.bit & 7 == 0 {
+                        *b = 0;
+                    }
+                    *b |= (((v >> i) & 1) as u8) << (self.bit & 7);
+                }
+                None => self.full = true,
+            }
+            self.bit += 1;
+        }
+    }
+}
+
+/// Bit reader over a payload.
+struct BitReader<'a> {
+    data: &'a [u8],
+    bit: usize,
+}
+
+impl BitReader<'_> {
+    fn get(&mut self, n: u32) -> Option<u64> {
+        let mut v = 0u64;
+        for i in 0..n {
+            let b = *self.data.get(self.bit >> 3)?;
+            v |= (((b >> (self.bit & 7)) & 1) as u64) << (i & 63);
+            self.bit += 1;
+        }
+        Some(v)
+    }
+}
+
+/// One split's bits, as both ends derive them.
+fn put_position(w: &mut BitWriter<'_>, h: &Header, p: [f32; 3]) {
+    if h.quantised {
+        for q in h.quantise(p) {
+            w.put(q as u64, 16);
+        }
+    } else {
+        for x in p {
+            w.put(x.to_bits() as u64, 32);
+        }
+    }
+}
+
+fn get_position(r: &mut BitReader<'_>, h: &Header) -> Option<[f32; 3]> {
+    if h.quantised {
+        let q = [r.get(16)? as u32, r.get(16)? as u32, r.get(16)? as u32];
+        Some(h.dequantise(q))
+    } else {
+        let p = [
+            f32::from_bits(r.get(32)? as u32),
+            f32::from_bits(r.get(32)? as u32),
+            f32::from_bits(r.get(32)? as u32),
+        ];
+        Some(p)
+    }
+}
+
+/// Sizes of an encoded stream.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Encoded {
+    /// Bytes written in all.
+    pub bytes: usize,
+    /// Header, base positions and base triangles, chunk framing included.
+    pub base_bytes: usize,
+    /// Bits of connectivity in all vertex splits (everything but positions and framing).
+    pub split_connectivity_bits: u64,
+    /// Bits of positions in all vertex splits.
+    pub split_position_bits: u64,
+    /// Vertex splits.
+    pub splits: usize,
+}
+
+/// Writes `pm`'s progressive stream into `out` and returns its sizes. `positions` are the
+/// input's, `order` maps new vertex numbers to them (both as [`Progressive::from_log`] left
+/// them). `max_payload` (16..=65535) bounds each chunk. `pm` ends at full resolution.
+pub fn encode<I: Index>(
+    pm: &mut Progressive<'_, I>,
+    positions: &[[f32; 3]],
+    order: &[I],
+    quantised: bool,
+    max_payload: u16,
+    out: &mut [u8],
+) -> Result<Encoded, StreamError> {
+    let full_vertices = pm.base_vertices() + pm.levels();
+    let pos = |v: usize| -> [f32; 3] {
+        order
+            .get(v)
+            .and_then(|&o| positions.get(o.to_usize()))
+            .copied()
+            .unwrap_or([0.0; 3])
+    };
+    let mut h = Header {
+        index_width: if full_vertices <= u16::MAX as usize {
+            2
+        } else {
+            4
+        },
+        quantised,
+        vertices: full_vertices as u32,
+        base_vertices: pm.base_vertices() as u32,
+        base_triangles: pm.base_triangles() as u32,
+        triangles: pm.full_triangles() as u32,
+        max_payload: max_payload.max(16),
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+    };
+    for v in 0..full_vertices {
+        for (a, x) in pos(v).into_iter().enumerate() {
+            h.min[a] = h.min[a].min(x);
+            h.max[a] = h.max[a].max(x);
+        }
+    }
+    if full_vertices == 0 {
+        h.min = [0.0; 3];
+        h.max = [0.0; 3];
+    }
+    let mut head = [0u8; HEADER];
+    h.write(&mut head);
+    let mut e = Encoded::default();
+    let mut chunks = Chunks {
+        out,
+        at: 0,
+        start: 0,
+        kind: 0,
+        count: 0,
+        bits: 0,
+        max_bits: h.max_payload as usize * 8,
+    };
+    chunks.raw(&head)?;
+    pm.set_level(0);
+    // Base positions and triangles.
+    let mut rec = [0u8; 48];
+    for v in 0..pm.base_vertices() {
+        let mut w = BitWriter {
+            out: &mut rec,
+            bit: 0,
+            full: false,
+        };
+        put_position(&mut w, &h, pos(v));
+        let n = w.bit;
+        chunks.item(KIND_POSITIONS, &rec, n)?;
+    }
+    let vb = bits(pm.base_vertices());
+    for u in 0..pm.base_triangles() {
+        let tri = pm.triangles().get(u).copied().unwrap_or([I::ZERO; 3]);
+        let mut w = BitWriter {
+            out: &mut rec,
+            bit: 0,
+            full: false,
+        };
+        for x in tri {
+            w.put(x.to_usize() as u64, vb);
+        }
+        let n = w.bit;
+        chunks.item(KIND_TRIANGLES, &rec, n)?;
+    }
+    chunks.close()?;
+    e.base_bytes = chunks.at;
+    // Vertex splits, each from the state the decoder will have.
+    for j in 0..pm.levels() {
+        let t = pm.base_vertices() + j;
+        let Some(&sp) = pm.splits().get(j) else {
+            break;
+        };
+        let s = sp.kept.to_usize();
+        let lists = &pm.lists;
+        let len = lists.len(s);
+        let live = pm.live;
+        let mut w = BitWriter {
+            out: &mut rec,
+            bit: 0,
+            full: false,
+        };
+        w.put(s as u64, bits(t));
+        w.put(sp.restored.saturating_sub(1) as u64, 1);
+        w.put(sp.moved, len.min(64) as u32);
+        for u in live..live + sp.restored as usize {
+            let tri = lists
+                .tris
+                .get(u)
+                .map_or([0; 3], |x| x.map(|i| i.to_usize()));
+            let ks = tri.iter().position(|&x| x == s).unwrap_or(0);
+            let t_next = tri[next3(ks)] == t;
+            let wv = if t_next {
+                tri[prev3(ks)]
+            } else {
+                tri[next3(ks)]
+            };
+            w.put(ks as u64, 2);
+            w.put(t_next as u64, 1);
+            // The wing among s's triangles, else by number.
+            let mut found = None;
+            let mut c = lists.first(s);
+            let mut p = 0;
+            while c != usize::MAX && found.is_none() {
+                let ct = lists
+                    .tris
+                    .get(c)
+                    .map_or([0; 3], |x| x.map(|i| i.to_usize()));
+                if let Some(k) = ct.iter().position(|&x| x == s) {
+                    if ct[next3(k)] == wv {
+                        found = Some((p, 0));
+                    } else if ct[prev3(k)] == wv {
+                        found = Some((p, 1));
+                    }
+                }
+                c = lists.after(c, s);
+                p += 1;
+            }
+            match found {
+                Some((p, which)) => {
+                    w.put(0, 1);
+                    w.put(p as u64, bits(len));
+                    w.put(which, 1);
+                }
+                None => {
+                    w.put(1, 1);
+                    w.put(wv as u64, bits(t));
+                }
+            }
+        }
+        e.split_connectivity_bits += w.bit as u64;
+        put_position(&mut w, &h, pos(t));
+        e.split_position_bits += h.position_bits() as u64;
+        let n = w.bit;
+        chunks.item(KIND_SPLITS, &rec, n)?;
+        pm.refine(1);
+    }
+    chunks.close()?;
+    e.bytes = chunks.at;
+    e.splits = pm.levels();
+    Ok(e)
+}
+
+/// Chunk writer for [`encode`].
+struct Chunks<'a> {
+    out: &'a mut [u8],
+    at: usize,
+    start: usize,
+    kind: u8,
+    count: u16,
+    bits: usize,
+    max_bits: usize,
+}
+
+impl Chunks<'_> {
+    fn raw(&mut self, b: &[u8]) -> Result<(), StreamError> {
+        let dst = self
+            .out
+            .get_mut(self.at..self.at + b.len())
+            .ok_or(StreamError::OutputFull)?;
+        dst.copy_from_slice(b);
+        self.at += b.len();
+        Ok(())
+    }
+
+    /// Appends an item of `n` bits (in `rec`) to the open chunk of `kind`, opening one first
+    /// if needed.
+    fn item(&mut self, kind: u8, rec: &[u8], n: usize) -> Result<(), StreamError> {
+        if self.kind != kind || self.bits + n > self.max_bits || self.count == u16::MAX {
+            self.close()?;
+            self.kind = kind;
+            self.start = self.at;
+            self.raw(&[0, 0, kind, 0, 0])?;
+        }
+        let base = self.start + 5;
+        let payload = self.out.get_mut(base..).ok_or(StreamError::OutputFull)?;
+        let mut w = BitWriter {
+            out: payload,
+            bit: self.bits,
+            full: false,
+        };
+        let mut r = BitReader { data: rec, bit: 0 };
+        let mut left = n;
+        while left > 0 {
+            let k = left.min(32) as u32;
+            let v = r.get(k).unwrap_or(0);
+            w.put(v, k);
+            left -= k as usize;
+        }
+        if w.full {
+            return Err(StreamError::OutputFull);
+        }
+        self.bits = w.bit;
+        self.count += 1;
+        Ok(())
+    }
+
+    fn close(&mut self) -> Result<(), StreamError> {
+        if self.kind == 0 {
+            return Ok(());
+        }
+        let len = self.bits.div_ceil(8);
+        let end = self.start + 5 + len;
+        let chunk = self
+            .out
+            .get_mut(self.start..end)
+            .ok_or(StreamError::OutputFull)?;
+        chunk[0..2].copy_from_slice(&(len as u16).to_le_bytes());
+        chunk[3..5].copy_from_slice(&self.count.to_le_bytes());
+        let c = crc32(chunk);
+        self.at = end;
+        self.raw(&c.to_le_bytes())?;
+        self.kind = 0;
+        self.count = 0;
+        self.bits = 0;
+        Ok(())
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    Header,
+    Chunks,
+    Done,
+    Failed(StreamError),
+}
+
+/// Incremental decoder: feed it bytes in chunks of any size as they arrive ([`Decoder::push`]);
+/// after every complete, verified chunk [`Decoder::progressive`] holds a valid mesh one level
+/// finer, whose vertices are in [`Decoder::positions`].
+///
+/// Memory: the [`Storage`] of a [`Progressive`] for the full mesh, its positions (12 bytes per
+/// vertex) and a chunk buffer of the stream's largest chunk plus
+/// [`CHUNK_OVERHEAD`] bytes (at least [`HEADER`]).
+pub struct Decoder<'a, I: Index> {
+    pm: Progressive<'a, I>,
+    positions: &'a mut [[f32; 3]],
+    buf: &'a mut [u8],
+    have: usize,
+    phase: Phase,
+    header: Header,
+    chunk: u32,
+    /// Base positions received.
+    base_read: usize,
+}
+
+impl<'a, I: Index> Decoder<'a, I> {
+    /// A decoder over caller-provided storage.
+    pub fn new(storage: Storage<'a, I>, positions: &'a mut [[f32; 3]], buf: &'a mut [u8]) -> Self {
+        Decoder {
+            pm: Progressive::empty(storage),
+            positions,
+            buf,
+            have: 0,
+            phase: Phase::Header,
+            header: Header::default(),
+            chunk: 0,
+            base_read: 0,
+        }
+    }
+
+    /// The header, once read.
+    pub fn header(&self) -> Option<Header> {
+        (self.phase != Phase::Header).then_some(self.header)
+    }
+
+    /// The mesh so far (and the slider over it).
+    pub fn progressive(&mut self) -> &mut Progressive<'a, I> {
+        &mut self.pm
+    }
+
+    /// The mesh so far, read-only.
+    pub fn mesh(&self) -> &Progressive<'a, I> {
+        &self.pm
+    }
+
+    /// Positions received so far, in the stream's vertex numbers.
+    pub fn positions(&self) -> &[[f32; 3]] {
+        let n = if self.pm.levels() > 0 {
+            self.pm.base_vertices() + self.pm.levels()
+        } else {
+            self.base_read
+        };
+        self.positions.get(..n).unwrap_or(&[])
+    }
+
+    /// Whether the full mesh has arrived.
+    pub fn is_complete(&self) -> bool {
+        self.phase == Phase::Done
+    }
+
+    /// `Ok` once the full mesh has arrived; [`StreamError::Truncated`] before; the error that
+    /// stopped the decoder after one.
+    pub fn finish(&self) -> Result<(), StreamError> {
+        match self.phase {
+            Phase::Done => Ok(()),
+            Phase::Failed(e) => Err(e),
+            _ => Err(StreamError::Truncated),
+        }
+    }
+
+    /// Takes the next bytes of the stream. Each chunk is checked, then applied whole; on an
+    /// error the decoder stops for good and the mesh stays the last valid level.
+    pub fn push(&mut self, mut bytes: &[u8]) -> Result<(), StreamError> {
+        while !bytes.is_empty() {
+            match self.phase {
+                Phase::Failed(e) => return Err(e),
+                Phase::Done => return self.fail(StreamError::TrailingData),
+                Phase::Header | Phase::Chunks => {}
+            }
+            // How many bytes the current unit needs.
+            let need = if self.phase == Phase::Header {
+                HEADER
+            } else if self.have < 2 {
+                2
+            } else {
+                let len = self.buf.first().copied().unwrap_or(0) as usize
+                    | (self.buf.get(1).copied().unwrap_or(0) as usize) << 8;
+                if len > self.header.max_payload as usize {
+                    return self.fail(StreamError::BadChunk {
+                        chunk: self.chunk + 1,
+                    });
+                }
+                len + CHUNK_OVERHEAD
+            };
+            let take = (need - self.have).min(bytes.len());
+            let Some(dst) = self.buf.get_mut(self.have..self.have + take) else {
+                return self.fail(StreamError::Capacity {
+                    what: "chunk buffer",
+                    needed: need,
+                    available: self.buf.len(),
+                });
+            };
+            dst.copy_from_slice(&bytes[..take]);
+            bytes = &bytes[take..];
+            self.have += take;
+            if self.have < need || need == 2 {
+                continue;
+            }
+            self.have = 0;
+            let r = if self.phase == Phase::Header {
+                self.read_header()
+            } else {
+                self.chunk += 1;
+                self.read_chunk(need)
+            };
+            if let Err(e) = r {
+                return self.fail(e);
+            }
+        }
+        Ok(())
+    }
+
+    fn fail(&mut self, e: StreamError) -> Result<(), StreamError> {
+        self.phase = Phase::Failed(e);
+        Err(e)
+    }
+
+    fn read_header(&mut self) -> Result<(), StreamError> {
+        let mut b = [0u8; HEADER];
+        b.copy_from_slice(self.buf.get(..HEADER).ok_or(StreamError::Truncated)?);
+        let h = Header::read(&b)?;
+        let cap = |what, needed: usize, available: usize| {
+            if needed > available {
+                Err(StreamError::Capacity {
+                    what,
+                    needed,
+                    available,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        let nv = h.vertices as usize;
+        cap(
+            "vertices",
+            nv,
+            self.positions.len().min(self.pm.vertex_capacity()),
+        )?;
+        cap(
+            "triangles",
+            h.triangles as usize,
+            self.pm.triangle_capacity(),
+        )?;
+        cap(
+            "splits",
+            nv - h.base_vertices as usize,
+            self.pm.split_capacity(),
+        )?;
+        cap(
+            "chunk buffer",
+            h.max_payload as usize + CHUNK_OVERHEAD,
+            self.buf.len(),
+        )?;
+        self.pm.start(h.base_vertices as usize);
+        self.header = h;
+        self.phase = Phase::Chunks;
+        self.check_done();
+        Ok(())
+    }
+
+    fn check_done(&mut self) {
+        let h = &self.header;
+        if self.base_read == h.base_vertices as usize
+            && self.pm.base_triangles() == h.base_triangles as usize
+            && self.pm.base_vertices() + self.pm.levels() == h.vertices as usize
+        {
+            self.phase = Phase::Done;
+        }
+    }
+
+    fn read_chunk(&mut self, total: usize) -> Result<(), StreamError> {
+        // The buffer is lent out while the chunk's items are applied to the mesh.
+        let buf = core::mem::take(&mut self.buf);
+        let r = self.apply_chunk(buf, total);
+        self.buf = buf;
+        r
+    }
+
+    fn apply_chunk(&mut self, buf: &[u8], total: usize) -> Result<(), StreamError> {
+        let chunk = self.chunk;
+        let bad = StreamError::BadChunk { chunk };
+        let data = buf.get(..total).ok_or(bad)?;
+        let (body, sum) = data.split_at(total - 4);
+        if crc32(body) != u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]) {
+            return Err(StreamError::Checksum { chunk });
+        }
+        let kind = body[2];
+        let count = u16::from_le_bytes([body[3], body[4]]) as usize;
+        let h = self.header;
+        let base_v = h.base_vertices as usize;
+        let base_t = h.base_triangles as usize;
+        let mut r = BitReader {
+            data: &body[5..],
+            bit: 0,
+        };
+        match kind {
+            KIND_POSITIONS if self.base_read + count <= base_v => {
+                for _ in 0..count {
+                    let p = get_position(&mut r, &h).ok_or(bad)?;
+                    let slot = self.positions.get_mut(self.base_read).ok_or(bad)?;
+                    *slot = p;
+                    self.base_read += 1;
+                }
+            }
+            KIND_TRIANGLES
+                if self.base_read == base_v && self.pm.base_triangles() + count <= base_t =>
+            {
+                let vb = bits(base_v);
+                for _ in 0..count {
+                    let mut tri = [I::ZERO; 3];
+                    for x in tri.iter_mut() {
+                        let v = r.get(vb).ok_or(bad)? as usize;
+                        if v >= base_v {
+                            return Err(bad);
+                        }
+                        *x = I::narrow(v);
+                    }
+                    if !self.pm.push_base(tri) {
+                        return Err(bad);
+                    }
+                }
+            }
+            KIND_SPLITS
+                if self.base_read == base_v
+                    && self.pm.base_triangles() == base_t
+                    && self.pm.base_vertices() + self.pm.levels() + count
+                        <= h.vertices as usize =>
+            {
+                for _ in 0..count {
+                    self.read_split(&mut r, &h)?;
+                }
+            }
+            _ => return Err(bad),
+        }
+        self.check_done();
+        Ok(())
+    }
+
+    fn read_split(&mut self, r: &mut BitReader<'_>, h: &Header) -> Result<(), StreamError> {
+        let j = self.pm.levels();
+        let bad = StreamError::BadSplit { split: j };
+        let short = StreamError::BadChunk { chunk: self.chunk };
+        self.pm.refine(usize::MAX);
+        let t = self.pm.base_vertices() + j;
+        let s = r.get(bits(t)).ok_or(short)? as usize;
+        if s >= t {
+            return Err(bad);
+        }
+        let restored = r.get(1).ok_or(short)? as u8 + 1;
+        let lists = &self.pm.lists;
+        let len = lists.len(s);
+        if len > 64 {
+            return Err(bad);
+        }
+        let moved = r.get(len as u32).ok_or(short)?;
+        let mut tris = [[I::ZERO; 3]; 2];
+        for tri in tris.iter_mut().take(restored as usize) {
+            let ks = r.get(2).ok_or(short)? as usize;
+            let t_next = r.get(1).ok_or(short)? == 1;
+            if ks > 2 {
+                return Err(bad);
+            }
+            let w = if r.get(1).ok_or(short)? == 0 {
+                let p = r.get(bits(len)).ok_or(short)? as usize;
+                let which = r.get(1).ok_or(short)?;
+                let c = lists.nth(s, p);
+                let ct = lists
+                    .tris
+                    .get(c)
+                    .map(|x| x.map(|i| i.to_usize()))
+                    .ok_or(bad)?;
+                let k = ct.iter().position(|&x| x == s).ok_or(bad)?;
+                if which == 0 {
+                    ct[next3(k)]
+                } else {
+                    ct[prev3(k)]
+                }
+            } else {
+                r.get(bits(t)).ok_or(short)? as usize
+            };
+            if w >= t || w == s {
+                return Err(bad);
+            }
+            let mut v = [0usize; 3];
+            v[ks] = s;
+            let (kt, kw) = if t_next {
+                (next3(ks), prev3(ks))
+            } else {
+                (prev3(ks), next3(ks))
+            };
+            v[kt] = t;
+            v[kw] = w;
+            *tri = v.map(I::narrow);
+        }
+        let p = get_position(r, h).ok_or(short)?;
+        let slot = self.positions.get_mut(t).ok_or(bad)?;
+        let split = Split {
+            kept: I::narrow(s),
+            restored,
+            moved,
+        };
+        if !self.pm.push_split(split, &tris[..restored as usize]) {
+            return Err(bad);
+        }
+        *slot = p;
+        Ok(())
+    }
+}
