@@ -200,18 +200,6 @@ impl<'a, I: Index> Lists<'a, I> {
         n
     }
 
-    /// The `p`-th triangle of `v`'s list.
-    pub(crate) fn nth(&self, v: usize, p: usize) -> usize {
-        let mut t = self.first(v);
-        for _ in 0..p {
-            if t == NIL {
-                break;
-            }
-            t = self.after(t, v);
-        }
-        t
-    }
-
     /// Inserts `t` (which holds `v`) into `v`'s list at its sorted place.
     fn insert(&mut self, v: usize, t: usize) {
         let mut prev = NIL;

@@ -35,8 +35,10 @@
 //!   triangles − 1 (1 bit); the moved mask, one bit per triangle in `s`'s list (its length `L`
 //!   is known to the decoder, at most 64); per restored triangle: the slot of `s` (2 bits),
 //!   whether `t` follows `s` in winding order (1 bit), and the third vertex `w`: a 0 bit, then
-//!   `w`'s place among `s`'s triangles (`bits(L)`) and whether it follows `s` there (1 bit), or
-//!   a 1 bit and `w` itself (`bits(t)`); then `t`'s position.
+//!   the place, among the `S` triangles of `s` that stay with `s`, of the one across edge
+//!   `s-w` (`bits(S)`; `w` is the vertex that follows `s` there if `t` follows `s` in the
+//!   restored triangle, else the one before), or a 1 bit and `w` itself (`bits(t)`); then `t`'s
+//!   position.
 
 use crate::index::Index;
 use crate::progressive::{Progressive, Split, Storage};
@@ -156,6 +158,36 @@ fn prev3(k: usize) -> usize {
         2 => 1,
         _ => 2,
     }
+}
+
+/// The triangles of `s`'s list that stay with `s` in a split moving the `moved` ones.
+fn staying<'l, I: Index>(
+    lists: &'l crate::progressive::Lists<'_, I>,
+    s: usize,
+    moved: u64,
+) -> impl Iterator<Item = [usize; 3]> + 'l {
+    let mut c = lists.first(s);
+    let mut p = 0u32;
+    core::iter::from_fn(move || {
+        while c != usize::MAX && p as usize <= lists.tris.len() {
+            let here = c;
+            let pos = p;
+            c = lists.after(c, s);
+            p += 1;
+            if pos < 64 && moved & (1u64 << (pos & 63)) != 0 {
+                continue;
+            }
+            return lists.tris.get(here).map(|x| x.map(|i| i.to_usize()));
+        }
+        None
+    })
+}
+
+/// The wing `w` that triangle `ct` (holding `s`) offers a restored triangle whose `t` follows
+/// `s` (`t_next`) or precedes it: the neighbour across edge `s-w` runs it the other way.
+fn wing(ct: [usize; 3], s: usize, t_next: bool) -> Option<usize> {
+    let k = ct.iter().position(|&x| x == s)?;
+    Some(if t_next { ct[next3(k)] } else { ct[prev3(k)] })
 }
 
 /// The stream's header.
@@ -477,30 +509,21 @@ pub fn encode<I: Index>(
             };
             w.put(ks as u64, 2);
             w.put(t_next as u64, 1);
-            // The wing among s's triangles, else by number.
+            // The wing: the triangle across edge s-w stays with s and (in a consistently
+            // wound mesh) runs that edge the other way, so its place among the staying
+            // triangles names w; else w by number.
+            let stay = len - sp.moved.count_ones() as usize;
             let mut found = None;
-            let mut c = lists.first(s);
-            let mut p = 0;
-            while c != usize::MAX && found.is_none() {
-                let ct = lists
-                    .tris
-                    .get(c)
-                    .map_or([0; 3], |x| x.map(|i| i.to_usize()));
-                if let Some(k) = ct.iter().position(|&x| x == s) {
-                    if ct[next3(k)] == wv {
-                        found = Some((p, 0));
-                    } else if ct[prev3(k)] == wv {
-                        found = Some((p, 1));
-                    }
+            for (q, ct) in staying(lists, s, sp.moved).enumerate() {
+                if wing(ct, s, t_next) == Some(wv) {
+                    found = Some(q);
+                    break;
                 }
-                c = lists.after(c, s);
-                p += 1;
             }
             match found {
-                Some((p, which)) => {
+                Some(q) => {
                     w.put(0, 1);
-                    w.put(p as u64, bits(len));
-                    w.put(which, 1);
+                    w.put(q as u64, bits(stay));
                 }
                 None => {
                     w.put(1, 1);
@@ -882,20 +905,10 @@ impl<'a, I: Index> Decoder<'a, I> {
                 return Err(bad);
             }
             let w = if r.get(1).ok_or(short)? == 0 {
-                let p = r.get(bits(len)).ok_or(short)? as usize;
-                let which = r.get(1).ok_or(short)?;
-                let c = lists.nth(s, p);
-                let ct = lists
-                    .tris
-                    .get(c)
-                    .map(|x| x.map(|i| i.to_usize()))
-                    .ok_or(bad)?;
-                let k = ct.iter().position(|&x| x == s).ok_or(bad)?;
-                if which == 0 {
-                    ct[next3(k)]
-                } else {
-                    ct[prev3(k)]
-                }
+                let stay = len - (moved.count_ones() as usize).min(len);
+                let q = r.get(bits(stay)).ok_or(short)? as usize;
+                let ct = staying(lists, s, moved).nth(q).ok_or(bad)?;
+                wing(ct, s, t_next).ok_or(bad)?
             } else {
                 r.get(bits(t)).ok_or(short)? as usize
             };
