@@ -31,14 +31,22 @@
 //! width of a number below `n`.
 //! - **Position**: 3 × f32, or 3 × 16-bit `q` with `p = min + q·(max − min)/65535`.
 //! - **Base triangle**: 3 vertex numbers, `bits(m₀)` each.
-//! - **Vertex split** creating vertex `t = m₀ + j`: kept vertex `s` (`bits(t)`); restored
-//!   triangles − 1 (1 bit); the moved mask, one bit per triangle in `s`'s list (its length `L`
-//!   is known to the decoder, at most 64); per restored triangle: the slot of `s` (2 bits),
-//!   whether `t` follows `s` in winding order (1 bit), and the third vertex `w`: a 0 bit, then
-//!   the place, among the `S` triangles of `s` that stay with `s`, of the one across edge
-//!   `s-w` (`bits(S)`; `w` is the vertex that follows `s` there if `t` follows `s` in the
-//!   restored triangle, else the one before), or a 1 bit and `w` itself (`bits(t)`); then `t`'s
-//!   position.
+//! - **Vertex split** creating vertex `t = m₀ + j`: a mode bit, the kept vertex `s`
+//!   (`bits(t)`), restored triangles − 1 (1 bit); `L` is the length of `s`'s list, known to
+//!   the decoder (at most 64).
+//!   - *Mode 0, fan run* (seed 000 §2.2's `vsplit(s, l, r)`: the removed vertex's fan sits
+//!     between its two wings): the first restored triangle's slot of `s` (2 bits) and whether
+//!     `t` follows `s` in it (1 bit); the place among `s`'s triangles of the one across edge
+//!     `s-w₁` (`bits(L)`; it runs the edge the other way, which names `w₁`); the number `k` of
+//!     triangles that move (`bits(L + 1)`), found by walking around `s` from `s-w₁`; for a
+//!     second restored triangle, its slot of `s` (2 bits): its `w₂` is where the walk ended
+//!     and its winding is the first one's reversed.
+//!   - *Mode 1, explicit* (whatever mode 0 cannot say): the moved mask (`L` bits, one per
+//!     triangle of `s`'s list), then per restored triangle the slot of `s`, whether `t`
+//!     follows `s`, and `w`: a 0 bit and the place, among the triangles staying with `s`, of
+//!     the one across edge `s-w` (`bits(staying)`), or a 1 bit and `w` itself (`bits(t)`).
+//!
+//!   Then `t`'s position.
 
 use crate::index::Index;
 use crate::progressive::{Progressive, Split, Storage};
@@ -188,6 +196,57 @@ fn staying<'l, I: Index>(
 fn wing(ct: [usize; 3], s: usize, t_next: bool) -> Option<usize> {
     let k = ct.iter().position(|&x| x == s)?;
     Some(if t_next { ct[next3(k)] } else { ct[prev3(k)] })
+}
+
+/// Marks "no vertex".
+const NONE: usize = usize::MAX;
+
+/// Restored triangle with `s` in slot `ks`, `t` after it (`t_next`) or before it, and `w` in
+/// the third slot; `None` if that is not a triangle of three distinct vertices below `t + 1`.
+fn arrange<I: Index>(ks: usize, t_next: bool, s: usize, t: usize, w: usize) -> Option<[I; 3]> {
+    if ks > 2 || w >= t || w == s || s >= t {
+        return None;
+    }
+    let mut v = [0usize; 3];
+    let (kt, kw) = if t_next {
+        (next3(ks), prev3(ks))
+    } else {
+        (prev3(ks), next3(ks))
+    };
+    v[ks] = s;
+    v[kt] = t;
+    v[kw] = w;
+    Some(v.map(I::narrow))
+}
+
+/// The fan run (mode 0 of a split): the staying triangle at place `q1` of `s`'s list names the
+/// wing `w1`; the `k` moved triangles are the ones met walking around `s` from edge `s-w1`
+/// away from that triangle (a collapse put the removed vertex's fan there, between its two
+/// wings). Returns the moved mask, `w1`, and the far vertex of the last moved triangle (the
+/// second wing). `None` if the walk leaves the list or passes position 63.
+fn fan_run<I: Index>(
+    lists: &crate::progressive::Lists<'_, I>,
+    s: usize,
+    q1: usize,
+    t_next: bool,
+    k: usize,
+) -> Option<(u64, usize, Option<usize>)> {
+    let w1 = wing(staying(lists, s, 0).nth(q1)?, s, t_next)?;
+    let mut mask = 0u64;
+    let mut x = w1;
+    let mut last = None;
+    for _ in 0..k {
+        let (p, ct, ks) = staying(lists, s, 0).enumerate().find_map(|(p, ct)| {
+            let ks = ct.iter().position(|&v| v == s)?;
+            let near = if t_next { ct[prev3(ks)] } else { ct[next3(ks)] };
+            let free = p < 64 && mask & (1u64 << (p & 63)) == 0;
+            (near == x && free).then_some((p, ct, ks))
+        })?;
+        mask |= 1u64 << (p & 63);
+        x = if t_next { ct[next3(ks)] } else { ct[prev3(ks)] };
+        last = Some(x);
+    }
+    Some((mask, w1, last))
 }
 
 /// The stream's header.
@@ -492,14 +551,14 @@ pub fn encode<I: Index>(
             bit: 0,
             full: false,
         };
-        w.put(s as u64, bits(t));
-        w.put(sp.restored.saturating_sub(1) as u64, 1);
-        w.put(sp.moved, len.min(64) as u32);
-        for u in live..live + sp.restored as usize {
-            let tri = lists
+        let restored: [[usize; 3]; 2] = [live, live + 1].map(|u| {
+            lists
                 .tris
                 .get(u)
-                .map_or([0; 3], |x| x.map(|i| i.to_usize()));
+                .map_or([NONE; 3], |x| x.map(|i| i.to_usize()))
+        });
+        // (slot of s, whether t follows s, the wing) of each restored triangle.
+        let shape = |tri: [usize; 3]| {
             let ks = tri.iter().position(|&x| x == s).unwrap_or(0);
             let t_next = tri[next3(ks)] == t;
             let wv = if t_next {
@@ -507,27 +566,51 @@ pub fn encode<I: Index>(
             } else {
                 tri[next3(ks)]
             };
-            w.put(ks as u64, 2);
-            w.put(t_next as u64, 1);
-            // The wing: the triangle across edge s-w stays with s and (in a consistently
-            // wound mesh) runs that edge the other way, so its place among the staying
-            // triangles names w; else w by number.
-            let stay = len - sp.moved.count_ones() as usize;
-            let mut found = None;
-            for (q, ct) in staying(lists, s, sp.moved).enumerate() {
-                if wing(ct, s, t_next) == Some(wv) {
-                    found = Some(q);
-                    break;
-                }
+            (ks, t_next, wv)
+        };
+        let r = sp.restored as usize;
+        let (ks1, tn1, w1) = shape(restored[0]);
+        // Mode 0, the fan run, when it describes this split exactly.
+        let k = sp.moved.count_ones() as usize;
+        let q1 = staying(lists, s, 0).position(|ct| wing(ct, s, tn1) == Some(w1));
+        let run = q1.and_then(|q1| {
+            let (mask, w1r, last) = fan_run(lists, s, q1, tn1, k)?;
+            let (ks2, tn2, w2) = shape(restored[1]);
+            let second_ok = r == 1 || (tn2 != tn1 && last == Some(w2));
+            (mask == sp.moved && w1r == w1 && second_ok).then_some((q1, ks2))
+        });
+        w.put(run.is_none() as u64, 1);
+        w.put(s as u64, bits(t));
+        w.put(sp.restored.saturating_sub(1) as u64, 1);
+        if let Some((q1, ks2)) = run {
+            w.put(ks1 as u64, 2);
+            w.put(tn1 as u64, 1);
+            w.put(q1 as u64, bits(len));
+            w.put(k as u64, bits(len + 1));
+            if r == 2 {
+                w.put(ks2 as u64, 2);
             }
-            match found {
-                Some(q) => {
-                    w.put(0, 1);
-                    w.put(q as u64, bits(stay));
-                }
-                None => {
-                    w.put(1, 1);
-                    w.put(wv as u64, bits(t));
+        } else {
+            w.put(sp.moved, len.min(64) as u32);
+            for &tri in restored.iter().take(r) {
+                let (ks, t_next, wv) = shape(tri);
+                w.put(ks as u64, 2);
+                w.put(t_next as u64, 1);
+                // The wing: the triangle across edge s-w stays with s and (in a consistently
+                // wound mesh) runs that edge the other way, so its place among the staying
+                // triangles names w; else w by number.
+                let stay = len - sp.moved.count_ones() as usize;
+                let found =
+                    staying(lists, s, sp.moved).position(|ct| wing(ct, s, t_next) == Some(wv));
+                match found {
+                    Some(q) => {
+                        w.put(0, 1);
+                        w.put(q as u64, bits(stay));
+                    }
+                    None => {
+                        w.put(1, 1);
+                        w.put(wv as u64, bits(t));
+                    }
                 }
             }
         }
@@ -886,6 +969,7 @@ impl<'a, I: Index> Decoder<'a, I> {
         let short = StreamError::BadChunk { chunk: self.chunk };
         self.pm.refine(usize::MAX);
         let t = self.pm.base_vertices() + j;
+        let explicit = r.get(1).ok_or(short)? == 1;
         let s = r.get(bits(t)).ok_or(short)? as usize;
         if s >= t {
             return Err(bad);
@@ -896,35 +980,35 @@ impl<'a, I: Index> Decoder<'a, I> {
         if len > 64 {
             return Err(bad);
         }
-        let moved = r.get(len as u32).ok_or(short)?;
         let mut tris = [[I::ZERO; 3]; 2];
-        for tri in tris.iter_mut().take(restored as usize) {
-            let ks = r.get(2).ok_or(short)? as usize;
-            let t_next = r.get(1).ok_or(short)? == 1;
-            if ks > 2 {
-                return Err(bad);
+        let moved;
+        if !explicit {
+            let ks1 = r.get(2).ok_or(short)? as usize;
+            let tn1 = r.get(1).ok_or(short)? == 1;
+            let q1 = r.get(bits(len)).ok_or(short)? as usize;
+            let k = r.get(bits(len + 1)).ok_or(short)? as usize;
+            let (mask, w1, last) = fan_run(lists, s, q1, tn1, k).ok_or(bad)?;
+            moved = mask;
+            tris[0] = arrange(ks1, tn1, s, t, w1).ok_or(bad)?;
+            if restored == 2 {
+                let ks2 = r.get(2).ok_or(short)? as usize;
+                tris[1] = arrange(ks2, !tn1, s, t, last.ok_or(bad)?).ok_or(bad)?;
             }
-            let w = if r.get(1).ok_or(short)? == 0 {
-                let stay = len - (moved.count_ones() as usize).min(len);
-                let q = r.get(bits(stay)).ok_or(short)? as usize;
-                let ct = staying(lists, s, moved).nth(q).ok_or(bad)?;
-                wing(ct, s, t_next).ok_or(bad)?
-            } else {
-                r.get(bits(t)).ok_or(short)? as usize
-            };
-            if w >= t || w == s {
-                return Err(bad);
+        } else {
+            moved = r.get(len as u32).ok_or(short)?;
+            for tri in tris.iter_mut().take(restored as usize) {
+                let ks = r.get(2).ok_or(short)? as usize;
+                let t_next = r.get(1).ok_or(short)? == 1;
+                let w = if r.get(1).ok_or(short)? == 0 {
+                    let stay = len - (moved.count_ones() as usize).min(len);
+                    let q = r.get(bits(stay)).ok_or(short)? as usize;
+                    let ct = staying(lists, s, moved).nth(q).ok_or(bad)?;
+                    wing(ct, s, t_next).ok_or(bad)?
+                } else {
+                    r.get(bits(t)).ok_or(short)? as usize
+                };
+                *tri = arrange(ks, t_next, s, t, w).ok_or(bad)?;
             }
-            let mut v = [0usize; 3];
-            v[ks] = s;
-            let (kt, kw) = if t_next {
-                (next3(ks), prev3(ks))
-            } else {
-                (prev3(ks), next3(ks))
-            };
-            v[kt] = t;
-            v[kw] = w;
-            *tri = v.map(I::narrow);
         }
         let p = get_position(r, h).ok_or(short)?;
         let slot = self.positions.get_mut(t).ok_or(bad)?;

@@ -262,7 +262,7 @@ fn split_records_are_small() {
             "cow: {} splits, {:.2} B connectivity + {geo:.1} B position per split, base {} B, total {} B",
             e.splits, conn, e.base_bytes, e.bytes
         );
-        assert!(conn <= 4.0, "{conn} B of connectivity per split");
+        assert!(conn <= 3.2, "{conn} B of connectivity per split");
         assert_eq!(geo, if quantised { 6.0 } else { 12.0 });
     }
 }

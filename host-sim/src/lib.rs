@@ -8,6 +8,7 @@ pub mod demo;
 pub mod golden;
 pub mod io;
 pub mod metro;
+pub mod pm;
 pub mod qemu;
 pub mod render;
 pub mod simplify;

@@ -5,7 +5,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::{bench, check, demo, golden, metro, qemu, render, simplify};
+use host_sim::{bench, check, demo, golden, metro, pm, qemu, render, simplify};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
@@ -35,6 +35,9 @@ enum Command {
     /// First impression: one mesh simplified on the host and on an emulated Cortex-M4F, side by
     /// side, and whether the outputs are byte-identical.
     Demo(demo::Args),
+    /// Progressive meshes: encode a mesh as a base mesh plus vertex splits, decode a stream to
+    /// a level, measure and draw a ladder of levels.
+    Pm(pm::Args),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
         Command::Qemu(a) => qemu::run(a),
         Command::Golden(a) => golden::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Pm(a) => pm::run(a),
     };
     result.unwrap_or_else(|e| {
         eprintln!("error: {e:#}");

@@ -19,7 +19,7 @@ pub const MAX_TRIANGLES: usize = 524_288;
 pub type HostWorkspace = Workspace<u32, MAX_VERTICES, MAX_TRIANGLES>;
 
 /// One big workspace in `.bss` (about 12 MB: too large for a thread's stack).
-static WS: Mutex<HostWorkspace> = Mutex::new(Workspace::new());
+pub static WS: Mutex<HostWorkspace> = Mutex::new(Workspace::new());
 
 /// Bytes of `tinydecimate::Workspace` per vertex and per triangle for link type `L`, read
 /// off the library's own `BYTES` (differences, so no fixed part or padding leaks in).
