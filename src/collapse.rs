@@ -180,7 +180,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     }
 
     /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
-    /// vertex numbers: the history that [`progressive::Layout`](crate::progressive::Layout)
+    /// vertex numbers: the history that [`Progressive::from_log`](crate::Progressive::from_log)
     /// turns into vertex splits (call it before the first step to have the whole history).
     /// When `log` is full the run stops with [`Stop::LogFull`] before the next collapse, so
     /// the log always holds every collapse made and the mesh stays valid.

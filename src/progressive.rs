@@ -406,7 +406,9 @@ impl<'a, I: Index> Progressive<'a, I> {
         ) else {
             return Err(ProgressiveError::BadLog { entry: 0 });
         };
-        tris.copy_from_slice(input);
+        for (d, &x) in tris.iter_mut().zip(input) {
+            *d = x;
+        }
         head.fill(I::NIL);
         // rank[u]: NIL while live, the collapse that removed it, or DROPPED.
         let dropped = I::narrow(I::COUNT - 1);
@@ -517,7 +519,9 @@ impl<'a, I: Index> Progressive<'a, I> {
         // The full mesh is the input itself (the replay left each removed triangle as it was
         // when removed): permute the input in place along the cycles of `dest`.
         let Lists { tris, next, head } = lists;
-        tris.copy_from_slice(input);
+        for (d, &x) in tris.iter_mut().zip(input) {
+            *d = x;
+        }
         for i in 0..nt {
             let mut guard = 0;
             while let Some(&j) = rank.get(i) {
@@ -525,8 +529,10 @@ impl<'a, I: Index> Progressive<'a, I> {
                 if j == i || j >= nt || guard > nt {
                     break;
                 }
-                tris.swap(i, j);
-                rank.swap(i, j);
+                if i < tris.len() && j < tris.len() && i < rank.len() && j < rank.len() {
+                    tris.swap(i, j);
+                    rank.swap(i, j);
+                }
                 guard += 1;
             }
         }
@@ -684,8 +690,8 @@ impl<'a, I: Index> Progressive<'a, I> {
         } = storage;
         heads.fill(I::NIL);
         let n = triangles.len().min(links.len()).min(I::COUNT);
-        let (tris, _) = triangles.split_at_mut(n);
-        let (next, _) = links.split_at_mut(n);
+        let tris = triangles.get_mut(..n).unwrap_or_default();
+        let next = links.get_mut(..n).unwrap_or_default();
         Progressive {
             lists: Lists::new(tris, next, heads),
             splits,

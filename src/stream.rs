@@ -152,7 +152,8 @@ fn bits(n: usize) -> u32 {
     }
 }
 
-/// The slot after / before `k` in winding order.
+/// The slot after / before `k` in winding order (always below 3, so indexing needs no check).
+#[inline(always)]
 fn next3(k: usize) -> usize {
     match k {
         0 => 1,
@@ -160,6 +161,7 @@ fn next3(k: usize) -> usize {
         _ => 0,
     }
 }
+#[inline(always)]
 fn prev3(k: usize) -> usize {
     match k {
         1 => 0,
@@ -207,15 +209,23 @@ fn arrange<I: Index>(ks: usize, t_next: bool, s: usize, t: usize, w: usize) -> O
     if ks > 2 || w >= t || w == s || s >= t {
         return None;
     }
-    let mut v = [0usize; 3];
     let (kt, kw) = if t_next {
         (next3(ks), prev3(ks))
     } else {
         (prev3(ks), next3(ks))
     };
-    v[ks] = s;
-    v[kt] = t;
-    v[kw] = w;
+    let mut v = [0usize; 3];
+    for (k, x) in v.iter_mut().enumerate() {
+        *x = if k == ks {
+            s
+        } else if k == kt {
+            t
+        } else if k == kw {
+            w
+        } else {
+            0
+        };
+    }
     Some(v.map(I::narrow))
 }
 
@@ -275,21 +285,28 @@ pub struct Header {
 impl Header {
     fn write(&self, out: &mut [u8; HEADER]) {
         out.fill(0);
-        out[0..4].copy_from_slice(&MAGIC);
-        out[4] = VERSION;
-        out[5] = self.index_width;
-        out[6] = self.quantised as u8;
-        out[8..12].copy_from_slice(&self.vertices.to_le_bytes());
-        out[12..16].copy_from_slice(&self.base_vertices.to_le_bytes());
-        out[16..20].copy_from_slice(&self.base_triangles.to_le_bytes());
-        out[20..24].copy_from_slice(&self.triangles.to_le_bytes());
-        out[24..26].copy_from_slice(&self.max_payload.to_le_bytes());
-        for a in 0..3 {
-            out[28 + 4 * a..32 + 4 * a].copy_from_slice(&self.min[a].to_le_bytes());
-            out[40 + 4 * a..44 + 4 * a].copy_from_slice(&self.max[a].to_le_bytes());
+        let mut put = |o: usize, bytes: &[u8]| {
+            for (k, &x) in bytes.iter().enumerate() {
+                if let Some(d) = out.get_mut(o + k) {
+                    *d = x;
+                }
+            }
+        };
+        put(0, &MAGIC);
+        put(4, &[VERSION, self.index_width, self.quantised as u8]);
+        put(8, &self.vertices.to_le_bytes());
+        put(12, &self.base_vertices.to_le_bytes());
+        put(16, &self.base_triangles.to_le_bytes());
+        put(20, &self.triangles.to_le_bytes());
+        put(24, &self.max_payload.to_le_bytes());
+        for (a, (lo, hi)) in self.min.iter().zip(&self.max).enumerate() {
+            put(28 + 4 * a, &lo.to_le_bytes());
+            put(40 + 4 * a, &hi.to_le_bytes());
         }
-        let c = crc32(&out[..52]);
-        out[52..56].copy_from_slice(&c.to_le_bytes());
+        let c = crc32(out.get(..52).unwrap_or(&[]));
+        for (d, x) in out.iter_mut().skip(52).zip(c.to_le_bytes()) {
+            *d = x;
+        }
     }
 
     fn read(b: &[u8; HEADER]) -> Result<Self, StreamError> {
@@ -299,8 +316,14 @@ impl Header {
         if b[4] != VERSION {
             return Err(StreamError::BadVersion(b[4]));
         }
-        let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
-        if crc32(&b[..52]) != u32_at(52) {
+        let u32_at = |o: usize| {
+            let mut w = [0u8; 4];
+            for (k, d) in w.iter_mut().enumerate() {
+                *d = b.get(o + k).copied().unwrap_or(0);
+            }
+            u32::from_le_bytes(w)
+        };
+        if crc32(b.get(..52).unwrap_or(&[])) != u32_at(52) {
             return Err(StreamError::Checksum { chunk: 0 });
         }
         let f32_at = |o: usize| f32::from_bits(u32_at(o));
@@ -339,11 +362,11 @@ impl Header {
 
     fn quantise(&self, p: [f32; 3]) -> [u32; 3] {
         let mut q = [0; 3];
-        for a in 0..3 {
-            let span = self.max[a] - self.min[a];
+        for (((q, &x), &lo), &hi) in q.iter_mut().zip(&p).zip(&self.min).zip(&self.max) {
+            let span = hi - lo;
             if span > 0.0 {
-                let x = (p[a] - self.min[a]) / span * 65535.0 + 0.5;
-                q[a] = if x >= 65535.0 {
+                let x = (x - lo) / span * 65535.0 + 0.5;
+                *q = if x >= 65535.0 {
                     65535
                 } else if x > 0.0 {
                     x as u32
@@ -358,8 +381,8 @@ impl Header {
     /// The position a decoder sees for quantised `q`.
     fn dequantise(&self, q: [u32; 3]) -> [f32; 3] {
         let mut p = [0.0; 3];
-        for a in 0..3 {
-            p[a] = self.min[a] + q[a] as f32 * ((self.max[a] - self.min[a]) / 65535.0);
+        for (((p, &q), &lo), &hi) in p.iter_mut().zip(&q).zip(&self.min).zip(&self.max) {
+            *p = lo + q as f32 * ((hi - lo) / 65535.0);
         }
         p
     }
@@ -485,9 +508,9 @@ pub fn encode<I: Index>(
         max: [f32::NEG_INFINITY; 3],
     };
     for v in 0..full_vertices {
-        for (a, x) in pos(v).into_iter().enumerate() {
-            h.min[a] = h.min[a].min(x);
-            h.max[a] = h.max[a].max(x);
+        for ((lo, hi), x) in h.min.iter_mut().zip(h.max.iter_mut()).zip(pos(v)) {
+            *lo = lo.min(x);
+            *hi = hi.max(x);
         }
     }
     if full_vertices == 0 {
@@ -640,11 +663,13 @@ struct Chunks<'a> {
 
 impl Chunks<'_> {
     fn raw(&mut self, b: &[u8]) -> Result<(), StreamError> {
-        let dst = self
-            .out
-            .get_mut(self.at..self.at + b.len())
-            .ok_or(StreamError::OutputFull)?;
-        dst.copy_from_slice(b);
+        let dst = self.out.get_mut(self.at..).ok_or(StreamError::OutputFull)?;
+        if dst.len() < b.len() {
+            return Err(StreamError::OutputFull);
+        }
+        for (d, &x) in dst.iter_mut().zip(b) {
+            *d = x;
+        }
         self.at += b.len();
         Ok(())
     }
@@ -691,8 +716,13 @@ impl Chunks<'_> {
             .out
             .get_mut(self.start..end)
             .ok_or(StreamError::OutputFull)?;
-        chunk[0..2].copy_from_slice(&(len as u16).to_le_bytes());
-        chunk[3..5].copy_from_slice(&self.count.to_le_bytes());
+        let [l0, l1] = (len as u16).to_le_bytes();
+        let [c0, c1] = self.count.to_le_bytes();
+        for (k, v) in [(0, l0), (1, l1), (3, c0), (4, c1)] {
+            if let Some(x) = chunk.get_mut(k) {
+                *x = v;
+            }
+        }
         let c = crc32(chunk);
         self.at = end;
         self.raw(&c.to_le_bytes())?;
@@ -817,8 +847,10 @@ impl<'a, I: Index> Decoder<'a, I> {
                     available: self.buf.len(),
                 });
             };
-            dst.copy_from_slice(&bytes[..take]);
-            bytes = &bytes[take..];
+            for (d, &x) in dst.iter_mut().zip(bytes) {
+                *d = x;
+            }
+            bytes = bytes.get(take..).unwrap_or(&[]);
             self.have += take;
             if self.have < need || need == 2 {
                 continue;
@@ -844,7 +876,9 @@ impl<'a, I: Index> Decoder<'a, I> {
 
     fn read_header(&mut self) -> Result<(), StreamError> {
         let mut b = [0u8; HEADER];
-        b.copy_from_slice(self.buf.get(..HEADER).ok_or(StreamError::Truncated)?);
+        for (d, &x) in b.iter_mut().zip(self.buf.iter()) {
+            *d = x;
+        }
         let h = Header::read(&b)?;
         let cap = |what, needed: usize, available: usize| {
             if needed > available {
@@ -907,17 +941,24 @@ impl<'a, I: Index> Decoder<'a, I> {
         let chunk = self.chunk;
         let bad = StreamError::BadChunk { chunk };
         let data = buf.get(..total).ok_or(bad)?;
-        let (body, sum) = data.split_at(total - 4);
-        if crc32(body) != u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]) {
+        let (Some(body), Some(&[s0, s1, s2, s3])) = (
+            data.get(..total.saturating_sub(4)),
+            data.get(total.saturating_sub(4)..),
+        ) else {
+            return Err(bad);
+        };
+        if crc32(body) != u32::from_le_bytes([s0, s1, s2, s3]) {
             return Err(StreamError::Checksum { chunk });
         }
-        let kind = body[2];
-        let count = u16::from_le_bytes([body[3], body[4]]) as usize;
+        let Some(&[_, _, kind, c0, c1]) = body.get(..5) else {
+            return Err(bad);
+        };
+        let count = u16::from_le_bytes([c0, c1]) as usize;
         let h = self.header;
         let base_v = h.base_vertices as usize;
         let base_t = h.base_triangles as usize;
         let mut r = BitReader {
-            data: &body[5..],
+            data: body.get(5..).unwrap_or(&[]),
             bit: 0,
         };
         match kind {
@@ -1017,7 +1058,10 @@ impl<'a, I: Index> Decoder<'a, I> {
             restored,
             moved,
         };
-        if !self.pm.push_split(split, &tris[..restored as usize]) {
+        if !self
+            .pm
+            .push_split(split, tris.get(..restored as usize).unwrap_or(&[]))
+        {
             return Err(bad);
         }
         *slot = p;

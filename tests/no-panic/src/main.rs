@@ -15,8 +15,11 @@ use core::hint::black_box;
 
 use cortex_m_rt::entry;
 use tinydecimate::cost::{Builtin, Cost, Move, NormalVariation, Quadric};
+use tinydecimate::progressive::{Split, Storage};
+use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, Error, FeatureMode, Index, Report, Schedule, Simplifier, Workspace,
+    Config, CostKind, Error, FeatureMode, Index, Progressive, Report, Schedule, Simplifier,
+    Workspace,
 };
 
 #[panic_handler]
@@ -110,7 +113,7 @@ impl Write for Sink {
     }
 }
 
-fn display(e: &Error) {
+fn display(e: &dyn core::fmt::Display) {
     let mut sink = Sink {
         buf: [0; 160],
         len: 0,
@@ -220,6 +223,109 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     black_box((I::NIL, I::COUNT, L::NIL, L::COUNT));
 }
 
+/// The progressive-mesh entry points: a logged simplification, the splits built from it,
+/// the slider, the stream encoder and the incremental decoder on opaque bytes.
+fn progressive<I: Index, const V: usize, const T: usize>() {
+    let mut ws = black_box(Workspace::<I, V, T>::new());
+    let positions: [[f32; 3]; V] = black_box([[0.0; 3]; V]);
+    let input_tris: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let mut tris = input_tris;
+    let mut log: [[I; 2]; V] = black_box([[I::ZERO; 2]; V]);
+    let (np, nt, nl) = (input(3) as usize, input(4) as usize, input(5) as usize);
+    let (Some(p), Some(t), Some(l), Some(orig)) = (
+        positions.get(..np),
+        tris.get_mut(..nt),
+        log.get_mut(..nl),
+        input_tris.get(..nt),
+    ) else {
+        return;
+    };
+    let config = opaque_config();
+    let logged = match ws.start(p, t, &config) {
+        Ok(s) => {
+            let mut s = s.record_into(l);
+            while !s.step(input(0)) {
+                if input(1) == 0 {
+                    break;
+                }
+            }
+            let n = s.records().len();
+            use_report(&s.finish());
+            n
+        }
+        Err(e) => {
+            display(&e);
+            0
+        }
+    };
+    let mut st_tris = [[I::ZERO; 3]; T];
+    let mut links = [[I::ZERO; 3]; T];
+    let mut heads = [I::ZERO; V];
+    let mut splits = [Split::<I>::EMPTY; V];
+    let mut order = [I::ZERO; V];
+    let mut scratch = [I::ZERO; T];
+    let storage = Storage {
+        triangles: &mut st_tris,
+        links: &mut links,
+        heads: &mut heads,
+        splits: &mut splits,
+    };
+    let used = log.get(..logged).unwrap_or(&[]);
+    let mut out = [0u8; 512];
+    match Progressive::from_log(orig, np, used, storage, &mut order, &mut scratch) {
+        Ok(mut pm) => {
+            black_box(pm.refine(input(6) as usize));
+            black_box(pm.coarsen(input(7) as usize));
+            pm.set_level(input(8) as usize);
+            black_box((pm.triangles(), pm.vertices(), pm.level(), pm.levels()));
+            black_box((pm.base_triangles(), pm.base_vertices(), pm.full_triangles()));
+            black_box(pm.splits());
+            let q = input(9) & 1 == 0;
+            match stream::encode(&mut pm, p, &order, q, input(10) as u16, &mut out) {
+                Ok(e) => {
+                    black_box(e);
+                }
+                Err(e) => display(&e),
+            }
+        }
+        Err(e) => display(&e),
+    }
+    // The decoder on opaque bytes, fed in opaque pieces.
+    let mut d_tris = [[I::ZERO; 3]; T];
+    let mut d_links = [[I::ZERO; 3]; T];
+    let mut d_heads = [I::ZERO; V];
+    let mut d_splits = [Split::<I>::EMPTY; V];
+    let mut d_pos = [[0f32; 3]; V];
+    let mut buf = [0u8; 300];
+    let mut d = Decoder::new(
+        Storage {
+            triangles: &mut d_tris,
+            links: &mut d_links,
+            heads: &mut d_heads,
+            splits: &mut d_splits,
+        },
+        &mut d_pos,
+        &mut buf,
+    );
+    let bytes = black_box(out);
+    let piece = input(11) as usize;
+    let mut at = 0;
+    while at < bytes.len() {
+        let end = at.saturating_add(piece).clamp(at + 1, bytes.len());
+        if let Err(e) = d.push(bytes.get(at..end).unwrap_or(&[])) {
+            display(&e);
+        }
+        at = end;
+    }
+    if let Err(e) = d.finish() {
+        display(&e);
+    }
+    black_box((d.header(), d.is_complete(), d.positions()));
+    d.progressive().set_level(input(12) as usize);
+    black_box(d.mesh().triangles());
+    black_box(stream::crc32(&bytes));
+}
+
 #[cfg(feature = "defmt")]
 mod log {
     /// A logger that drops everything (defmt needs one to link).
@@ -245,6 +351,8 @@ fn main() -> ! {
     run::<u32, u32, 96, 160>();
     run::<u16, u32, 96, 160>();
     run::<u32, u16, 96, 160>();
+    progressive::<u16, 48, 80>();
+    progressive::<u32, 48, 80>();
     loop {
         black_box(());
     }
