@@ -3,8 +3,9 @@
 #   1. library and harness tests on the host (property tests, real meshes, bad input, ...);
 #   2. golden outputs on the host, with both math backends (libm, micromath);
 #   3. the same golden files under QEMU on five Cortex-M cores, both backends: the same bytes
-#      on every core and on the host;
-#   4. the link-time proof that no panic path is left in the library.
+#      on every core and on the host.
+# The link-time proof that no panic path is left in the library (tests/no-panic/check.sh), the
+# fuzz smoke run and Miri are not run here: CI runs them after this script (see .ci/run).
 # It installs the rustup targets it needs; QEMU comes from `apt-get install qemu-system-arm`.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,6 +1,7 @@
 //! Metro-style surface distance between two meshes (Cignoni, Rocchini, Scopigno, "Metro:
 //! measuring error on simplified surfaces", 1998; the error definitions are quoted in seed 001
-//! §4: `E_max = max q(v, S2)` and `E_mean = ∫ q(v, S2) ds / |S1|`).
+//! §4, Zhu, Wang and Meng, mesh simplification with control-point error control, 2007:
+//! `E_max = max q(v, S2)` and `E_mean = ∫ q(v, S2) ds / |S1|`).
 //!
 //! For each direction (a→b, then b→a) the source mesh is sampled and each sample's exact
 //! distance to the other mesh's surface is computed (closest point on a triangle, f64, found

@@ -1,0 +1,115 @@
+//! The words of README.md, the scripts and the sources: citations and figures that were wrong
+//! once (issue 11, items 11 and 12) must not come back.
+
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn read(rel: &str) -> String {
+    std::fs::read_to_string(root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// Every text file the citations and figures live in: README, docs, scripts and all `.rs`
+/// files of the library, the tests and host-sim (firmware included).
+fn texts() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut stack: Vec<PathBuf> = [
+        "src",
+        "tests",
+        "host-sim/src",
+        "host-sim/firmware/src",
+        "scripts",
+        "docs",
+    ]
+    .iter()
+    .map(|d| root().join(d))
+    .collect();
+    while let Some(d) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("rs" | "md" | "sh")
+            ) {
+                if let Ok(s) = std::fs::read_to_string(&p) {
+                    out.push((p.display().to_string(), s));
+                }
+            }
+        }
+    }
+    out.push(("README.md".into(), read("README.md")));
+    out
+}
+
+/// Item 11: seed 000 is Cheng, Pan and Shi (not Hoppe), seed 001 is Zhu, Wang and Meng (not
+/// Garland-Heckbert); the link condition is seed 000 §3.2(1).
+#[test]
+fn seed_citations() {
+    let this = file!();
+    for (name, text) in texts() {
+        if name.ends_with(this.rsplit('/').next().unwrap()) {
+            continue;
+        }
+        for bad in [
+            "Hoppe",
+            "Garland-Heckbert",
+            "Garland and Heckbert",
+            "§3.1-3.3",
+        ] {
+            assert!(!text.contains(bad), "{name} still says {bad:?}");
+        }
+        for line in text.lines() {
+            if line.contains("§3.1") {
+                assert!(
+                    line.contains("irregular") || line.contains("(§3.1)"),
+                    "{name}: §3.1 of seed 000 is the vertex classification: {line}"
+                );
+            }
+        }
+    }
+    let legality = read("src/legality.rs");
+    let link = legality
+        .lines()
+        .find(|l| l.starts_with("//! | `Link`"))
+        .unwrap();
+    assert!(link.contains("seed 000 §3.2(1)"), "{link}");
+    let readme = read("README.md");
+    assert!(readme.contains("Cheng, Pan and Shi"));
+    assert!(readme.contains("§3.2(1)"));
+    assert!(read("host-sim/src/metro.rs").contains("Zhu, Wang and Meng"));
+}
+
+/// Item 12: stale or overstated lines.
+#[test]
+fn stale_lines() {
+    let test_sh = read("scripts/test.sh");
+    let header: String = test_sh
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(!header.contains("4. the link-time proof"), "{header}");
+    assert!(
+        !test_sh.contains("no-panic/check.sh\n"),
+        "test.sh does not run the proof"
+    );
+    assert!(!read("host-sim/firmware/src/board.rs").contains("21 844"));
+    for (name, text) in texts() {
+        assert!(
+            !text.contains("normal_of"),
+            "{name} mentions a Mesh::normal_of"
+        );
+    }
+    let readme = read("README.md");
+    assert!(!readme.contains("feature is never removed."));
+    assert!(readme.contains("never removed while it is one"));
+    let fuzz_row = readme.lines().find(|l| l.contains("6 714 088")).unwrap();
+    assert!(fuzz_row.contains("interrupted"), "{fuzz_row}");
+}
