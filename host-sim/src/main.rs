@@ -1,6 +1,8 @@
 //! `host-sim`: command-line front end of the harness. Each subcommand's arguments and code live
 //! in its module (`Args` + `run`); this file only dispatches. Exit codes: 0 success, 1 the
 //! result is not a valid simplification (`check`, `simplify`), 2 error (bad file, bad input).
+//! A closed standard output (`host-sim check A B --json | head -1`) ends a command quietly with
+//! exit code 0: nothing is printed with `println!`, which would panic (see `host_sim::out!`).
 
 use std::process::ExitCode;
 
@@ -50,6 +52,14 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(a),
     };
     result.unwrap_or_else(|e| {
+        // A reader that closed the pipe early wants no more: end quietly, as `out!` does.
+        if let Some(io) = e
+            .chain()
+            .find_map(|c| c.downcast_ref::<std::io::Error>())
+            .filter(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        {
+            return ExitCode::from(host_sim::exit_code_for_io(io) as u8);
+        }
         eprintln!("error: {e:#}");
         ExitCode::from(2)
     })

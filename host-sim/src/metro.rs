@@ -608,8 +608,8 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     if !(args.samples_per_triangle.is_finite() && args.samples_per_triangle > 0.0) {
         anyhow::bail!("--samples-per-triangle must be a positive number");
     }
-    let a = crate::io::load(&args.original)?;
-    let b = crate::io::load(&args.simplified)?;
+    let a = crate::io::load_noting(&args.original)?;
+    let b = crate::io::load_noting(&args.simplified)?;
     let opts = MetroOptions {
         samples_per_triangle: args.samples_per_triangle,
         seed: args.seed,
@@ -618,15 +618,15 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     let start = std::time::Instant::now();
     let r = metro(&a, &b, &opts);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&r)?);
     } else {
-        println!(
+        crate::outln!(
             "metro {} vs {}:",
             args.original.display(),
             args.simplified.display()
         );
-        println!("{r}");
-        println!(
+        crate::outln!("{r}");
+        crate::outln!(
             "  time                     {:.2} s",
             start.elapsed().as_secs_f64()
         );

@@ -643,7 +643,7 @@ pub fn check(
                 (Ok((None, run)), _) => Verdict::Failed(format!("no result: {}", run.describe())),
                 (Ok((Some(o), run)), Some(g)) => {
                     if verbose {
-                        println!("{} / {}: {}", b.name, case.name, run.describe());
+                        crate::outln!("{} / {}: {}", b.name, case.name, run.describe());
                     }
                     golden::judge(case, backend, g, &o)?
                 }
@@ -665,20 +665,20 @@ pub fn check(
         Expected::Golden(dir) => format!("golden files {}/{backend}", dir.display()),
         Expected::Host => format!("the library on the host ({backend})"),
     };
-    println!("\ncases x boards, compared with {what}:\n");
+    crate::outln!("\ncases x boards, compared with {what}:\n");
     let name_w = cases.iter().map(|c| c.name.len()).max().unwrap_or(4).max(4);
     let col_w: Vec<usize> = columns.iter().map(|(n, _)| n.len().max(9)).collect();
     let mut line = format!("{:<name_w$}", "case");
     for ((n, _), w) in columns.iter().zip(&col_w) {
         line.push_str(&format!("  {n:<w$}"));
     }
-    println!("{}", line.trim_end());
+    crate::outln!("{}", line.trim_end());
     for (i, case) in cases.iter().enumerate() {
         let mut line = format!("{:<name_w$}", case.name);
         for ((_, col), w) in columns.iter().zip(&col_w) {
             line.push_str(&format!("  {:<w$}", col[i].cell()));
         }
-        println!("{}", line.trim_end());
+        crate::outln!("{}", line.trim_end());
     }
     let (mut same, mut skipped, mut failed) = (0, 0, 0);
     let mut details = Vec::new();
@@ -709,11 +709,11 @@ pub fn check(
             }
         }
     }
-    println!();
+    crate::outln!();
     for d in &details {
-        println!("{d}");
+        crate::outln!("{d}");
     }
-    println!(
+    crate::outln!(
         "{backend}: {same} identical, {skipped} skipped (too big for the board), {failed} DIFF or FAILED"
     );
     Ok(failed)
@@ -1094,11 +1094,14 @@ fn delta(a: u64, b: u64) -> i64 {
 pub fn print_measurement(m: &Measurement) {
     let b = m.board;
     let (s, w) = (&m.sizes, &m.sizes_without);
-    println!(
+    crate::outln!(
         "\n== {} ({}, {}), {} backend",
-        b.name, b.core, b.target, m.backend
+        b.name,
+        b.core,
+        b.target,
+        m.backend
     );
-    println!(
+    crate::outln!(
         "firmware:      flash {:>8} B (text {}, rodata {}, .data image {}), static RAM {:>8} B of {} KB, stack {} B",
         s.flash,
         s.text,
@@ -1109,7 +1112,7 @@ pub fn print_measurement(m: &Measurement) {
         u64::from(b.ram).saturating_sub(s.static_ram)
     );
     let lib_stack = m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0);
-    println!(
+    crate::outln!(
         "library alone: flash {:>8} B (text {:+}, rodata {:+}), static RAM {:>8} B (workspace {} B) + stack <= {} B \
          [image with the library - image without]",
         delta(s.flash, w.flash),
@@ -1120,25 +1123,35 @@ pub fn print_measurement(m: &Measurement) {
         lib_stack
     );
     let (without, with) = m.instantiation;
-    println!(
+    crate::outln!(
         "instantiation: flash {:>8} B ({:.1} KB; text + rodata {with} with the call - {without} without) \
          [tests/flash as scripts/flash.sh builds it: {ONE_INSTANTIATION}]",
         delta(with, without),
         delta(with, without) as f64 / 1024.0,
     );
-    println!(
+    crate::outln!(
         "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per SysTick tick (calibrated)",
         m.capacity.0, m.capacity.1, m.capacity.2, m.instructions_per_tick
     );
-    println!(
+    crate::outln!(
         "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  vs host",
-        "case", "in", "out", "collapses", "instructions", "instr/coll", "stack lib", "high-water"
+        "case",
+        "in",
+        "out",
+        "collapses",
+        "instructions",
+        "instr/coll",
+        "stack lib",
+        "high-water"
     );
     for c in &m.cases {
         if c.verdict == "skipped" || c.verdict == "FAILED" {
-            println!(
+            crate::outln!(
                 "  {:<26} {:>6}  {}: {}",
-                c.name, c.triangles_in, c.verdict, c.note
+                c.name,
+                c.triangles_in,
+                c.verdict,
+                c.note
             );
             continue;
         }
@@ -1147,7 +1160,7 @@ pub fn print_measurement(m: &Measurement) {
         } else {
             "-".into()
         };
-        println!(
+        crate::outln!(
             "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  {}",
             c.name,
             c.triangles_in,
@@ -1174,7 +1187,7 @@ pub fn print_measurement(m: &Measurement) {
             Some((v, t, why)) => format!("{t} / {v} fail: {why}"),
             None => "no failure up to the search limit".into(),
         };
-        println!(
+        crate::outln!(
             "largest {it} mesh (bisecting `strip T`, Config::new()): {ok}; {fail} [{} runs, {:.1} s]",
             l.probes,
             l.wall.as_secs_f64()
@@ -1187,13 +1200,13 @@ pub fn print_summary(ms: &[Measurement]) {
     if ms.is_empty() {
         return;
     }
-    println!(
+    crate::outln!(
         "\nsummary ({} backend); sizes in bytes; lib = firmware image with - without the library; \
          1-inst = one instantiation ({ONE_INSTANTIATION}; scripts/flash.sh); \
          instr/collapse over the cases run (min..max)",
         ms[0].backend
     );
-    println!(
+    crate::outln!(
         "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
         "board",
         "fw flash",
@@ -1224,7 +1237,7 @@ pub fn print_summary(ms: &[Measurement]) {
                 .and_then(|l| l.ok)
                 .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
         };
-        println!(
+        crate::outln!(
             "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
             m.board.name,
             m.sizes.flash,
@@ -1338,13 +1351,13 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 None => false,
             };
             failed += usize::from(!echoed);
-            println!(
+            crate::outln!(
                 "{:<12} echo {}",
                 b.name,
                 if echoed { "ok" } else { "FAILED" }
             );
             if a.verbose || !echoed {
-                println!("    {}", run.describe().replace('\n', "\n    "));
+                crate::outln!("    {}", run.describe().replace('\n', "\n    "));
             }
         }
     } else if a.handlers {
@@ -1358,13 +1371,13 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 let run = run_command(b, &elf, cmd, timeout)?;
                 let ok = run.exit_code == Some(want);
                 failed += usize::from(!ok);
-                println!(
+                crate::outln!(
                     "{:<12} {cmd:<9} {}",
                     b.name,
                     if ok { "ok" } else { "FAILED" }
                 );
                 if a.verbose || !ok {
-                    println!("    {}", run.describe().replace('\n', "\n    "));
+                    crate::outln!("    {}", run.describe().replace('\n', "\n    "));
                 }
             }
             let dir = scratch_dir("missing")?;
@@ -1379,7 +1392,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             let _ = std::fs::remove_dir_all(&dir);
             let ok = run.exit_code == Some(EXIT_IO);
             failed += usize::from(!ok);
-            println!(
+            crate::outln!(
                 "{:<12} {:<9} {}",
                 b.name,
                 "missing",
@@ -1406,7 +1419,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     Ok(if failed == 0 {
         ExitCode::SUCCESS
     } else {
-        println!("{failed} failed");
+        crate::outln!("{failed} failed");
         ExitCode::from(1)
     })
 }
