@@ -423,10 +423,15 @@ pub fn renumber_onto(input: &MeshData, output: &MeshData) -> Option<(MeshData, u
 // ---------------------------------------------------------------------------------------------
 // Polygons
 
+/// Polygons with more corners than this are split as a fan from their first corner instead of
+/// by ear clipping (which is cubic in the worst case).
+pub const MAX_EAR_CLIPPED: usize = 1024;
+
 /// Splits a polygon (vertex indices in order, at least three) into `n - 2` triangles wound as
 /// the polygon is, by ear clipping in the plane the polygon faces most (Newell's normal), so
 /// concave polygons come out right; a polygon with no area or that crosses itself is still split
-/// into `n - 2` triangles (the best ear there is, then any), never refused.
+/// into `n - 2` triangles (the best ear there is, then any), never refused. Past
+/// [`MAX_EAR_CLIPPED`] corners: a fan.
 pub fn triangulate(positions: &[[f32; 3]], poly: &[u32]) -> Vec<[u32; 3]> {
     let n = poly.len();
     if n < 3 {
@@ -434,6 +439,12 @@ pub fn triangulate(positions: &[[f32; 3]], poly: &[u32]) -> Vec<[u32; 3]> {
     }
     if n == 3 {
         return vec![[poly[0], poly[1], poly[2]]];
+    }
+    if n > MAX_EAR_CLIPPED {
+        // Ear clipping is cubic in the worst case; such faces are not seen in real files.
+        return (1..n - 1)
+            .map(|k| [poly[0], poly[k], poly[k + 1]])
+            .collect();
     }
     let p3 = |i: u32| -> [f64; 3] {
         positions

@@ -37,6 +37,9 @@ enum Command {
     /// First impression: one mesh simplified on the host and on an emulated Cortex-M4F, side by
     /// side, and whether the outputs are byte-identical.
     Demo(demo::Args),
+    /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
+    /// examples/firmware (`cargo run --example … --target thumbv7em-none-eabihf`).
+    RunElf(qemu::RunElfArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Qemu(a) => qemu::run(a),
         Command::Golden(a) => golden::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::RunElf(a) => qemu::run_elf(a),
     };
     result.unwrap_or_else(|e| {
         // A reader that closed the pipe early wants no more: end quietly, as `out!` does.

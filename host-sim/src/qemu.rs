@@ -507,6 +507,43 @@ pub fn run_command(board: &Board, elf: &Path, command: &str, timeout: Duration) 
     run
 }
 
+/// `host-sim run-elf ELF`: the Cargo runner of the firmware example (examples/firmware).
+#[derive(Clone, Debug, clap::Args)]
+pub struct RunElfArgs {
+    /// The firmware image (as Cargo hands it to a runner).
+    pub elf: PathBuf,
+    /// QEMU board (machine) to run it on.
+    #[arg(long, default_value = "mps2-an386")]
+    pub board: String,
+    /// Kill QEMU after this many seconds.
+    #[arg(long, default_value_t = 60)]
+    pub timeout: u64,
+}
+
+/// Runs a firmware image under QEMU, prints its defmt log decoded with the image's own table,
+/// and exits with the firmware's semihosting exit code (124 on a timeout).
+pub fn run_elf(a: &RunElfArgs) -> Result<ExitCode> {
+    let b = board(&a.board)?;
+    let elf = std::fs::canonicalize(&a.elf).with_context(|| format!("{}", a.elf.display()))?;
+    let dir = scratch_dir("run-elf")?;
+    let run = run_in(b, &elf, &dir, &[], None, Duration::from_secs(a.timeout));
+    let _ = std::fs::remove_dir_all(&dir);
+    let run = run?;
+    for l in &run.log {
+        crate::outln!("{l}");
+    }
+    if !run.stderr.trim().is_empty() {
+        eprintln!("qemu: {}", run.stderr.trim());
+    }
+    if run.timed_out {
+        eprintln!("killed after {} s", a.timeout);
+        return Ok(ExitCode::from(124));
+    }
+    Ok(ExitCode::from(
+        run.exit_code.map_or(1, |c| c.clamp(0, 255) as u8),
+    ))
+}
+
 /// Firmware exit status: the result file was written.
 pub const EXIT_DONE: i32 = 0;
 /// Firmware exit status: host file I/O through semihosting failed.

@@ -113,3 +113,27 @@ fn stale_lines() {
     let fuzz_row = readme.lines().find(|l| l.contains("6 714 088")).unwrap();
     assert!(fuzz_row.contains("interrupted"), "{fuzz_row}");
 }
+
+/// Items 9 and 10: the README shows the workspace as a `static`, says what static_cell needs on
+/// thumbv6m, and points at the runnable firmware example that scripts/test.sh runs.
+#[test]
+fn firmware_advice_and_example() {
+    let readme = read("README.md");
+    assert!(
+        readme.contains("static WORKSPACE"),
+        "the workspace as a static"
+    );
+    assert!(!readme.contains("let mut ws = Workspace::<u16, 512, 1024>::new();"));
+    assert!(readme.contains("thumbv6m") && readme.contains("portable-atomic"));
+    assert!(readme.contains("cortex_m::singleton!"));
+    let cmd = "cargo run --release --example simplify_in_flash --target thumbv7em-none-eabihf";
+    assert!(readme.contains(cmd));
+    let example = read("examples/cortex-m4f/examples/simplify_in_flash.rs");
+    assert!(example.contains("static POSITIONS") && example.contains("static WORKSPACE"));
+    assert!(example.contains("defmt::info!"));
+    let config = read("examples/cortex-m4f/.cargo/config.toml");
+    assert!(config.contains("runner = \"./qemu-runner.sh\""));
+    assert!(config.contains("# runner = \"probe-rs run"));
+    let test_sh = read("scripts/test.sh");
+    assert!(test_sh.contains("--example simplify_in_flash --target thumbv7em-none-eabihf"));
+}
