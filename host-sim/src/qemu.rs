@@ -50,6 +50,42 @@ pub struct Board {
     pub clock_hz: u32,
 }
 
+/// The golden cases each board is expected to skip because their mesh does not fit its
+/// buffers (host-sim/firmware/src/board.rs). `qemu --check` fails on any other skip (a board
+/// whose buffers shrank would otherwise pass with its cases skipped) and on a listed case that
+/// ran after all (the list is stale). The soft-float cores (Cortex-M0, M3) are the only boards
+/// that skip; README.md names their cases. Checked against the boards' capacities in the tests.
+pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
+    ("microbit", MICROBIT_SKIPS),
+    ("lm3s6965evb", LM3S_SKIPS),
+    ("mps2-an386", &[]),
+    ("mps2-an500", &[]),
+    ("mps2-an505", &[]),
+];
+const MICROBIT_SKIPS: &[&str] = &["plate-new-u16", "cow-new-u16"];
+const LM3S_SKIPS: &[&str] = &["cow-new-u16"];
+
+/// Whether `board` is expected to skip `case` ([`EXPECTED_SKIPS`]).
+pub fn expected_skip(board: &str, case: &str) -> bool {
+    EXPECTED_SKIPS
+        .iter()
+        .any(|(b, cases)| *b == board && cases.contains(&case))
+}
+
+/// A board's verdict on a case, held against [`EXPECTED_SKIPS`]: an unexpected skip, or an
+/// expected skip that ran identically, becomes a failure.
+pub fn against_expected_skips(board: &str, case: &str, v: Verdict) -> Verdict {
+    match v {
+        Verdict::Skipped(why) if !expected_skip(board, case) => Verdict::Failed(format!(
+            "skipped, but not an expected skip of {board} (qemu::EXPECTED_SKIPS): {why}"
+        )),
+        Verdict::Identical if expected_skip(board, case) => Verdict::Failed(format!(
+            "ran, but listed as an expected skip of {board} in qemu::EXPECTED_SKIPS: update the list"
+        )),
+        v => v,
+    }
+}
+
 /// The five boards, smallest first. QEMU 7.2+.
 pub const BOARDS: [Board; 5] = [
     Board {
@@ -686,7 +722,7 @@ pub fn check(
                 }
                 (Ok(_), None) => Verdict::Failed("no golden files".into()),
             };
-            col.push(v);
+            col.push(against_expected_skips(b.name, &case.name, v));
         }
         eprintln!(
             "{:<12} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
@@ -1502,6 +1538,44 @@ fn isolate(cmd: &mut std::process::Command) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// EXPECTED_SKIPS is exactly the cases that do not fit each board's buffers
+    /// (host-sim/firmware/src/board.rs: vertices, and triangles of the case's index type in a
+    /// buffer of MAX_TRIANGLES triangles of the board's link type).
+    #[test]
+    fn expected_skips_match_the_board_capacities() {
+        // (board, MAX_VERTICES, MAX_TRIANGLES, bytes per link)
+        let caps = [
+            ("microbit", 240, 440, 2),
+            ("lm3s6965evb", 1_250, 2_400, 2),
+            ("mps2-an386", 53_000, 106_000, 4),
+            ("mps2-an500", 53_000, 106_000, 4),
+            ("mps2-an505", 53_000, 106_000, 4),
+        ];
+        let cases = golden::load_cases(&golden::default_dir()).unwrap();
+        for (board, v, t, link) in caps {
+            let too_big: Vec<&str> = cases
+                .iter()
+                .filter(|c| {
+                    let per = c.index_type.triangle_bytes();
+                    let fit = (t * 3 * link / per).min(t);
+                    c.positions.len() > v || c.triangles.len() > fit
+                })
+                .map(|c| c.name.as_str())
+                .collect();
+            let listed: Vec<&str> = EXPECTED_SKIPS
+                .iter()
+                .find(|(b, _)| *b == board)
+                .map(|(_, c)| c.to_vec())
+                .unwrap_or_default();
+            assert_eq!(too_big, listed, "{board}");
+        }
+        assert_eq!(EXPECTED_SKIPS.len(), BOARDS.len());
+        assert!(matches!(
+            against_expected_skips("mps2-an386", "cow-new-u16", Verdict::Skipped("x".into())),
+            Verdict::Failed(_)
+        ));
+    }
 
     #[test]
     fn boards_are_unique_and_known() {

@@ -137,3 +137,24 @@ fn firmware_advice_and_example() {
     let test_sh = read("scripts/test.sh");
     assert!(test_sh.contains("--example simplify_in_flash --target thumbv7em-none-eabihf"));
 }
+
+/// Item 13: the README names the cases the soft-float cores skip, as qemu.rs lists them.
+#[test]
+fn readme_names_the_expected_skips() {
+    let readme = read("README.md");
+    let qemu = read("host-sim/src/qemu.rs");
+    for (list, board) in [("MICROBIT_SKIPS", "Cortex-M0"), ("LM3S_SKIPS", "Cortex-M3")] {
+        let line = qemu
+            .lines()
+            .find(|l| l.starts_with(&format!("const {list}")))
+            .unwrap();
+        let para = &readme[readme.find(board).unwrap()..];
+        let para = &para[..para.find(')').unwrap() + 200];
+        for name in line.split('"').skip(1).step_by(2) {
+            assert!(
+                para.contains(&format!("`{name}`")),
+                "{board} {name}: {para}"
+            );
+        }
+    }
+}
