@@ -9,12 +9,12 @@
 //! |------------|---------------------------------------------------------------------|--------|
 //! | `Locked`   | a or b is on a non-manifold edge, a pinched fan or an inconsistently wound edge | seed 000 §3.1 (irregular vertices) |
 //! | `Feature`  | a is a feature vertex; or b is, unless feature targets are allowed  | seed 004 §3.3 |
-//! | `Boundary` | a is on the boundary and a-b is not a boundary edge; or the boundary loop through a-b has only three edges | seed 000 §3.2 (second and third conditions), §3.3 |
-//! | `Link`     | a vertex adjacent to both a and b is not opposite a-b (the surface would pinch) | seed 000 §3.2 (first condition) |
+//! | `Boundary` | a is on the boundary and a-b is not a boundary edge; or the boundary loop through a-b has only three edges | seed 000 §3.2(1), second and third conditions |
+//! | `Link`     | a vertex adjacent to both a and b is not opposite a-b (the surface would pinch) | seed 000 §3.2(1), first condition |
 //! | `Duplicate`| a triangle of a would become a copy of one of b's                    | |
 //! | `Sliver`   | a surviving triangle gets zero area, or a quality below the limit that is also worse than before | |
-//! | `NormalTurn` | a surviving triangle's normal turns by more than the limit       | seed 000 §3.2 (2), the dihedral threshold β |
-//! | `Fold`     | a surviving triangle and a neighbour across any of its edges end up with nearly opposite normals | seed 000 §3.2 (2) |
+//! | `NormalTurn` | a surviving triangle's normal turns by more than the limit       | seed 000 §3.2(2), the dihedral threshold β |
+//! | `Fold`     | a surviving triangle and a neighbour across any of its edges end up with nearly opposite normals | seed 000 §3.2(2) |
 //!
 //! Interior vertices may move onto boundary vertices (the boundary does not change), never the
 //! reverse. Together with the link condition this keeps a closed manifold closed, keeps the

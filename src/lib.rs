@@ -6,13 +6,14 @@
 //! It follows the mobile-terminal method of Lin Mouguang (seed 004, "A Geometry Compression
 //! Method for Mobile Computing Terminal", 2007): edge collapse with subset placement (§2), so
 //! the positions are only ever read and may stay in flash, and *feature vertices*, whose
-//! triangles' normals differ most from each other (§3, eq. 3-5), are never removed. The
+//! triangles' normals differ most from each other (§3, eq. 3-5), are never removed while they
+//! are features. The
 //! default cost is a memoryless quadric (Lindstrom-Turk style; the plane quadrics of seed 000
 //! §2.3 without per-vertex storage); the paper's own normal variation W (eq. 1-2, Algorithm 1)
-//! and its passes are [`Config::paper`]. Legality follows Cheng, Pan and Shi's progressive
-//! meshes (seed 000 §3.1-3.3): irregular vertices locked, the link condition, boundary edges
-//! only between boundary vertices, a dihedral (normal-turn and fold) threshold; plus no
-//! sliver or duplicate triangles.
+//! and its passes are [`Config::paper`]. Legality follows seed 000 (Cheng, Pan and Shi, "A
+//! fast algorithm for generating progressive meshes"): irregular vertices locked (§3.1), the
+//! link condition and boundary edges only between boundary vertices (§3.2(1)), a dihedral
+//! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
 //! Data flows one way:
 //!

@@ -15,7 +15,7 @@ pub enum Reject {
     /// A boundary vertex would leave its boundary, or two boundary vertices are joined across
     /// the interior, or a boundary loop of three edges would close.
     Boundary,
-    /// The link condition fails (seed 000 §3.2, Cheng/Pan/Shi): a common neighbour of both endpoints is not
+    /// The link condition fails (seed 000 §3.2(1), first condition; Cheng/Pan/Shi): a common neighbour of both endpoints is not
     /// opposite the edge, so the collapse would pinch the surface.
     Link,
     /// The collapse would create a triangle that already exists.

@@ -148,16 +148,11 @@ fn no_fold_when_a_stray_vertex_dwarfs_the_mesh() {
 /// failure one step further (after f055ab3).
 ///
 /// With the stray vertex at x = 1e30 the rest of the mesh is ~1e-30 across in normalised
-/// units, so the *cross product* in `Mesh::normal_of` (src/mesh.rs) underflows to zero before
-/// `math::unit` can rescale anything. `price` is safe now (its `shape` divides the edges by
-/// their largest component first), but `legality::connectivity`/`folds` still take
-/// `math::unit(mesh.normal_of(..))`, get zero vectors and never see a fold: collapses fold
-/// (0, 2, 6) onto (0, 2, 5) and (2, 6, 7) onto (2, 5, 7).
-///
-/// Suggested fix: make `Mesh::normal_of` divide both edge vectors by their largest |component|
-/// (componentwise `e / m`, not `e * (1 / m)`, which overflows for subnormal `m`) before the
-/// cross product; its callers only use the direction (`unit`), and `feature::variation` gets
-/// the same protection. (With that change this case passes.)
+/// units, so a cross product of the raw edge vectors underflows to zero. When this input was
+/// found, the legality rules took the direction of exactly such a cross product, got zero
+/// vectors and never saw a fold: collapses folded (0, 2, 6) onto (0, 2, 5) and (2, 6, 7) onto
+/// (2, 5, 7). Fixed since: the rules take every normal from `legality::Shape::of`
+/// (src/legality.rs), which scales the edges by a power of two before the cross product.
 #[test]
 fn no_fold_when_a_stray_vertex_is_1e30_away() {
     let positions: [[f32; 3]; 8] = [

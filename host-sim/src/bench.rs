@@ -1312,7 +1312,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     let (opts, out, json) = args.options();
     let results = bench(&opts, &command_line())?;
     let md = markdown(&results);
-    print!("{md}");
+    crate::out!("{md}");
     if let Some(p) = &out {
         write_file(p, &md)?;
         eprintln!("wrote {}", p.display());

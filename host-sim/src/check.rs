@@ -33,33 +33,74 @@ pub fn compare(input: &MeshData, output: &MeshData) -> Validity {
 /// `host-sim check ORIGINAL SIMPLIFIED`
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
-    /// The input mesh.
+    /// The input mesh (`-`: standard input).
     pub original: std::path::PathBuf,
-    /// The simplified mesh (same vertex numbering).
+    /// The simplified mesh: the input's vertex numbering, or a file `host-sim simplify` wrote
+    /// with unreferenced vertices dropped (matched back by position, see `renumbered`).
     pub simplified: std::path::PathBuf,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
 }
 
+/// Whether `output` uses `input`'s numbering: every vertex an output triangle uses is an
+/// input vertex at the same position.
+pub fn same_numbering(input: &MeshData, output: &MeshData) -> bool {
+    output.triangles.iter().flatten().all(|&i| {
+        let i = i as usize;
+        i < input.positions.len() && output.positions.get(i) == input.positions.get(i)
+    })
+}
+
+/// `output` in `input`'s numbering: itself if it already is, else matched back by position
+/// ([`crate::io::renumber_onto`]) when it is an order-keeping subset of the input's vertices.
+/// The note says what was done, if anything.
+pub fn renumbered(input: &MeshData, output: &MeshData) -> (MeshData, Option<String>) {
+    if same_numbering(input, output) {
+        return (output.clone(), None);
+    }
+    match crate::io::renumber_onto(input, output) {
+        Some((m, twins)) => {
+            let mut note = format!(
+                "the simplified mesh has its own vertex numbering ({} vertices): matched back \
+                 onto the original's by position",
+                output.positions.len()
+            );
+            if twins > 0 {
+                note += &format!(
+                    "; {twins} of them share their position with another original vertex and \
+                     were matched in order (write with --keep-numbering for an exact check)"
+                );
+            }
+            (m, Some(note))
+        }
+        None => (output.clone(), None),
+    }
+}
+
 /// `host-sim check`: topology of both meshes and the validity; exit code 1 if invalid.
 pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
-    let a = crate::io::load(&args.original)?;
-    let b = crate::io::load(&args.simplified)?;
+    let a = crate::io::load_noting(&args.original)?;
+    let b = crate::io::load_noting(&args.simplified)?;
+    let (b, note) = renumbered(&a, &b);
     let (ta, tb, v) = (analyse(&a), analyse(&b), compare(&a, &b));
     if args.json {
         let j = serde_json::json!({
             "original": ta,
             "simplified": tb,
+            "renumbered": note,
             "validity": v,
             "defects": v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
             "valid": v.is_valid(),
         });
-        println!("{}", serde_json::to_string_pretty(&j)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&j)?);
     } else {
-        println!("original {}:\n{ta}", args.original.display());
-        println!("simplified {}:\n{tb}", args.simplified.display());
-        println!("validity:\n{v}");
+        crate::outln!("original {}:\n{ta}", args.original.display());
+        crate::outln!("simplified {}:\n{tb}", args.simplified.display());
+        if let Some(n) = note {
+            crate::outln!("note: {n}");
+        }
+        crate::outln!("validity (against the cleaned original: degenerate and duplicate triangles dropped as the library does):\n{v}");
     }
     Ok(if v.is_valid() {
         std::process::ExitCode::SUCCESS

@@ -144,7 +144,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 o.header.capacity_triangles as usize,
             );
             let sub = subset_that_fits(&case, v, t);
-            println!(
+            crate::outln!(
                 "{} has {} vertices / {} triangles; {} holds {v} / {t}: using its first {} triangles ({} vertices)",
                 case.mesh,
                 case.positions.len(),
@@ -159,10 +159,10 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     }
     let (device, run) = ran;
     if a.verbose {
-        println!("{}", run.describe());
+        crate::outln!("{}", run.describe());
     }
     let Some(device) = device else {
-        println!(
+        crate::outln!(
             "the firmware on {} gave no result: {}",
             board.name,
             run.describe()
@@ -179,7 +179,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     } else {
         "u32"
     };
-    println!(
+    crate::outln!(
         "\ntinydecimate demo: {} ({} vertices, {} {it} triangles)\nconfig: {} ({:?}, ratio {}, lambda {}), {backend} backend\n",
         case.mesh,
         case.positions.len(),
@@ -195,7 +195,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     );
     let host_col = format!("host ({}, std)", std::env::consts::ARCH);
     let dev_col = format!("{} ({}, QEMU)", board.name, board.core);
-    let row = |k: &str, x: String, y: String| println!("{k:<22} {x:<46} {y}");
+    let row = |k: &str, x: String, y: String| crate::outln!("{k:<22} {x:<46} {y}");
     row("", host_col, dev_col);
     let status = |o: &Outcome| match o.header.status {
         Status::Ok => "ok".to_string(),
@@ -272,20 +272,20 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         golden::sha256_hex(&gh.bin)[..16].to_string(),
         golden::sha256_hex(&gd.bin)[..16].to_string(),
     );
-    println!();
+    crate::outln!();
     match golden::diff(index_type, &gh, &gd) {
         Verdict::Identical => {
-            println!(
+            crate::outln!(
                 "byte-identical: yes ({} bytes of output triangles, same report)",
                 gh.bin.len()
             );
             Ok(ExitCode::SUCCESS)
         }
         v => {
-            println!("byte-identical: NO");
+            crate::outln!("byte-identical: NO");
             if let Verdict::Diff(d) = v {
                 for l in d {
-                    println!("  {l}");
+                    crate::outln!("  {l}");
                 }
             }
             Ok(ExitCode::from(1))

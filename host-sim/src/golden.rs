@@ -887,23 +887,23 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         return reinvoke(backend);
     }
     if a.bless {
-        println!(
+        crate::outln!(
             "blessing {} with the {backend} backend:",
             a.dir.join(backend.name()).display()
         );
         for l in bless(&a.dir, backend)? {
-            println!("  {l}");
+            crate::outln!("  {l}");
         }
         return Ok(ExitCode::SUCCESS);
     }
-    println!(
+    crate::outln!(
         "checking {} against the library on the host ({backend}):",
         a.dir.join(backend.name()).display()
     );
     let results = check_host(&a.dir, backend)?;
     let mut failed = 0;
     for (case, v) in &results {
-        println!(
+        crate::outln!(
             "  {:<28} {:>4} V {:>5} T {:<3}  {}",
             case.name,
             case.positions.len(),
@@ -916,17 +916,17 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             v.cell()
         );
         match v {
-            Verdict::Diff(d) => d.iter().for_each(|l| println!("      {l}")),
-            Verdict::Failed(why) | Verdict::Skipped(why) => println!("      {why}"),
+            Verdict::Diff(d) => d.iter().for_each(|l| crate::outln!("      {l}")),
+            Verdict::Failed(why) | Verdict::Skipped(why) => crate::outln!("      {why}"),
             Verdict::Identical => {}
         }
         failed += usize::from(v.is_failure());
     }
     if failed == 0 {
-        println!("{} cases identical", results.len());
+        crate::outln!("{} cases identical", results.len());
         Ok(ExitCode::SUCCESS)
     } else {
-        println!(
+        crate::outln!(
             "{failed} of {} cases differ; if the change is intended: host-sim golden --bless --backend {backend}",
             results.len()
         );

@@ -1,14 +1,21 @@
-//! Mesh files: OBJ, PLY (ascii and binary) and STL (ascii and binary) in, OBJ and binary PLY out.
+//! Mesh files: OBJ, PLY (ascii and binary) and STL (ascii and binary) in; OBJ, binary PLY and
+//! binary STL out. `-` is standard input (format found from the bytes) or standard output (the
+//! format given by the caller, OBJ by default).
+//!
+//! Only positions and faces are read: attributes (texture coordinates, normals, colours, any
+//! other PLY property) are not carried, and [`LoadNotes`] says which were dropped. Faces with
+//! more than three corners (quads, n-gons, concave ones too) are split into triangles by ear
+//! clipping ([`triangulate`]), and [`LoadNotes`] counts them.
 //!
 //! * **OBJ**: only `v` and `f` lines matter (`vt`, `vn`, `o`, `g`, `s`, `usemtl`, `l`, `p`, ...
 //!   are ignored). Vertices keep the file's numbering exactly, unreferenced ones included; face
 //!   corners may be written `a`, `a/b`, `a//c` or `a/b/c` and may be negative (relative).
-//!   Faces that are not triangles are rejected. This is a small reader of our own: `tobj`
+//!   Faces with fewer than three corners are rejected. This is a small reader of our own: `tobj`
 //!   always renumbers vertices in order of first use and drops unreferenced ones (checked in
 //!   tobj 4.0.5, `add_vertex`/`add_vertex_multi_index`), so it cannot keep the file's
 //!   numbering; `tobj` is used in the tests as an independent cross-check of the geometry.
 //! * **PLY**: via `ply-rs-bw`; element `vertex` (`x`, `y`, `z`, any scalar type) and element
-//!   `face` (list `vertex_indices` or `vertex_index`, triangles only).
+//!   `face` (list `vertex_indices` or `vertex_index`; polygons are triangulated).
 //! * **STL**: via `stl_io`; corners are welded by bit-exact `f32` position, vertices numbered
 //!   by first appearance. A file is binary when its size is exactly `84 + 50 n` bytes with `n`
 //!   the triangle count at offset 80, even if its header starts with `solid` (`stl_io` 0.11
@@ -64,14 +71,56 @@ impl MeshData {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Format {
+/// A mesh file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// Wavefront OBJ (text).
     Obj,
+    /// PLY (binary little endian when written).
     Ply,
+    /// STL (binary when written).
     Stl,
 }
 
-fn format_of(path: &Path) -> Result<Format> {
+/// What a reader did besides copying triangles: polygons it split, attributes it dropped.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LoadNotes {
+    /// Faces with more than three corners, split into triangles.
+    pub polygons_split: usize,
+    /// Triangles those faces became.
+    pub triangles_from_polygons: usize,
+    /// Attributes that were in the file and are not carried, e.g. "1204 texture coordinates
+    /// (vt)" or "vertex properties nx, ny, nz".
+    pub dropped: Vec<String>,
+}
+
+impl LoadNotes {
+    /// One line per note, for stderr; none if there is nothing to say.
+    pub fn lines(&self, name: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.polygons_split > 0 {
+            out.push(format!(
+                "note: {name}: {} polygon(s) with more than 3 corners split into {} triangles",
+                self.polygons_split, self.triangles_from_polygons
+            ));
+        }
+        if !self.dropped.is_empty() {
+            out.push(format!(
+                "warning: {name}: attributes are not carried, dropped: {}",
+                self.dropped.join("; ")
+            ));
+        }
+        out
+    }
+}
+
+/// Whether `path` means standard input or output.
+pub fn is_std(path: &Path) -> bool {
+    path.as_os_str() == "-"
+}
+
+/// The format a path's extension names (`.obj`, `.ply`, `.stl`, any case).
+pub fn format_of(path: &Path) -> Result<Format> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -87,20 +136,71 @@ fn format_of(path: &Path) -> Result<Format> {
     }
 }
 
-/// Loads a triangle mesh, choosing the format by extension (`.obj`, `.ply`, `.stl`, any case).
-pub fn load(path: impl AsRef<Path>) -> Result<MeshData> {
-    let path = path.as_ref();
-    let format = format_of(path)?;
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let name = path.display().to_string();
-    let mesh = match format {
-        Format::Obj => parse_obj(&bytes),
-        Format::Ply => parse_ply(&bytes),
-        Format::Stl => parse_stl(&bytes),
+/// The format of mesh bytes read from standard input: PLY by its magic, STL by a binary size or
+/// an ascii `solid` header with `facet` lines, else OBJ.
+pub fn sniff(bytes: &[u8]) -> Format {
+    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+        return Format::Ply;
     }
-    .map_err(|e| anyhow!("{name}: {e}"))?;
+    if stl_size_matches_binary(bytes) {
+        return Format::Stl;
+    }
+    let head = &bytes[..bytes.len().min(4096)];
+    if bytes.trim_ascii_start().starts_with(b"solid") && head.windows(5).any(|w| w == b"facet") {
+        return Format::Stl;
+    }
+    Format::Obj
+}
+
+/// Loads a triangle mesh, choosing the format by extension (`.obj`, `.ply`, `.stl`, any case);
+/// `-` reads standard input and finds the format from the bytes ([`sniff`]).
+pub fn load(path: impl AsRef<Path>) -> Result<MeshData> {
+    load_with_notes(path).map(|(m, _)| m)
+}
+
+/// [`load`], and what the reader split or dropped.
+pub fn load_with_notes(path: impl AsRef<Path>) -> Result<(MeshData, LoadNotes)> {
+    let path = path.as_ref();
+    let (bytes, format, name) = if is_std(path) {
+        let mut bytes = Vec::new();
+        std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes)
+            .context("standard input: cannot read")?;
+        let f = sniff(&bytes);
+        (bytes, f, "standard input".to_string())
+    } else {
+        let format = format_of(path)?;
+        let bytes =
+            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        (bytes, format, path.display().to_string())
+    };
+    let (mesh, notes) = parse_format(&bytes, format).map_err(|e| anyhow!("{name}: {e}"))?;
     validate(&mesh).map_err(|e| anyhow!("{name}: {e}"))?;
-    Ok(mesh)
+    Ok((mesh, notes))
+}
+
+/// [`load_with_notes`] for the command line: prints the notes on stderr.
+pub fn load_noting(path: impl AsRef<Path>) -> Result<MeshData> {
+    let path = path.as_ref();
+    let (m, notes) = load_with_notes(path)?;
+    let name = if is_std(path) {
+        "standard input".to_string()
+    } else {
+        path.display().to_string()
+    };
+    for l in notes.lines(&name) {
+        eprintln!("{l}");
+    }
+    Ok(m)
+}
+
+type Parsed = std::result::Result<(MeshData, LoadNotes), String>;
+
+fn parse_format(bytes: &[u8], format: Format) -> Parsed {
+    match format {
+        Format::Obj => parse_obj(bytes),
+        Format::Ply => parse_ply(bytes),
+        Format::Stl => parse_stl(bytes).map(|m| (m, LoadNotes::default())),
+    }
 }
 
 /// Parses a mesh from memory, the format given by `ext` (`obj`, `ply` or `stl`, any case, no
@@ -112,12 +212,7 @@ pub fn parse_bytes(bytes: &[u8], ext: &str) -> Result<MeshData> {
         "stl" => Format::Stl,
         _ => bail!("unknown mesh format {ext:?} (expected obj, ply or stl)"),
     };
-    let mesh = match format {
-        Format::Obj => parse_obj(bytes),
-        Format::Ply => parse_ply(bytes),
-        Format::Stl => parse_stl(bytes),
-    }
-    .map_err(|e| anyhow!(e))?;
+    let (mesh, _) = parse_format(bytes, format).map_err(|e| anyhow!(e))?;
     validate(&mesh).map_err(|e| anyhow!(e))?;
     Ok(mesh)
 }
@@ -148,35 +243,293 @@ fn validate(mesh: &MeshData) -> std::result::Result<(), String> {
 }
 
 /// Saves a mesh, choosing the format by extension: `.obj` (text, 1-based, shortest round-trip
-/// coordinates) or `.ply` (binary little endian, `float` x y z, `list uchar int
-/// vertex_indices`). All positions are written, so the vertex numbering is kept.
+/// coordinates), `.ply` (binary little endian, `float` x y z, `list uchar int
+/// vertex_indices`) or `.stl` (binary, facet normals computed). All positions are written, so
+/// the vertex numbering is kept ([`compact`] drops unreferenced vertices first).
 pub fn save(path: impl AsRef<Path>, mesh: &MeshData) -> Result<()> {
     let path = path.as_ref();
-    let format = format_of(path)?;
-    let bytes = match format {
-        Format::Obj => obj_bytes(mesh),
-        Format::Ply => ply_bytes(mesh).map_err(|e| anyhow!("{}: {e}", path.display()))?,
-        Format::Stl => bail!("{}: writing STL is not supported", path.display()),
+    let format = output_format(path, None)?;
+    save_as(path, format, mesh)
+}
+
+/// The format an output path will be written in: `format` if given, else the extension's;
+/// standard output (`-`) is OBJ unless `format` says otherwise.
+pub fn output_format(path: &Path, format: Option<Format>) -> Result<Format> {
+    match format {
+        Some(f) => Ok(f),
+        None if is_std(path) => Ok(Format::Obj),
+        None => format_of(path),
+    }
+}
+
+/// Checks, before any long work, that `path` can be written in a known format: the format is
+/// known, the path is not a directory, its folder exists and the file can be created or opened
+/// for writing. Creates nothing that was not there (a new file made for the test is removed)
+/// and never truncates an existing file. Returns the format.
+pub fn check_writable(path: &Path, format: Option<Format>) -> Result<Format> {
+    let f = output_format(path, format)?;
+    if is_std(path) {
+        return Ok(f);
+    }
+    if path.is_dir() {
+        bail!("{}: is a directory, not a file to write", path.display());
+    }
+    if path.exists() {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open(path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    } else {
+        std::fs::File::create(path)
+            .with_context(|| format!("{}: cannot create", path.display()))?;
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(f)
+}
+
+/// Saves `mesh` to `path` (`-`: standard output) in `format`.
+pub fn save_as(path: &Path, format: Format, mesh: &MeshData) -> Result<()> {
+    let name = if is_std(path) {
+        "standard output".to_string()
+    } else {
+        path.display().to_string()
     };
-    let file = std::fs::File::create(path)
-        .with_context(|| format!("{}: cannot create", path.display()))?;
+    let bytes = encode(format, mesh).map_err(|e| anyhow!("{name}: {e}"))?;
+    if is_std(path) {
+        let mut out = std::io::stdout().lock();
+        return out
+            .write_all(&bytes)
+            .and_then(|()| out.flush())
+            .with_context(|| format!("{name}: cannot write"));
+    }
+    let file = std::fs::File::create(path).with_context(|| format!("{name}: cannot create"))?;
     let mut w = BufWriter::new(file);
     w.write_all(&bytes)
         .and_then(|()| w.flush())
-        .with_context(|| format!("{}: cannot write", path.display()))?;
+        .with_context(|| format!("{name}: cannot write"))?;
     Ok(())
+}
+
+/// The bytes of `mesh` in `format`.
+pub fn encode(format: Format, mesh: &MeshData) -> std::result::Result<Vec<u8>, String> {
+    match format {
+        Format::Obj => Ok(obj_bytes(mesh)),
+        Format::Ply => ply_bytes(mesh),
+        Format::Stl => stl_bytes(mesh),
+    }
+}
+
+/// `mesh` without the vertices no triangle uses; the others keep their order (so vertex `i`
+/// of the result is the `i`-th used vertex of `mesh`). Returns the result and, for each of its
+/// vertices, the index it had in `mesh`.
+pub fn compact(mesh: &MeshData) -> (MeshData, Vec<u32>) {
+    let mut used = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        for &i in t {
+            if let Some(u) = used.get_mut(i as usize) {
+                *u = true;
+            }
+        }
+    }
+    let mut new_of = vec![u32::MAX; mesh.positions.len()];
+    let mut old_of = Vec::new();
+    let mut positions = Vec::new();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        if used[i] {
+            new_of[i] = old_of.len() as u32;
+            old_of.push(i as u32);
+            positions.push(*p);
+        }
+    }
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| new_of.get(i as usize).copied().unwrap_or(u32::MAX)))
+        .collect();
+    (
+        MeshData {
+            positions,
+            triangles,
+        },
+        old_of,
+    )
+}
+
+/// Maps the vertices of `output`, a mesh written in its own numbering (unreferenced vertices
+/// dropped by [`compact`], or an STL file welded by position), back onto `input`'s numbering
+/// by position (bit for bit), among the input vertices some input triangle uses. When the
+/// output keeps the input's order (as [`compact`] does), each output vertex takes the next
+/// match in order; otherwise the first match. Returns the renumbered output and how many
+/// output vertices had another used input vertex at the same position (where the match may
+/// be the wrong twin), or `None` if some output vertex is at no input vertex's position.
+pub fn renumber_onto(input: &MeshData, output: &MeshData) -> Option<(MeshData, usize)> {
+    let mut used = vec![false; input.positions.len()];
+    for t in &input.triangles {
+        for &i in t {
+            if let Some(u) = used.get_mut(i as usize) {
+                *u = true;
+            }
+        }
+    }
+    let key = |p: &[f32; 3]| p.map(f32::to_bits);
+    let mut at: HashMap<[u32; 3], Vec<u32>> = HashMap::new();
+    for (i, p) in input.positions.iter().enumerate() {
+        if used[i] {
+            at.entry(key(p)).or_default().push(i as u32);
+        }
+    }
+    let mut ambiguous = 0;
+    for p in &output.positions {
+        match at.get(&key(p)) {
+            None => return None,
+            Some(c) if c.len() > 1 => ambiguous += 1,
+            Some(_) => {}
+        }
+    }
+    // In order if possible: the next candidate after the previous match.
+    let mut map = Vec::with_capacity(output.positions.len());
+    let mut last: Option<u32> = None;
+    for p in &output.positions {
+        let c = &at[&key(p)];
+        let next = c.iter().copied().find(|&i| last.is_none_or(|l| i > l));
+        match next {
+            Some(i) => {
+                map.push(i);
+                last = Some(i);
+            }
+            None => {
+                map.clear();
+                break;
+            }
+        }
+    }
+    if map.len() != output.positions.len() {
+        map = output.positions.iter().map(|p| at[&key(p)][0]).collect();
+    }
+    let triangles = output
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| map.get(i as usize).copied().unwrap_or(u32::MAX)))
+        .collect();
+    Some((
+        MeshData {
+            positions: input.positions.clone(),
+            triangles,
+        },
+        ambiguous,
+    ))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Polygons
+
+/// Polygons with more corners than this are split as a fan from their first corner instead of
+/// by ear clipping (which is cubic in the worst case).
+pub const MAX_EAR_CLIPPED: usize = 1024;
+
+/// Splits a polygon (vertex indices in order, at least three) into `n - 2` triangles wound as
+/// the polygon is, by ear clipping in the plane the polygon faces most (Newell's normal), so
+/// concave polygons come out right; a polygon with no area or that crosses itself is still split
+/// into `n - 2` triangles (the best ear there is, then any), never refused. Past
+/// [`MAX_EAR_CLIPPED`] corners: a fan.
+pub fn triangulate(positions: &[[f32; 3]], poly: &[u32]) -> Vec<[u32; 3]> {
+    let n = poly.len();
+    if n < 3 {
+        return Vec::new();
+    }
+    if n == 3 {
+        return vec![[poly[0], poly[1], poly[2]]];
+    }
+    if n > MAX_EAR_CLIPPED {
+        // Ear clipping is cubic in the worst case; such faces are not seen in real files.
+        return (1..n - 1)
+            .map(|k| [poly[0], poly[k], poly[k + 1]])
+            .collect();
+    }
+    let p3 = |i: u32| -> [f64; 3] {
+        positions
+            .get(i as usize)
+            .map_or([0.0; 3], |p| p.map(f64::from))
+    };
+    // Newell's normal.
+    let mut nrm = [0.0f64; 3];
+    for k in 0..n {
+        let (a, b) = (p3(poly[k]), p3(poly[(k + 1) % n]));
+        nrm[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        nrm[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        nrm[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| nrm[a].abs().total_cmp(&nrm[b].abs()))
+        .unwrap_or(2);
+    // (u, v) axes cyclic after the dropped one: a polygon facing +axis runs counter-clockwise.
+    let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+    let sign = if nrm[axis] < 0.0 { -1.0 } else { 1.0 };
+    let pt: Vec<[f64; 2]> = poly
+        .iter()
+        .map(|&i| {
+            let p = p3(i);
+            [p[ua], sign * p[va]]
+        })
+        .collect();
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut rest: Vec<usize> = (0..n).collect();
+    let mut out = Vec::with_capacity(n - 2);
+    // The first ear tried is corners 0, 1, 2: a convex quad a b c d becomes a b c, a c d.
+    let mut start = 1;
+    while rest.len() > 3 {
+        let m = rest.len();
+        let mut ear = None;
+        let mut convex_any = None;
+        for s in 0..m {
+            let k = (start + s) % m;
+            let (a, b, c) = (rest[(k + m - 1) % m], rest[k], rest[(k + 1) % m]);
+            if cross(pt[a], pt[b], pt[c]) <= 0.0 {
+                continue; // reflex or flat: not an ear
+            }
+            convex_any.get_or_insert(k);
+            // No other corner inside or on the triangle (corners at the same place as one of
+            // a, b, c excepted: a polygon may touch itself there).
+            let blocked = rest.iter().any(|&q| {
+                if q == a || q == b || q == c || [a, b, c].iter().any(|&x| pt[x] == pt[q]) {
+                    return false;
+                }
+                cross(pt[a], pt[b], pt[q]) >= 0.0
+                    && cross(pt[b], pt[c], pt[q]) >= 0.0
+                    && cross(pt[c], pt[a], pt[q]) >= 0.0
+            });
+            if !blocked {
+                ear = Some(k);
+                break;
+            }
+        }
+        let k = ear.or(convex_any).unwrap_or(start % m);
+        let (a, b, c) = (rest[(k + m - 1) % m], rest[k], rest[(k + 1) % m]);
+        out.push([poly[a], poly[b], poly[c]]);
+        rest.remove(k);
+        start = k % rest.len();
+    }
+    out.push([poly[rest[0]], poly[rest[1]], poly[rest[2]]]);
+    out
 }
 
 // ---------------------------------------------------------------------------------------------
 // OBJ
 
-fn parse_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+fn parse_obj(bytes: &[u8]) -> Parsed {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let at = e.valid_up_to();
         let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
         format!("line {line} (byte offset {at}): not valid UTF-8 text")
     })?;
     let mut mesh = MeshData::default();
+    let mut notes = LoadNotes::default();
+    // Polygons with more than 3 corners: (index of the triangle slot they go to, corners),
+    // split once every vertex is read (a face may refer to a vertex defined later).
+    let mut polygons: Vec<(usize, Vec<u32>)> = Vec::new();
+    let (mut vt, mut vn, mut other) = (0usize, 0usize, std::collections::BTreeSet::new());
     // Largest vertex index referenced by a face and the line it is on, checked at the end
     // (an OBJ face may refer to a vertex defined later).
     let mut max_ref: Option<(usize, usize)> = None;
@@ -208,16 +561,21 @@ fn parse_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
                 }
                 mesh.positions.push(p);
             }
+            "vt" => vt += 1,
+            "vn" => vn += 1,
+            "vp" | "l" | "p" | "curv" | "curv2" | "surf" | "usemtl" | "mtllib" => {
+                other.insert(keyword.to_string());
+            }
             "f" => {
                 let corners: Vec<&str> = tokens.collect();
-                if corners.len() != 3 {
+                if corners.len() < 3 {
                     return Err(format!(
-                        "line {line_no}: face with {} corner(s); only triangles are supported",
+                        "line {line_no}: face with {} corner(s); a face needs at least 3",
                         corners.len()
                     ));
                 }
-                let mut tri = [0u32; 3];
-                for (slot, tok) in tri.iter_mut().zip(&corners) {
+                let mut face = vec![0u32; corners.len()];
+                for (slot, tok) in face.iter_mut().zip(&corners) {
                     let idx = tok.split('/').next().unwrap_or("");
                     let i: i64 = idx
                         .parse()
@@ -240,7 +598,11 @@ fn parse_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
                     }
                     *slot = z;
                 }
-                mesh.triangles.push(tri);
+                if let [a, b, c] = face[..] {
+                    mesh.triangles.push([a, b, c]);
+                } else {
+                    polygons.push((mesh.triangles.len(), face));
+                }
             }
             _ => {}
         }
@@ -254,7 +616,33 @@ fn parse_obj(bytes: &[u8]) -> std::result::Result<MeshData, String> {
             ));
         }
     }
-    Ok(mesh)
+    if !polygons.is_empty() {
+        // Splice each polygon's triangles in at its place in the file.
+        let tris = std::mem::take(&mut mesh.triangles);
+        let mut out = Vec::with_capacity(tris.len() + polygons.len() * 2);
+        let mut next = 0;
+        for (at, face) in &polygons {
+            out.extend_from_slice(&tris[next..*at]);
+            next = *at;
+            let split = triangulate(&mesh.positions, face);
+            notes.polygons_split += 1;
+            notes.triangles_from_polygons += split.len();
+            out.extend(split);
+        }
+        out.extend_from_slice(&tris[next..]);
+        mesh.triangles = out;
+    }
+    if vt > 0 {
+        notes.dropped.push(format!("{vt} texture coordinates (vt)"));
+    }
+    if vn > 0 {
+        notes.dropped.push(format!("{vn} normals (vn)"));
+    }
+    if !other.is_empty() {
+        let o: Vec<String> = other.into_iter().collect();
+        notes.dropped.push(format!("`{}` lines", o.join("`, `")));
+    }
+    Ok((mesh, notes))
 }
 
 fn obj_bytes(mesh: &MeshData) -> Vec<u8> {
@@ -289,7 +677,7 @@ fn scalar_bytes(t: &ply_rs_bw::ply::ScalarType) -> usize {
     }
 }
 
-fn parse_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
+fn parse_ply(bytes: &[u8]) -> Parsed {
     use ply_rs_bw::parser::{Parser, Reader};
     use ply_rs_bw::ply::{DefaultElement, Encoding};
 
@@ -346,6 +734,28 @@ fn parse_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
     })?;
 
     let mut mesh = MeshData::default();
+    let mut notes = LoadNotes::default();
+    for e in header.elements.values() {
+        let keep: &[&str] = match e.name.as_str() {
+            "vertex" => &["x", "y", "z"],
+            "face" => &["vertex_indices", "vertex_index"],
+            _ => {
+                notes.dropped.push(format!("element `{}`", e.name));
+                continue;
+            }
+        };
+        let extra: Vec<&str> = e
+            .properties
+            .keys()
+            .map(String::as_str)
+            .filter(|k| !keep.contains(k))
+            .collect();
+        if !extra.is_empty() {
+            notes
+                .dropped
+                .push(format!("{} properties {}", e.name, extra.join(", ")));
+        }
+    }
     let vertices = payload
         .get("vertex")
         .ok_or("PLY file has no `vertex` element")?;
@@ -372,15 +782,25 @@ fn parse_ply(bytes: &[u8]) -> std::result::Result<MeshData, String> {
         let idx = list.to_u32_list().ok_or_else(|| {
             format!("PLY face {i}: indices are not a list of non-negative integers")
         })?;
-        let tri: [u32; 3] = idx.as_slice().try_into().map_err(|_| {
-            format!(
-                "PLY face {i} has {} corners; only triangles are supported",
-                idx.len()
-            )
-        })?;
-        mesh.triangles.push(tri);
+        match idx[..] {
+            [a, b, c] => mesh.triangles.push([a, b, c]),
+            _ if idx.len() > 3 => {
+                // Indices are checked against the vertex count by `validate` afterwards;
+                // `triangulate` puts out-of-range ones at the origin meanwhile.
+                let split = triangulate(&mesh.positions, &idx);
+                notes.polygons_split += 1;
+                notes.triangles_from_polygons += split.len();
+                mesh.triangles.extend(split);
+            }
+            _ => {
+                return Err(format!(
+                    "PLY face {i} has {} corners; a face needs at least 3",
+                    idx.len()
+                ))
+            }
+        }
     }
-    Ok(mesh)
+    Ok((mesh, notes))
 }
 
 fn ply_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String> {
@@ -444,6 +864,48 @@ fn ply_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String> {
 
 // ---------------------------------------------------------------------------------------------
 // STL
+
+/// Binary STL: an 80-byte header, the count, and per triangle its unit normal (zero if it has
+/// no area), three corners and a zero attribute word. STL has no vertex numbering: reading it
+/// back welds corners by position.
+fn stl_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String> {
+    let n = u32::try_from(mesh.triangles.len()).map_err(|_| "too many triangles for STL")?;
+    let mut b = Vec::with_capacity(84 + 50 * mesh.triangles.len());
+    let mut header = [b' '; 80];
+    let text = b"binary STL written by tinydecimate host-sim";
+    header[..text.len()].copy_from_slice(text);
+    b.extend_from_slice(&header);
+    b.extend_from_slice(&n.to_le_bytes());
+    for t in &mesh.triangles {
+        let mut p = [[0f32; 3]; 3];
+        for (slot, &i) in p.iter_mut().zip(t) {
+            *slot = *mesh
+                .positions
+                .get(i as usize)
+                .ok_or_else(|| format!("a triangle refers to vertex {i}, past the last"))?;
+        }
+        let e1 = [0, 1, 2].map(|k| f64::from(p[1][k]) - f64::from(p[0][k]));
+        let e2 = [0, 1, 2].map(|k| f64::from(p[2][k]) - f64::from(p[0][k]));
+        let cr = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let len = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
+        let nrm = if len > 0.0 && len.is_finite() {
+            cr.map(|x| (x / len) as f32)
+        } else {
+            [0.0; 3]
+        };
+        for v in [nrm, p[0], p[1], p[2]] {
+            for x in v {
+                b.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        b.extend_from_slice(&[0, 0]);
+    }
+    Ok(b)
+}
 
 /// Whether `bytes` is a binary STL by its size: `84 + 50 n` with `n` at offset 80.
 fn stl_size_matches_binary(bytes: &[u8]) -> bool {
@@ -601,10 +1063,10 @@ mod tests {
     fn obj_errors_name_file_and_line() {
         let d = tmp();
         let p = d.path().join("q.obj");
-        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n").unwrap();
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2\n").unwrap();
         let e = err_of(&p);
         assert!(
-            e.contains("q.obj") && e.contains("line 5") && e.contains("only triangles"),
+            e.contains("q.obj") && e.contains("line 5") && e.contains("at least 3"),
             "{e}"
         );
 
@@ -689,8 +1151,196 @@ mod tests {
             ),
         )
         .unwrap();
-        let e = err_of(&p);
-        assert!(e.contains("only triangles"), "{e}");
+        let (m, notes) = load_with_notes(&p).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 3], [0, 3, 2], [1, 3, 2]]);
+        assert_eq!(
+            (notes.polygons_split, notes.triangles_from_polygons),
+            (1, 2)
+        );
+        assert_eq!(notes.dropped, vec!["vertex properties confidence"]);
+    }
+
+    /// Twice the signed area of a triangle in the z = 0 plane.
+    fn area2(p: &[[f32; 3]], t: [u32; 3]) -> f64 {
+        let [a, b, c] = t.map(|i| p[i as usize].map(f64::from));
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    }
+
+    #[test]
+    fn concave_polygons_are_ear_clipped() {
+        // An arrow (concave at vertex 4) and a comb with three teeth, counter-clockwise.
+        let arrow: Vec<[f32; 3]> = vec![
+            [0., 0., 0.],
+            [4., 0., 0.],
+            [4., 4., 0.],
+            [2., 4., 0.],
+            [2., 1., 0.], // the notch
+            [0., 4., 0.],
+        ];
+        let comb: Vec<[f32; 3]> = vec![
+            [0., 0., 0.],
+            [5., 0., 0.],
+            [5., 3., 0.],
+            [4., 3., 0.],
+            [4., 1., 0.],
+            [3., 1., 0.],
+            [3., 3., 0.],
+            [2., 3., 0.],
+            [2., 1., 0.],
+            [1., 1., 0.],
+            [1., 3., 0.],
+            [0., 3., 0.],
+        ];
+        for (p, area) in [(arrow, 13.0), (comb, 11.0)] {
+            let n = p.len() as u32;
+            let poly: Vec<u32> = (0..n).collect();
+            for flip in [false, true] {
+                // The same polygon wound the other way must give the mirrored triangles.
+                let poly: Vec<u32> = if flip {
+                    poly.iter().rev().copied().collect()
+                } else {
+                    poly.clone()
+                };
+                let tris = triangulate(&p, &poly);
+                assert_eq!(tris.len(), n as usize - 2);
+                let mut sum = 0.0;
+                for &t in &tris {
+                    let a = area2(&p, t) * if flip { -1.0 } else { 1.0 };
+                    assert!(a > 0.0, "{t:?} is wound against the polygon or flat");
+                    sum += a / 2.0;
+                }
+                assert!(
+                    (sum - area).abs() < 1e-9,
+                    "{sum} != {area}: triangles overlap"
+                );
+            }
+            // Tilted into 3D (facing mostly -x), still n - 2 triangles covering the area.
+            let q: Vec<[f32; 3]> = p.iter().map(|v| [-0.2 * v[0], v[1], v[0]]).collect();
+            assert_eq!(
+                triangulate(&q, &(0..n).collect::<Vec<_>>()).len(),
+                n as usize - 2
+            );
+        }
+        // Degenerate: all corners on a line; still n - 2 triangles, no panic.
+        let line: Vec<[f32; 3]> = (0..5).map(|i| [i as f32, 0., 0.]).collect();
+        assert_eq!(triangulate(&line, &[0, 1, 2, 3, 4]).len(), 3);
+    }
+
+    #[test]
+    fn obj_polygons_are_split_and_attributes_noted() {
+        let d = tmp();
+        let p = d.path().join("poly.obj");
+        std::fs::write(
+            &p,
+            "mtllib m.mtl\nv 0 0 0\nv 4 0 0\nv 4 4 0\nv 2 4 0\nv 2 1 0\nv 0 4 0\nvt 0 0\n\
+             vn 0 0 1\nvn 0 0 1\nusemtl red\nf 1 2 3\nf 1/1/1 2/1/1 3/1/2 4/1/2 5/1/2 6/1/2\n\
+             f 1 3 6\n",
+        )
+        .unwrap();
+        let (m, notes) = load_with_notes(&p).unwrap();
+        assert_eq!(m.triangles.len(), 1 + 4 + 1);
+        // In file order: the hexagon's four triangles between the two triangles.
+        assert_eq!(m.triangles[0], [0, 1, 2]);
+        assert_eq!(m.triangles[5], [0, 2, 5]);
+        assert_eq!(
+            (notes.polygons_split, notes.triangles_from_polygons),
+            (1, 4)
+        );
+        let lines = notes.lines("poly.obj");
+        assert!(lines[0].contains("1 polygon(s)") && lines[0].contains("4 triangles"));
+        assert!(
+            lines[1].contains("1 texture coordinates (vt)")
+                && lines[1].contains("2 normals (vn)")
+                && lines[1].contains("`mtllib`, `usemtl`"),
+            "{lines:?}"
+        );
+        // Only positions and triangles: nothing to say.
+        save(&p, &tetra()).unwrap();
+        assert!(load_with_notes(&p).unwrap().1.lines("x").is_empty());
+    }
+
+    #[test]
+    fn stl_is_written_and_reads_back() {
+        let d = tmp();
+        let p = d.path().join("t.stl");
+        let m = tetra();
+        save(&p, &m).unwrap();
+        let bytes = std::fs::read(&p).unwrap();
+        assert_eq!(bytes.len(), 84 + 50 * 4);
+        let back = load(&p).unwrap();
+        assert_eq!(expand(&back), stl_tris());
+        // Facet normal of [0, 2, 1] (z = 0 plane, wound clockwise seen from +z): -z.
+        let n: Vec<f32> = (0..3)
+            .map(|k| f32::from_le_bytes(bytes[84 + 4 * k..88 + 4 * k].try_into().unwrap()))
+            .collect();
+        assert_eq!(n, vec![0.0, 0.0, -1.0]);
+        assert_eq!(sniff(&bytes), Format::Stl);
+    }
+
+    #[test]
+    fn formats_are_sniffed_from_bytes() {
+        assert_eq!(sniff(b"ply\nformat ascii 1.0\n"), Format::Ply);
+        assert_eq!(sniff(b"solid x\nfacet normal 0 0 1\n"), Format::Stl);
+        assert_eq!(sniff(b"v 0 0 0\nf 1 1 1\n"), Format::Obj);
+        assert_eq!(sniff(b"solid_name.obj\nv 0 0 0\n"), Format::Obj);
+    }
+
+    #[test]
+    fn compact_drops_unreferenced_vertices_in_order() {
+        let m = tetra();
+        let (c, old) = compact(&m);
+        assert_eq!(old, vec![0, 1, 2, 3]);
+        assert_eq!(c.positions, m.positions[..4].to_vec());
+        assert_eq!(c.triangles, m.triangles);
+        let cut = MeshData {
+            positions: m.positions.clone(),
+            triangles: vec![[1, 2, 3]],
+        };
+        let (c, old) = compact(&cut);
+        assert_eq!(old, vec![1, 2, 3]);
+        assert_eq!(c.triangles, vec![[0, 1, 2]]);
+        // ... and the check maps it back.
+        let (r, twins) = renumber_onto(&m, &c).unwrap();
+        assert_eq!((r.triangles, twins), (vec![[1, 2, 3]], 0));
+        // A vertex the input does not have: no match.
+        let mut bad = c.clone();
+        bad.positions[0] = [9.0, 9.0, 9.0];
+        assert!(renumber_onto(&m, &bad).is_none());
+    }
+
+    #[test]
+    fn output_paths_are_checked_before_work() {
+        let d = tmp();
+        assert_eq!(
+            check_writable(&d.path().join("a.stl"), None).unwrap(),
+            Format::Stl
+        );
+        assert!(!d.path().join("a.stl").exists(), "the probe leaves nothing");
+        let e = format!(
+            "{:#}",
+            check_writable(&d.path().join("a.off"), None).unwrap_err()
+        );
+        assert!(e.contains("unknown mesh format"), "{e}");
+        let e = format!(
+            "{:#}",
+            check_writable(&d.path().join("no/such/dir/a.obj"), None).unwrap_err()
+        );
+        assert!(e.contains("cannot create"), "{e}");
+        let e = format!(
+            "{:#}",
+            check_writable(d.path(), Some(Format::Obj)).unwrap_err()
+        );
+        assert!(e.contains("directory"), "{e}");
+        // An existing file is not truncated by the check.
+        let p = d.path().join("keep.obj");
+        std::fs::write(&p, "v 0 0 0\n").unwrap();
+        check_writable(&p, None).unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "v 0 0 0\n");
+        assert_eq!(check_writable(Path::new("-"), None).unwrap(), Format::Obj);
+        assert_eq!(
+            check_writable(Path::new("-"), Some(Format::Ply)).unwrap(),
+            Format::Ply
+        );
     }
 
     /// Element counts the file cannot hold are refused before the payload is read: found by

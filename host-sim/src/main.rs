@@ -1,6 +1,8 @@
 //! `host-sim`: command-line front end of the harness. Each subcommand's arguments and code live
 //! in its module (`Args` + `run`); this file only dispatches. Exit codes: 0 success, 1 the
 //! result is not a valid simplification (`check`, `simplify`), 2 error (bad file, bad input).
+//! A closed standard output (`host-sim check A B --json | head -1`) ends a command quietly with
+//! exit code 0: nothing is printed with `println!`, which would panic (see `host_sim::out!`).
 
 use std::process::ExitCode;
 
@@ -38,6 +40,9 @@ enum Command {
     /// Progressive meshes: encode a mesh as a base mesh plus vertex splits, decode a stream to
     /// a level, measure and draw a ladder of levels.
     Pm(pm::Args),
+    /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
+    /// examples/firmware (`cargo run --example … --target thumbv7em-none-eabihf`).
+    RunElf(qemu::RunElfArgs),
 }
 
 fn main() -> ExitCode {
@@ -52,8 +57,17 @@ fn main() -> ExitCode {
         Command::Golden(a) => golden::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Pm(a) => pm::run(a),
+        Command::RunElf(a) => qemu::run_elf(a),
     };
     result.unwrap_or_else(|e| {
+        // A reader that closed the pipe early wants no more: end quietly, as `out!` does.
+        if let Some(io) = e
+            .chain()
+            .find_map(|c| c.downcast_ref::<std::io::Error>())
+            .filter(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+        {
+            return ExitCode::from(host_sim::exit_code_for_io(io) as u8);
+        }
         eprintln!("error: {e:#}");
         ExitCode::from(2)
     })

@@ -1,6 +1,7 @@
 //! Metro-style surface distance between two meshes (Cignoni, Rocchini, Scopigno, "Metro:
 //! measuring error on simplified surfaces", 1998; the error definitions are quoted in seed 001
-//! §4: `E_max = max q(v, S2)` and `E_mean = ∫ q(v, S2) ds / |S1|`).
+//! §4, Zhu, Wang and Meng, mesh simplification with control-point error control, 2007:
+//! `E_max = max q(v, S2)` and `E_mean = ∫ q(v, S2) ds / |S1|`).
 //!
 //! For each direction (a→b, then b→a) the source mesh is sampled and each sample's exact
 //! distance to the other mesh's surface is computed (closest point on a triangle, f64, found
@@ -607,8 +608,8 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     if !(args.samples_per_triangle.is_finite() && args.samples_per_triangle > 0.0) {
         anyhow::bail!("--samples-per-triangle must be a positive number");
     }
-    let a = crate::io::load(&args.original)?;
-    let b = crate::io::load(&args.simplified)?;
+    let a = crate::io::load_noting(&args.original)?;
+    let b = crate::io::load_noting(&args.simplified)?;
     let opts = MetroOptions {
         samples_per_triangle: args.samples_per_triangle,
         seed: args.seed,
@@ -617,15 +618,15 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     let start = std::time::Instant::now();
     let r = metro(&a, &b, &opts);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&r)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&r)?);
     } else {
-        println!(
+        crate::outln!(
             "metro {} vs {}:",
             args.original.display(),
             args.simplified.display()
         );
-        println!("{r}");
-        println!(
+        crate::outln!("{r}");
+        crate::outln!(
             "  time                     {:.2} s",
             start.elapsed().as_secs_f64()
         );

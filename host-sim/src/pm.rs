@@ -188,24 +188,24 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
     std::fs::write(&a.output, &bytes).with_context(|| format!("writing {}", a.output.display()))?;
     let d = decode_bytes(&bytes, bytes.len(), None)?;
     let h = d.header;
-    println!(
+    crate::outln!(
         "input            {} triangles, {} vertices",
         mesh.triangles.len(),
         mesh.positions.len()
     );
-    println!(
+    crate::outln!(
         "base mesh        {} triangles, {} vertices, {} bytes (header, positions, triangles, framing)",
         h.base_triangles, h.base_vertices, e.base_bytes
     );
-    println!("vertex splits    {}", e.splits);
+    crate::outln!("vertex splits    {}", e.splits);
     let per = |bits: u64| bits as f64 / 8.0 / e.splits.max(1) as f64;
-    println!(
+    crate::outln!(
         "per split        {:.2} B connectivity + {:.1} B position ({})",
         per(e.split_connectivity_bits),
         per(e.split_position_bits),
         if quantised { "16-bit quantised" } else { "f32" }
     );
-    println!(
+    crate::outln!(
         "stream           {} bytes ({} in all)",
         e.bytes,
         a.output.display()
@@ -222,12 +222,12 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
                 .sqrt();
             worst = worst.max(e);
         }
-        println!(
+        crate::outln!(
             "quantisation     max {:.5} % of the diagonal",
             100.0 * worst / diag
         );
     }
-    println!(
+    crate::outln!(
         "time             {:.1} ms (simplify, build the splits, encode)",
         took.as_secs_f64() * 1e3
     );
@@ -308,7 +308,7 @@ fn decode(a: &DecodeArgs) -> Result<()> {
             triangles: d.triangles.clone(),
         },
     )?;
-    println!(
+    crate::outln!(
         "decoded {} bytes in {}-byte pieces: base {} triangles, full {} triangles, {} vertices",
         bytes.len(),
         a.piece,
@@ -316,7 +316,7 @@ fn decode(a: &DecodeArgs) -> Result<()> {
         d.header.triangles,
         d.header.vertices
     );
-    println!(
+    crate::outln!(
         "wrote {} triangles to {} ({:.1} ms)",
         d.triangles.len(),
         a.output.display(),
@@ -346,8 +346,8 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
             picks.push(lvl);
         }
     }
-    println!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
-    println!("|---:|---:|---:|---:|");
+    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
+    crate::outln!("|---:|---:|---:|---:|");
     let mut meshes = Vec::new();
     for &lvl in &picks {
         let m = MeshData {
@@ -355,7 +355,7 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
             triangles: d.levels[lvl].clone(),
         };
         let r = metro(&full, &m, &MetroOptions::default());
-        println!(
+        crate::outln!(
             "| {lvl} | {} | {:.4} | {:.4} |",
             m.triangles.len(),
             r.symmetric_mean_pct,
@@ -377,7 +377,7 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
         strip
             .save(path)
             .with_context(|| format!("writing {}", path.display()))?;
-        println!("strip: {} ({} levels)", path.display(), images.len());
+        crate::outln!("strip: {} ({} levels)", path.display(), images.len());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -294,15 +294,15 @@ pub fn run(args: &Args) -> Result<std::process::ExitCode> {
 
 /// Draws `mesh` (or the comparison with `compare`) into the PNG file `out`.
 pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
-    let m = crate::io::load(mesh)?;
+    let m = crate::io::load_noting(mesh)?;
     let img = match compare {
         None => render(&m, &View::fit(&m)),
         Some(orig) => {
-            let o = crate::io::load(orig)?;
+            let o = crate::io::load_noting(orig)?;
             let (img, top) = render_compare(&o, &m);
             let diag = o.bbox_diagonal();
             let pct = if diag > 0.0 { 100.0 * top / diag } else { 0.0 };
-            println!(
+            crate::outln!(
                 "panels: original | simplified | error heatmap (blue = 0, red = {top:.6e} = {pct:.4} % of the original's bbox diagonal)"
             );
             img
@@ -310,7 +310,7 @@ pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
     };
     img.save_with_format(out, ImageFormat::Png)
         .with_context(|| format!("{}: cannot write PNG", out.display()))?;
-    println!("wrote {} ({}x{})", out.display(), img.width(), img.height());
+    crate::outln!("wrote {} ({}x{})", out.display(), img.width(), img.height());
     Ok(())
 }
 

@@ -1,15 +1,20 @@
 //! `host-sim simplify`: runs the library on a mesh file, prints its report, memory figures and
-//! (unless `--no-measure`) the validity check and the Metro error of the result.
+//! (unless `--no-measure`) the validity check and the Metro error of the result, as text or
+//! (`--json`) as one JSON object.
+//!
+//! The output path and format are checked before anything else; the input may be standard
+//! input and the output standard output (`-`). Output files keep only the vertices the result
+//! uses unless `--keep-numbering`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Workspace};
 
-use crate::io::MeshData;
+use crate::io::{Format, MeshData};
 
 /// Largest mesh the harness takes: vertices.
 pub const MAX_VERTICES: usize = 262_144;
@@ -82,25 +87,108 @@ impl From<CostArg> for CostKind {
     }
 }
 
+/// A number in a range, for clap: the error names the range and what the value means.
+fn ranged(
+    v: &str,
+    ok: impl Fn(f32) -> bool,
+    range: &str,
+    meaning: &str,
+) -> std::result::Result<f32, String> {
+    let x: f32 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("{v:?} is not a number; accepted: {range} ({meaning})"))?;
+    if x.is_finite() && ok(x) {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{v} is out of range; accepted: {range} ({meaning})"
+        ))
+    }
+}
+
+fn parse_ratio(v: &str) -> std::result::Result<f32, String> {
+    ranged(
+        v,
+        |x| (0.0..=1.0).contains(&x),
+        "0 to 1",
+        "the fraction of the input triangles to keep, 0.25 keeps a quarter",
+    )
+}
+
+fn parse_max_error(v: &str) -> std::result::Result<f32, String> {
+    ranged(
+        v,
+        |x| x > 0.0 && x <= 1.0,
+        "above 0, at most 1",
+        "a fraction of the bounding-box diagonal, 0.01 is 1 %",
+    )
+}
+
+fn parse_lambda(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x >= 0.0, "0 or more", "the feature factor λ")
+}
+
+fn parse_turn(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x > 0.0 && x < 180.0, "above 0, below 180", "degrees")
+}
+
+fn parse_quality(v: &str) -> std::result::Result<f32, String> {
+    ranged(
+        v,
+        |x| (0.0..1.0).contains(&x),
+        "0 or more, below 1",
+        "1 is an equilateral triangle",
+    )
+}
+
+fn parse_weight(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x >= 0.0, "0 or more", "a weight")
+}
+
+fn parse_samples(v: &str) -> std::result::Result<f64, String> {
+    ranged(v, |x| x > 0.0, "above 0", "samples per triangle").map(f64::from)
+}
+
 /// `host-sim simplify IN OUT ...`
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
 pub struct Args {
-    /// Input mesh (.obj, .ply, .stl).
+    /// Input mesh (.obj, .ply, .stl; `-` reads standard input, the format found from the
+    /// bytes). Quads and n-gons are split into triangles (ear clipping). Only positions and
+    /// faces are read: attributes (texture coordinates, normals, colours) are not carried yet,
+    /// and a warning says which were dropped.
     pub input: PathBuf,
-    /// Output mesh (.obj or .ply); keeps the input's vertex numbering.
+    /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
+    /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no
+    /// output triangle uses are dropped (see --keep-numbering).
     pub output: PathBuf,
-    /// Target fraction of the input triangles, in [0, 1].
-    #[arg(long, group = "target")]
+    /// Output format, instead of the output's extension.
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
+    /// Keep every input vertex in the output file, so that its indices are the input's (what
+    /// a firmware's index buffer into the same positions needs). STL has no numbering.
+    #[arg(long)]
+    pub keep_numbering: bool,
+    /// Target fraction of the input triangles, 0 to 1.
+    #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
     pub ratio: Option<f32>,
     /// Target triangle count (with --ratio, the higher target wins).
     #[arg(long, group = "target")]
     pub target_triangles: Option<usize>,
+    /// Stop before a collapse would cost more than this error, given as a fraction of the
+    /// bounding-box diagonal (0.01 = 1 %). With --ratio or --target-triangles, whichever stops
+    /// first. Quadric cost only. Approximate, until the library bounds the error itself: the
+    /// distance is mapped onto the quadric's cost units as the cost of moving a vertex this far
+    /// off the planes of a fan of 6 triangles of the input's mean area (see `max_cost_for`).
+    /// The measured Metro error is printed afterwards.
+    #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_max_error)]
+    pub max_error: Option<f32>,
     /// Collapse schedule.
     #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
     pub schedule: ScheduleArg,
     /// Feature factor λ: a vertex is a feature iff D > λ·mean(D) (default 2; 1 with passes).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_lambda)]
     pub lambda: Option<f32>,
     /// Normalise the feature measure D by valence² (FeatureMode::ValenceNormalized).
     #[arg(long)]
@@ -112,13 +200,13 @@ pub struct Args {
     #[arg(long)]
     pub no_feature_targets: bool,
     /// Largest normal turn of a triangle in one collapse, degrees.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_turn)]
     pub max_turn: Option<f32>,
     /// Smallest triangle quality a collapse may create (unless already worse).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_quality)]
     pub min_quality: Option<f32>,
     /// Weight of the boundary retreat in the cost.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_weight)]
     pub boundary_weight: Option<f32>,
     /// Collapse cost (default: the schedule's own, quadric for greedy as in `Config::new()`,
     /// normal for passes as in `Config::paper()`).
@@ -128,8 +216,51 @@ pub struct Args {
     #[arg(long)]
     pub no_measure: bool,
     /// Metro face samples per triangle of the larger mesh.
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = parse_samples)]
     pub samples_per_triangle: f64,
+    /// Print the report, the check and the Metro error as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The `max_cost` (quadric cost units) that `--max-error e` stands for on `mesh`.
+///
+/// The library works in normalised units: coordinates divided by the largest side `L` of the
+/// bounding box. The quadric prices a move of the removed vertex by `d` as
+/// `Σ A_t (n_t·d)² · (1 + Ā / A_fan)` (A: twice a triangle's area, Ā: their mean). A move of
+/// distance `δ = e · diagonal / L` straight off the planes of a fan of 6 triangles of the
+/// input's mean area costs `δ² · (6 Ā + Ā) = 7 Ā δ²`, which is the bound returned. Fans of
+/// larger or more curved triangles reach it at a smaller distance, so the measured error is
+/// usually below `e`; it is an approximation, not a guarantee.
+pub fn max_cost_for(mesh: &MeshData, e: f32) -> f32 {
+    let Some((lo, hi)) = mesh.bbox() else {
+        return 0.0;
+    };
+    let side = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    if side <= 0.0 {
+        return 0.0;
+    }
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize].map(|x| f64::from(x) / side));
+        let (u, v) = (
+            [0, 1, 2].map(|k| b[k] - a[k]),
+            [0, 1, 2].map(|k| c[k] - a[k]),
+        );
+        let cr = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let area2 = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
+        if area2 > 0.0 {
+            sum += area2;
+            n += 1;
+        }
+    }
+    let mean = if n > 0 { sum / n as f64 } else { 0.0 };
+    let delta = f64::from(e) * mesh.bbox_diagonal() / side;
+    (7.0 * mean * delta * delta) as f32
 }
 
 impl Args {
@@ -238,37 +369,146 @@ pub fn format_report(r: &Report) -> String {
     )
 }
 
+/// [`simplify`] driven step by step, with a progress bar on stderr when it is a terminal and
+/// the run takes over a second. Same result as [`simplify`] (steps of any size give the result
+/// of `Workspace::simplify`).
+pub fn simplify_with_progress(
+    mesh: &MeshData,
+    config: &Config,
+) -> Result<(MeshData, Report, Duration)> {
+    let mut tris = mesh.triangles.clone();
+    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let start = Instant::now();
+    let progress = crate::progress::Progress::new(
+        "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
+        mesh.triangles.len() as u64,
+    );
+    let report = {
+        let mut s = ws
+            .start(&mesh.positions, &mut tris, config)
+            .map_err(|e| anyhow!("tinydecimate: {e}"))?;
+        let n0 = s.live_triangles();
+        while !s.step(1 << 14) {
+            progress.set((n0 - s.live_triangles().min(n0)) as u64);
+        }
+        s.finish()
+    };
+    progress.finish();
+    let elapsed = start.elapsed();
+    tris.truncate(report.triangles_out);
+    let out = MeshData {
+        positions: mesh.positions.clone(),
+        triangles: tris,
+    };
+    Ok((out, report, elapsed))
+}
+
+/// The report as JSON: every field of `Report`.
+pub fn report_json(r: &Report) -> serde_json::Value {
+    let j = &r.rejected;
+    serde_json::json!({
+        "triangles_in": r.triangles_in,
+        "degenerate_dropped": r.degenerate_dropped,
+        "duplicates_dropped": r.duplicates_dropped,
+        "triangles_out": r.triangles_out,
+        "target_triangles": r.target_triangles,
+        "target_reached": r.target_reached,
+        "stop": format!("{:?}", r.stop),
+        "collapses": r.collapses,
+        "vertices_removed": r.vertices_removed,
+        "locked_vertices": r.locked_vertices,
+        "feature_vertices": r.feature_vertices,
+        "passes": r.passes,
+        "pass_triangles": r.pass_triangles.iter().collect::<Vec<_>>(),
+        "rejected": {
+            "total": j.total(),
+            "locked": j.locked,
+            "feature": j.feature,
+            "boundary": j.boundary,
+            "link": j.link,
+            "duplicate": j.duplicate,
+            "normal_turn": j.normal_turn,
+            "sliver": j.sliver,
+            "fold": j.fold,
+        },
+    })
+}
+
 /// `host-sim simplify`. Exit code 1 if the measured result is not a valid simplification.
 pub fn run(args: &Args) -> Result<ExitCode> {
-    let mesh = crate::io::load(&args.input)?;
-    let config = args.config();
-    let (out, report, elapsed) = simplify(&mesh, &config)?;
-    crate::io::save(&args.output, &out)?;
+    use std::fmt::Write as _;
+    // Everything that can be refused is refused before the long work.
+    let to_stdout = crate::io::is_std(&args.output);
+    if to_stdout && args.json {
+        bail!("--json and an output of `-` would both write standard output: give an output file");
+    }
+    let out_format = crate::io::check_writable(&args.output, args.format)?;
+    let mesh = crate::io::load_noting(&args.input)?;
+    let mut config = args.config();
+    if let Some(e) = args.max_error {
+        if config.cost != CostKind::Quadric {
+            bail!(
+                "--max-error is mapped onto the quadric cost's units only; drop --cost normal / \
+                 --schedule passes, or use --ratio / --target-triangles"
+            );
+        }
+        config = config.with_max_cost(max_cost_for(&mesh, e));
+    }
+    config
+        .validate()
+        .map_err(|e| anyhow!("configuration: {e}"))?;
+    let (out, report, elapsed) = simplify_with_progress(&mesh, &config)?;
+    let written = if args.keep_numbering {
+        out.clone()
+    } else {
+        crate::io::compact(&out).0
+    };
+    crate::io::save_as(&args.output, out_format, &written)?;
 
-    println!(
-        "simplify {} -> {}",
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "simplify {} -> {} ({:?}, {} vertices{})",
         args.input.display(),
-        args.output.display()
+        args.output.display(),
+        out_format,
+        written.positions.len(),
+        if args.keep_numbering {
+            ", input numbering kept"
+        } else {
+            ", unreferenced dropped"
+        }
     );
-    println!(
+    let _ = writeln!(
+        text,
         "  schedule, cost         {:?}, {:?}",
         config.schedule, config.cost
     );
-    println!("{}", format_report(&report));
-    println!(
+    if let Some(e) = args.max_error {
+        let _ = writeln!(
+            text,
+            "  max error              {e} of the diagonal = max_cost {:e} (quadric units, approximate)",
+            config.max_cost
+        );
+    }
+    let _ = writeln!(text, "{}", format_report(&report));
+    let _ = writeln!(
+        text,
         "  library call           {:.3} ms",
         elapsed.as_secs_f64() * 1e3
     );
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let per_tri = |b: usize| b as f64 / t.max(1) as f64;
-    println!(
+    let _ = writeln!(
+        text,
         "  workspace (static)     {} bytes = Workspace<u32, {MAX_VERTICES}, {MAX_TRIANGLES}> \
          ({:.1} bytes per input triangle, misleading for a fixed big static)",
         HostWorkspace::BYTES,
         per_tri(HostWorkspace::BYTES)
     );
     let (need, link) = workspace_bytes(v, t);
-    println!(
+    let _ = writeln!(
+        text,
         "  workspace (right-size) {need} bytes for V = {v}, T = {t} with {link}-byte links \
          ({} bytes per vertex, {} per triangle; {:.2} bytes per input triangle)",
         if link == 2 {
@@ -283,22 +523,65 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         },
         per_tri(need)
     );
-
-    if args.no_measure {
-        return Ok(ExitCode::SUCCESS);
-    }
-    let validity = crate::check::compare(&mesh, &out);
-    println!("check (input vs output):");
-    println!("{validity}");
-    let opts = crate::metro::MetroOptions {
-        samples_per_triangle: args.samples_per_triangle,
-        progress: true,
-        ..Default::default()
+    let say = |text: &str| {
+        if to_stdout {
+            eprint!("{text}");
+        } else if !args.json {
+            crate::out!("{text}");
+        }
     };
-    let m = crate::metro::metro(&mesh, &out, &opts);
-    println!("metro (input vs output):");
-    println!("{m}");
-    Ok(if validity.is_valid() {
+    say(&text);
+    text.clear();
+
+    let mut json = serde_json::json!({
+        "input": args.input.display().to_string(),
+        "output": args.output.display().to_string(),
+        "output_format": format!("{out_format:?}"),
+        "output_vertices": written.positions.len(),
+        "keep_numbering": args.keep_numbering,
+        "schedule": format!("{:?}", config.schedule),
+        "cost": format!("{:?}", config.cost),
+        "max_error": args.max_error,
+        "max_cost": if config.max_cost.is_finite() { Some(config.max_cost) } else { None },
+        "report": report_json(&report),
+        "library_ms": elapsed.as_secs_f64() * 1e3,
+        "workspace_bytes": need,
+    });
+    let mut valid = true;
+    if !args.no_measure {
+        // The library drops degenerate and duplicate triangles before it starts; the check
+        // compares the output with the input as the library saw it (`meshcheck::clean`).
+        let validity = crate::check::compare(&mesh, &out);
+        valid = validity.is_valid();
+        let _ = writeln!(
+            text,
+            "check (output vs the cleaned input: the input less its {} degenerate and {} \
+             duplicate triangles, as the library dropped them):",
+            report.degenerate_dropped, report.duplicates_dropped
+        );
+        let _ = writeln!(text, "{validity}");
+        let opts = crate::metro::MetroOptions {
+            samples_per_triangle: args.samples_per_triangle,
+            progress: true,
+            ..Default::default()
+        };
+        let m = crate::metro::metro(&mesh, &out, &opts);
+        let _ = writeln!(text, "metro (input vs output):");
+        let _ = writeln!(text, "{m}");
+        say(&text);
+        json["check"] = serde_json::json!({
+            "against": "cleaned input",
+            "validity": validity,
+            "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
+            "valid": valid,
+        });
+        json["metro"] = serde_json::to_value(&m)?;
+    }
+    json["valid"] = serde_json::Value::Bool(valid);
+    if args.json {
+        crate::outln!("{}", serde_json::to_string_pretty(&json)?);
+    }
+    Ok(if valid {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)

@@ -47,7 +47,8 @@ mod sel {
     pub const BOARD: super::Board = super::Board::Mps2An505;
     #[cfg(feature = "board-mps2-an505")]
     pub const NAME: &str = "mps2-an505";
-    /// 4 MB of RAM, u32 links (a u16 workspace stops at 21 844 triangles): positions
+    /// 4 MB of RAM, u32 links (u16 links stop at 65 535 vertices and 65 535 triangles, below
+    /// this board's 106 000 triangles): positions
     /// 636 000 B, triangles 1 272 000 B, workspace 2 173 000 B; ~110 KB left for the stack.
     pub const MAX_VERTICES: usize = 53_000;
     pub const MAX_TRIANGLES: usize = 106_000;

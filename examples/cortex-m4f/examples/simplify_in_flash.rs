@@ -1,0 +1,92 @@
+//! A complete firmware for a Cortex-M4F board: simplifies a mesh kept in flash with a `static`
+//! workspace and logs the report through defmt.
+//!
+//! In QEMU (mps2-an386), from this folder, with `qemu-system-arm` installed:
+//!
+//! ```text
+//! cargo run --release --example simplify_in_flash --target thumbv7em-none-eabihf
+//! ```
+//!
+//! The runner in `.cargo/config.toml` starts QEMU through `host-sim run-elf`, which decodes
+//! the defmt log with this image's table and exits with the firmware's exit code (0: the target
+//! was reached). On a real board, switch to the commented probe-rs runner in the same file and
+//! to that board's `memory.x` (see build.rs); with probe-rs, defmt-rtt is the usual transport
+//! instead of defmt-semihosting (see Cargo.toml).
+
+#![no_std]
+#![no_main]
+
+use core::panic::PanicInfo;
+
+// The critical-section implementation defmt needs (cortex-m's `critical-section-single-core`).
+use cortex_m as _;
+use cortex_m_rt::entry;
+use defmt_semihosting as _;
+use static_cell::ConstStaticCell;
+use tinydecimate::{Config, Workspace};
+use tinydecimate_examples::saddle;
+
+/// The mesh's positions: a `static`, so in flash. The library only ever reads them.
+static POSITIONS: [[f32; 3]; saddle::VERTICES] = saddle::positions();
+
+/// The triangles, which the library rewrites in place: initialised from flash into RAM at
+/// boot (`.data`).
+static TRIANGLES: ConstStaticCell<[[u16; 3]; saddle::TRIANGLES]> =
+    ConstStaticCell::new(saddle::triangles());
+
+/// The workspace type: u16 links, sized for this mesh at compile time.
+type Ws = Workspace<u16, { saddle::VERTICES }, { saddle::TRIANGLES }>;
+
+/// The workspace: a `static` in `.bss` (`Workspace::new` is a `const fn`), never on the stack.
+static WORKSPACE: ConstStaticCell<Ws> = ConstStaticCell::new(Workspace::new());
+
+#[entry]
+fn main() -> ! {
+    let ws = WORKSPACE.take();
+    let triangles = TRIANGLES.take();
+    // The positions are read where they are: in flash, below RAM at 0x2000_0000 (mps2-an386's
+    // code memory, a real board's flash).
+    let at = POSITIONS.as_ptr() as usize;
+    defmt::info!(
+        "simplifying {} triangles over {} vertices in flash at {=usize:#x}; static workspace {} bytes",
+        saddle::TRIANGLES,
+        saddle::VERTICES,
+        at,
+        Ws::BYTES
+    );
+    if at >= 0x2000_0000 {
+        defmt::error!("the positions are not in flash");
+        exit(3);
+    }
+    match ws.simplify(&POSITIONS, triangles, &Config::new().with_ratio(0.25)) {
+        Ok(report) => {
+            defmt::info!("{}", report);
+            defmt::info!(
+                "kept {} of {} triangles; first: {}",
+                report.triangles_out,
+                report.triangles_in,
+                triangles[0]
+            );
+            exit(if report.target_reached { 0 } else { 1 })
+        }
+        Err(e) => {
+            defmt::error!("tinydecimate: {}", e);
+            exit(1)
+        }
+    }
+}
+
+/// Ends the QEMU run (semihosting SYS_EXIT) with `code` as its exit code.
+fn exit(code: i32) -> ! {
+    semihosting::process::exit(code)
+}
+
+#[panic_handler]
+fn panic(_: &PanicInfo) -> ! {
+    exit(101)
+}
+
+#[defmt::panic_handler]
+fn defmt_panic() -> ! {
+    exit(101)
+}
