@@ -98,6 +98,12 @@ pub enum ClusterError {
         /// Triangles needed, extrapolated.
         estimate: usize,
     },
+    /// More output vertices than the caller's vertex buffer holds
+    /// ([`cluster_then_collapse`]).
+    VerticesFull {
+        /// Vertices the buffer holds.
+        capacity: usize,
+    },
     /// The table has more cells than the output index type can number (cell numbers are
     /// stored in the output buffer while the stream runs).
     TableTooWide {
@@ -155,6 +161,9 @@ impl core::fmt::Display for ClusterError {
                 f,
                 "table of {cells} cells is too wide for an index type of {index_count} values"
             ),
+            ClusterError::VerticesFull { capacity } => {
+                write!(f, "vertex buffer of {capacity} is full")
+            }
             ClusterError::VertexTooWide { vertex } => {
                 write!(f, "vertex {vertex} does not fit the output index type")
             }
@@ -835,6 +844,55 @@ fn finish_report<I: Index>(
     })
 }
 
+/// Like [`finish_report`], but numbers the output vertices 0, 1, ... in order of first use and
+/// writes each one's input vertex number to `vertices`; returns the report and the count.
+fn finish_compact<I: Index>(
+    pass: &mut Pass<'_, I>,
+    passes: u32,
+    target: usize,
+    vertices: &mut [u32],
+) -> Result<(ClusterReport, usize), ClusterError> {
+    // The keys are no longer needed: they become the slot -> new number map.
+    let ids = core::mem::take(&mut pass.key);
+    ids.iter_mut().for_each(|k| *k = EMPTY);
+    let reps = core::mem::take(&mut pass.rep);
+    let mut nv = 0usize;
+    let mut full = false;
+    let out = pass.finish(|s| {
+        let id = ids.get_mut(s)?;
+        if *id == EMPTY {
+            let Some(slot) = vertices.get_mut(nv) else {
+                full = true;
+                return Some(0);
+            };
+            *slot = *reps.get(s)?;
+            *id = nv as u32;
+            nv += 1;
+        }
+        Some(*id)
+    });
+    if full {
+        return Err(ClusterError::VerticesFull {
+            capacity: vertices.len(),
+        });
+    }
+    let triangles_out = out?;
+    Ok((
+        ClusterReport {
+            triangles_in: pass.read,
+            triangles_out,
+            collapsed: pass.collapsed,
+            duplicates: pass.duplicates,
+            opposite_duplicates: pass.opposite,
+            cells: pass.cells,
+            grid: pass.grid,
+            passes,
+            target_triangles: target,
+        },
+        nv,
+    ))
+}
+
 impl<const CELLS: usize> Clusterer<CELLS> {
     /// Bytes per cell of the table (key, representative, its score).
     pub const BYTES_PER_CELL: usize = 12;
@@ -908,6 +966,33 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         config: &ClusterConfig,
         out: &mut [[I; 3]],
     ) -> Result<ClusterReport, ClusterError> {
+        self.cluster_into(source, quadrics, config, out, None)
+            .map(|(r, _)| r)
+    }
+
+    /// Like [`Clusterer::cluster`], but the output triangles use new vertex numbers 0, 1, ...
+    /// (in order of first use) and `vertices[i]` receives the input number of new vertex `i`:
+    /// a compact mesh for [`Workspace`](crate::Workspace). Returns the report and the number
+    /// of vertices. [`ClusterError::VerticesFull`] if `vertices` is too short.
+    pub fn cluster_compact<S: Source, I: Index>(
+        &mut self,
+        source: &mut S,
+        quadrics: Option<&mut Quadrics<CELLS>>,
+        config: &ClusterConfig,
+        out: &mut [[I; 3]],
+        vertices: &mut [u32],
+    ) -> Result<(ClusterReport, usize), ClusterError> {
+        self.cluster_into(source, quadrics, config, out, Some(vertices))
+    }
+
+    fn cluster_into<S: Source, I: Index>(
+        &mut self,
+        source: &mut S,
+        quadrics: Option<&mut Quadrics<CELLS>>,
+        config: &ClusterConfig,
+        out: &mut [[I; 3]],
+        vertices: Option<&mut [u32]>,
+    ) -> Result<(ClusterReport, usize), ClusterError> {
         let mut passes = 0u32;
         let (min, max) = match config.bbox {
             Some(b) => b,
@@ -947,7 +1032,10 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             // `collapsed` was counted twice.
             pass.collapsed /= 2;
         }
-        finish_report(&mut pass, passes, target)
+        match vertices {
+            Some(v) => finish_compact(&mut pass, passes, target, v),
+            None => finish_report(&mut pass, passes, target).map(|r| (r, 0)),
+        }
     }
 
     /// Search for the finest resolution (cells along the longest side) whose output fits
@@ -1082,6 +1170,99 @@ fn corners<P: Positions + ?Sized>(
         }
     }
     Ok(p)
+}
+
+/// Why [`cluster_then_collapse`] failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ThenCollapseError {
+    /// The clustering step failed.
+    Cluster(ClusterError),
+    /// The collapse step failed.
+    Collapse(crate::Error),
+}
+
+impl core::fmt::Display for ThenCollapseError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ThenCollapseError::Cluster(e) => write!(f, "clustering: {e}"),
+            ThenCollapseError::Collapse(e) => write!(f, "collapse: {e}"),
+        }
+    }
+}
+
+/// Cluster, then collapse: clusters `source` down to what fits `workspace` (at most its
+/// triangle capacity, `out.len()` and twice `vertices.len()` triangles; the grid is searched
+/// as for [`GridChoice::TargetTriangles`] unless `cluster_config` fixes it), copies the
+/// surviving vertices' positions into `positions` (RAM: 12 bytes per vertex), then runs the
+/// collapse engine with `config` (give it an absolute target with
+/// [`Config::with_target_triangles`](crate::Config::with_target_triangles)). On success the
+/// first `collapse.triangles_out` entries of `out` hold the result **in input vertex
+/// numbers**; `vertices` and `positions` are scratch. A small device thus gets collapse
+/// quality from a mesh it could never hold.
+#[allow(clippy::too_many_arguments)]
+pub fn cluster_then_collapse<
+    S: Source,
+    I: Index,
+    L: Index,
+    const CELLS: usize,
+    const V: usize,
+    const T: usize,
+>(
+    table: &mut Clusterer<CELLS>,
+    quadrics: Option<&mut Quadrics<CELLS>>,
+    workspace: &mut crate::Workspace<L, V, T>,
+    source: &mut S,
+    cluster_config: &ClusterConfig,
+    config: &crate::Config,
+    out: &mut [[I; 3]],
+    vertices: &mut [u32],
+    positions: &mut [[f32; 3]],
+) -> Result<(ClusterReport, crate::Report), ThenCollapseError> {
+    let mut cc = *cluster_config;
+    if let GridChoice::TargetTriangles(t) = cc.grid {
+        let fit = T
+            .min(out.len())
+            .min(vertices.len().saturating_mul(2))
+            .min(positions.len().saturating_mul(2))
+            .min(V.saturating_mul(2));
+        cc.grid = GridChoice::TargetTriangles(t.min(fit));
+    }
+    let nv_cap = vertices.len().min(positions.len());
+    let vbuf = vertices.get_mut(..nv_cap).unwrap_or(&mut []);
+    let (cr, nv) = table
+        .cluster_compact(source, quadrics, &cc, out, vbuf)
+        .map_err(ThenCollapseError::Cluster)?;
+    let (Some(vs), Some(ps), Some(tris)) = (
+        vertices.get(..nv),
+        positions.get_mut(..nv),
+        out.get_mut(..cr.triangles_out),
+    ) else {
+        return Err(ThenCollapseError::Cluster(ClusterError::VerticesFull {
+            capacity: nv_cap,
+        }));
+    };
+    for (p, &v) in ps.iter_mut().zip(vs) {
+        *p = source
+            .position(v as usize)
+            .ok_or(ThenCollapseError::Cluster(ClusterError::IndexOutOfRange {
+                triangle: 0,
+                index: v as usize,
+            }))?;
+    }
+    let report = workspace
+        .simplify(ps, tris, config)
+        .map_err(ThenCollapseError::Collapse)?;
+    let done = tris.get_mut(..report.triangles_out).unwrap_or(&mut []);
+    for t in done.iter_mut() {
+        for i in t.iter_mut() {
+            let v = vs.get(i.to_usize()).copied().unwrap_or(u32::MAX);
+            *i = I::from_usize(v as usize).ok_or(ThenCollapseError::Cluster(
+                ClusterError::VertexTooWide { vertex: v as usize },
+            ))?;
+        }
+    }
+    Ok((cr, report))
 }
 
 /// Runs one pass over the source; returns the triangles read.

@@ -305,3 +305,43 @@ proptest! {
         check("prop", &m, &out, &r);
     }
 }
+
+/// Cluster, then collapse: the bunny (69 451 triangles) through a workspace of 4 096
+/// triangles, to 600, in input vertex numbers, valid.
+#[test]
+fn cluster_then_collapse_fits_a_small_workspace() {
+    use tinydecimate::cluster::cluster_then_collapse;
+    use tinydecimate::{Config, Workspace};
+    let m = load_obj("stanford_bunny.obj");
+    let mut table = Box::new(Clusterer::<4096>::new());
+    let mut ws = Box::new(Workspace::<u16, 2048, 4096>::new());
+    let mut out = vec![[0u16; 3]; 4096];
+    let mut vertices = vec![0u32; 2048];
+    let mut positions = vec![[0.0f32; 3]; 2048];
+    let mut src = SliceSource::new(&m.positions, &m.triangles);
+    let (cr, r) = cluster_then_collapse(
+        &mut table,
+        None,
+        &mut ws,
+        &mut src,
+        &ClusterConfig::target(usize::MAX),
+        &Config::new().with_target_triangles(600),
+        &mut out,
+        &mut vertices,
+        &mut positions,
+    )
+    .unwrap();
+    eprintln!(
+        "cluster {} -> {} (grid {:?}), collapse -> {}",
+        cr.triangles_in, cr.triangles_out, cr.grid.dims, r.triangles_out
+    );
+    assert!(cr.triangles_out <= 4096 && cr.triangles_out > 2000);
+    assert!(r.triangles_out <= 600 && r.triangles_out > 500);
+    let tris: Vec<Tri> = out[..r.triangles_out]
+        .iter()
+        .map(|t| t.map(u32::from))
+        .collect();
+    let a = meshcheck::analyse(&m.positions, &tris);
+    assert_eq!(a.topology.duplicate_triangles, 0);
+    assert!(a.out_of_range.is_empty() && a.degenerate.is_empty());
+}
