@@ -265,80 +265,115 @@ fn to_u32(v: usize) -> u32 {
     u32::try_from(v).unwrap_or(u32::MAX)
 }
 
-/// A uniform grid of cubic cells.
+/// Fixed-point bits of a position inside the box (per axis, along the longest side).
+const QBITS: u32 = 20;
+const QMAX: u32 = (1 << QBITS) - 1;
+
+/// A uniform grid of cubic cells: `n` cells along the longest side of the bounding box.
+///
+/// A position is first quantised to 20-bit fixed point along the box's longest side
+/// (`q = floor((p - origin) · 2^20 / extent)`, one multiplication per axis), then its cell is
+/// `(q · n) >> 20`, in integers. So the counting passes of the target search test many
+/// resolutions for the price of one float conversion per corner, and every grid's cells are
+/// exactly `extent / n` wide: a requested cell size is rounded down to the next such width.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Grid {
     /// The corner of cell (0, 0, 0): the bounding box's minimum.
     pub origin: [f32; 3],
-    /// Edge length of a cell.
+    /// Edge length of a cell (`extent / n`).
     pub cell: f32,
     /// Cells along each axis (each at most [`MAX_RESOLUTION`]).
     pub dims: [u32; 3],
-    inv: f32,
+    /// Cells along the longest side.
+    pub n: u32,
+    /// `2^20 / extent`.
+    scale: f32,
 }
 
 impl Grid {
-    /// The grid of cells of edge `cell` over the box `min`..`max`.
+    /// The grid of cells of edge at most `cell` over the box `min`..`max` (the edge is
+    /// rounded down so that a whole number of cells spans the longest side).
     pub fn with_cell_size(min: [f32; 3], max: [f32; 3], cell: f32) -> Result<Grid, ClusterError> {
         if !(cell > 0.0 && cell.is_finite()) {
             return Err(ClusterError::InvalidGrid);
         }
-        let inv = 1.0 / cell;
-        if !inv.is_finite() {
+        let ext = extent(min, max)?;
+        let t = ext / cell;
+        if !(t.is_finite() && t <= MAX_RESOLUTION as f32) {
             return Err(ClusterError::InvalidGrid);
         }
-        let mut dims = [1u32; 3];
-        for (a, d) in dims.iter_mut().enumerate() {
-            let (lo, hi) = (get3(min, a), get3(max, a));
-            let e = (hi - lo) * inv;
-            if !(e >= 0.0 && e.is_finite() && lo.is_finite()) || e >= MAX_RESOLUTION as f32 {
-                return Err(ClusterError::InvalidGrid);
-            }
-            // `as` truncates: floor for e >= 0.
-            *d = (e as u32).saturating_add(1).min(MAX_RESOLUTION);
+        // ceil(t), written out (`as` truncates).
+        let mut n = t as u32;
+        if (n as f32) < t {
+            n += 1;
         }
-        Ok(Grid {
-            origin: min,
-            cell,
-            dims,
-            inv,
-        })
+        Grid::with_resolution(min, max, n)
     }
 
-    /// The grid with `n` cells (1..=[`MAX_RESOLUTION`]) along the longest side of the box.
+    /// The grid with `n` cells (clamped to 1..=[`MAX_RESOLUTION`]) along the longest side of
+    /// the box.
     pub fn with_resolution(min: [f32; 3], max: [f32; 3], n: u32) -> Result<Grid, ClusterError> {
         let n = n.clamp(1, MAX_RESOLUTION);
-        let ext = math::max_abs(math::sub(max, min));
-        if !(ext.is_finite() && ext >= 0.0) {
+        let ext = extent(min, max)?;
+        let scale = (1u32 << QBITS) as f32 / ext;
+        if !(scale.is_finite() && scale > 0.0) {
             return Err(ClusterError::InvalidGrid);
         }
-        // Slightly larger than ext/n so that the far side stays in cell n - 1.
-        let cell = if ext > 0.0 {
-            ext / n as f32 * (1.0 + 1.0 / 4096.0)
-        } else {
-            1.0
+        let mut g = Grid {
+            origin: min,
+            cell: ext / n as f32,
+            dims: [1; 3],
+            n,
+            scale,
         };
-        Grid::with_cell_size(min, max, cell)
+        let q = g.quantise(max);
+        g.dims = [
+            g.cell_of(q[0]) + 1,
+            g.cell_of(q[1]) + 1,
+            g.cell_of(q[2]) + 1,
+        ];
+        Ok(g)
     }
 
     /// Cells along the longest axis.
     pub fn resolution(&self) -> u32 {
-        self.dims[0].max(self.dims[1]).max(self.dims[2])
+        self.n
     }
 
-    /// The key of the cell holding `p` (positions outside the box go to the nearest cell).
+    /// 20-bit fixed-point coordinates of `p` in the box (clamped to it; NaN to 0).
     #[inline]
-    fn key(&self, p: V3) -> u32 {
-        let mut k = 0u32;
-        for a in 0..3 {
-            let t = (get3(p, a) - get3(self.origin, a)) * self.inv;
-            // Truncation is floor for t >= 0; NaN and negatives become 0, huge values saturate.
-            let i = if t > 0.0 { t as u32 } else { 0 };
-            let d = get3u(self.dims, a).saturating_sub(1);
-            k |= i.min(d) << (10 * a);
-        }
-        k
+    fn quantise(&self, p: V3) -> [u32; 3] {
+        let q = |a: usize| {
+            let t = (get3(p, a) - get3(self.origin, a)) * self.scale;
+            // Truncation is floor for t > 0.
+            if t >= QMAX as f32 {
+                QMAX
+            } else if t > 0.0 {
+                t as u32
+            } else {
+                0
+            }
+        };
+        [q(0), q(1), q(2)]
+    }
+
+    #[inline]
+    fn cell_of(&self, q: u32) -> u32 {
+        (q.min(QMAX) * self.n) >> QBITS
+    }
+
+    /// The key of the cell of quantised coordinates `q`.
+    #[inline]
+    fn key_q(&self, q: [u32; 3]) -> u32 {
+        self.cell_of(q[0]) | (self.cell_of(q[1]) << 10) | (self.cell_of(q[2]) << 20)
+    }
+
+    /// The key of the cell holding `p`: cell coordinates `x | y << 10 | z << 20` (positions
+    /// outside the box go to the nearest cell).
+    #[inline]
+    pub fn key(&self, p: [f32; 3]) -> u32 {
+        self.key_q(self.quantise(p))
     }
 
     /// Centre of the cell with key `k`.
@@ -361,17 +396,22 @@ impl Grid {
     }
 }
 
-#[inline]
-fn get3(v: [f32; 3], a: usize) -> f32 {
-    match a {
-        0 => v[0],
-        1 => v[1],
-        _ => v[2],
+/// The longest side of the box (1 for a single point), or an error for a box that is not
+/// finite.
+fn extent(min: [f32; 3], max: [f32; 3]) -> Result<f32, ClusterError> {
+    let d = math::sub(max, min);
+    if !(d[0] >= 0.0 && d[1] >= 0.0 && d[2] >= 0.0) {
+        return Err(ClusterError::InvalidGrid);
     }
+    let ext = math::max_abs(d);
+    if !ext.is_finite() {
+        return Err(ClusterError::InvalidGrid);
+    }
+    Ok(if ext > 0.0 { ext } else { 1.0 })
 }
 
 #[inline]
-fn get3u(v: [u32; 3], a: usize) -> u32 {
+fn get3(v: [f32; 3], a: usize) -> f32 {
     match a {
         0 => v[0],
         1 => v[1],
@@ -1137,9 +1177,14 @@ fn count<S: Source>(
         for t in chunk {
             let p = corners(&mut SourcePositions(&mut *source), t, index)?;
             index += 1;
+            // Every probe shares the origin and scale: quantise once.
+            let Some(g0) = grids.iter().flatten().next() else {
+                continue;
+            };
+            let q = [g0.quantise(p[0]), g0.quantise(p[1]), g0.quantise(p[2])];
             for (g, c) in grids.iter().zip(counts.iter_mut()) {
                 if let Some(g) = g {
-                    let k = [g.key(p[0]), g.key(p[1]), g.key(p[2])];
+                    let k = [g.key_q(q[0]), g.key_q(q[1]), g.key_q(q[2])];
                     if k[0] != k[1] && k[1] != k[2] && k[0] != k[2] {
                         *c += 1;
                     }
@@ -1367,11 +1412,13 @@ mod tests {
     #[test]
     fn keys_floor_and_clamp() {
         let g = Grid::with_cell_size([0.0; 3], [10.0; 3], 1.0).unwrap();
-        assert_eq!(g.dims, [11; 3]);
+        assert_eq!((g.n, g.dims), (10, [10; 3]));
         assert_eq!(g.key([0.5, 1.5, 2.5]), (2 << 20) | (1 << 10));
-        assert_eq!(g.key([-5.0, 99.0, 0.0]), 10 << 10);
+        assert_eq!(g.key([-5.0, 99.0, 10.0]), (9 << 20) | (9 << 10));
         let g = Grid::with_resolution([0.0; 3], [1.0, 2.0, 0.0], 8).unwrap();
-        assert_eq!(g.dims, [4, 8, 1]);
+        assert_eq!(g.dims, [5, 8, 1]);
+        let g = Grid::with_cell_size([0.0; 3], [1.0, 2.0, 0.0], 0.3).unwrap();
+        assert_eq!(g.n, 7);
     }
 
     #[test]
@@ -1382,6 +1429,10 @@ mod tests {
         );
         assert_eq!(
             Grid::with_cell_size([0.0; 3], [1.0; 3], 1e-4),
+            Err(ClusterError::InvalidGrid)
+        );
+        assert_eq!(
+            Grid::with_resolution([0.0; 3], [f32::INFINITY; 3], 4),
             Err(ClusterError::InvalidGrid)
         );
     }
