@@ -451,7 +451,7 @@ impl ClusterConfig {
         ClusterConfig {
             grid: GridChoice::TargetTriangles(triangles),
             bbox: None,
-            refine_passes: 3,
+            refine_passes: 2,
         }
     }
     /// Cells of edge `size`.
@@ -519,9 +519,18 @@ impl<const CELLS: usize> Default for Quadrics<CELLS> {
 /// representative vertex. 12 bytes per cell ([`Clusterer::BYTES_PER_CELL`]); keep it about
 /// 1.3x the occupied cells for short probes (it works up to completely full).
 pub struct Clusterer<const CELLS: usize> {
-    key: [u32; CELLS],
-    rep: [u32; CELLS],
-    best: [f32; CELLS],
+    slots: [Slot; CELLS],
+}
+
+/// One cell of the table: 12 bytes, in one place so that a probe touches one cache line.
+#[derive(Clone, Copy)]
+struct Slot {
+    /// Cell key ([`EMPTY`]: free).
+    key: u32,
+    /// Representative vertex.
+    rep: u32,
+    /// Its score (squared distance to the centre, or quadric error).
+    best: f32,
 }
 
 impl<const CELLS: usize> Default for Clusterer<CELLS> {
@@ -533,9 +542,7 @@ impl<const CELLS: usize> Default for Clusterer<CELLS> {
 /// One pass: the table, the output hash set and the counts.
 struct Pass<'a, I: Index> {
     grid: Grid,
-    key: &'a mut [u32],
-    rep: &'a mut [u32],
-    best: &'a mut [f32],
+    slots: &'a mut [Slot],
     quad: Option<&'a mut [[f32; 10]]>,
     out: &'a mut [[I; 3]],
     cells: usize,
@@ -588,22 +595,20 @@ impl<I: Index> Pass<'_, I> {
     /// The slot of cell `k`, inserted if new; `None` when the table is full.
     #[inline]
     fn cell(&mut self, k: u32) -> Option<usize> {
-        let n = self.key.len();
+        let n = self.slots.len();
         let mut s = slot_of(hash_key(k), n);
         for _ in 0..n {
-            match self.key.get(s).copied() {
+            match self.slots.get(s).map(|x| x.key) {
                 Some(EMPTY) => {
                     if self.choose {
                         return None;
                     }
-                    if let (Some(kk), Some(r), Some(b)) = (
-                        self.key.get_mut(s),
-                        self.rep.get_mut(s),
-                        self.best.get_mut(s),
-                    ) {
-                        *kk = k;
-                        *r = EMPTY;
-                        *b = f32::INFINITY;
+                    if let Some(x) = self.slots.get_mut(s) {
+                        *x = Slot {
+                            key: k,
+                            rep: EMPTY,
+                            best: f32::INFINITY,
+                        };
                     }
                     if let Some(q) = self.quad.as_deref_mut().and_then(|q| q.get_mut(s)) {
                         *q = [0.0; 10];
@@ -635,10 +640,10 @@ impl<I: Index> Pass<'_, I> {
             let d = math::sub(p, self.grid.centre(k));
             math::dot(d, d)
         };
-        if let (Some(r), Some(b)) = (self.rep.get_mut(s), self.best.get_mut(s)) {
-            if score < *b || (score == *b && v < *r) || *r == EMPTY {
-                *b = score;
-                *r = v;
+        if let Some(x) = self.slots.get_mut(s) {
+            if score < x.best || (score == x.best && v < x.rep) || x.rep == EMPTY {
+                x.best = score;
+                x.rep = v;
             }
         }
     }
@@ -742,7 +747,7 @@ impl<I: Index> Pass<'_, I> {
         };
         if self.cells_missed > 0 {
             return Err(ClusterError::TableFull {
-                capacity: self.key.len(),
+                capacity: self.slots.len(),
                 needed_at_least: self.cells + 1,
                 estimate: extrapolate(self.cells, self.cells_missed),
             });
@@ -867,9 +872,9 @@ fn finish_report<I: Index>(
     passes: u32,
     target: usize,
 ) -> Result<ClusterReport, ClusterError> {
-    let reps = core::mem::take(&mut pass.rep);
-    let out = pass.finish(|s| reps.get(s).copied());
-    pass.rep = reps;
+    let slots = core::mem::take(&mut pass.slots);
+    let out = pass.finish(|s| slots.get(s).map(|x| x.rep));
+    pass.slots = slots;
     let triangles_out = out?;
     Ok(ClusterReport {
         triangles_in: pass.read,
@@ -893,23 +898,22 @@ fn finish_compact<I: Index>(
     vertices: &mut [u32],
 ) -> Result<(ClusterReport, usize), ClusterError> {
     // The keys are no longer needed: they become the slot -> new number map.
-    let ids = core::mem::take(&mut pass.key);
-    ids.iter_mut().for_each(|k| *k = EMPTY);
-    let reps = core::mem::take(&mut pass.rep);
+    let slots = core::mem::take(&mut pass.slots);
+    slots.iter_mut().for_each(|x| x.key = EMPTY);
     let mut nv = 0usize;
     let mut full = false;
     let out = pass.finish(|s| {
-        let id = ids.get_mut(s)?;
-        if *id == EMPTY {
+        let x = slots.get_mut(s)?;
+        if x.key == EMPTY {
             let Some(slot) = vertices.get_mut(nv) else {
                 full = true;
                 return Some(0);
             };
-            *slot = *reps.get(s)?;
-            *id = nv as u32;
+            *slot = x.rep;
+            x.key = nv as u32;
             nv += 1;
         }
-        Some(*id)
+        Some(x.key)
     });
     if full {
         return Err(ClusterError::VerticesFull {
@@ -942,9 +946,11 @@ impl<const CELLS: usize> Clusterer<CELLS> {
     /// An empty table (`const`, so it can be a `static`).
     pub const fn new() -> Self {
         Clusterer {
-            key: [0; CELLS],
-            rep: [0; CELLS],
-            best: [0.0; CELLS],
+            slots: [Slot {
+                key: 0,
+                rep: 0,
+                best: 0.0,
+            }; CELLS],
         }
     }
 
@@ -953,6 +959,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         grid: Grid,
         quad: Option<&'a mut [[f32; 10]]>,
         out: &'a mut [[I; 3]],
+        active: usize,
     ) -> Result<Pass<'a, I>, ClusterError> {
         if CELLS > I::COUNT || CELLS > u32::MAX as usize - 1 {
             return Err(ClusterError::TableTooWide {
@@ -960,15 +967,20 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                 index_count: I::COUNT,
             });
         }
-        self.key.iter_mut().for_each(|k| *k = EMPTY);
+        // Only the first `active` cells take part (fewer cache lines for a small output).
+        let active = if active > 0 && active < CELLS {
+            active
+        } else {
+            CELLS
+        };
+        let slots = self.slots.get_mut(..active).unwrap_or(&mut []);
+        slots.iter_mut().for_each(|x| x.key = EMPTY);
         for e in out.iter_mut() {
             *e = [I::NIL; 3];
         }
         Ok(Pass {
             grid,
-            key: &mut self.key,
-            rep: &mut self.rep,
-            best: &mut self.best,
+            slots,
             quad,
             out,
             cells: 0,
@@ -991,7 +1003,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &'a mut [[I; 3]],
     ) -> Result<Stream<'a, I>, ClusterError> {
         Ok(Stream {
-            pass: self.pass(grid, None, out)?,
+            pass: self.pass(grid, None, out, CELLS)?,
         })
     }
 
@@ -1055,26 +1067,50 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         if passes > 0 && !source.rewind() {
             return Err(ClusterError::NotRereadable);
         }
-        let quad = quadrics.map(|q| &mut q.q[..]);
-        let has_quad = quad.is_some();
-        let mut pass = self.pass(grid, quad, out)?;
-        let total = run(&mut pass, source)?;
-        passes += 1;
-        pass.check_full(Some(total))?;
-        if has_quad {
-            if !source.rewind() {
+        let mut quad = quadrics.map(|q| &mut q.q[..]);
+        let mut vertices = vertices;
+        // A target bounds the output (the counts bound it from above) and, loosely, the cells:
+        // use a prefix of the table and of the buffer, and all of them if that fills.
+        let (mut ac, mut ao) = if target > 0 {
+            (
+                target.saturating_mul(2).saturating_add(64),
+                target.saturating_add(target / 4).saturating_add(16),
+            )
+        } else {
+            (CELLS, out.len())
+        };
+        let out_len = out.len();
+        loop {
+            if passes > 0 && !source.rewind() {
                 return Err(ClusterError::NotRereadable);
             }
-            pass.choose = true;
-            pass.read = 0;
-            run(&mut pass, source)?;
+            let (ac_now, ao_now) = (ac.min(CELLS), ao.min(out_len));
+            let o = out.get_mut(..ao_now).unwrap_or(&mut []);
+            let mut pass = self.pass(grid, quad.as_deref_mut(), o, ac_now)?;
+            let total = run(&mut pass, source)?;
             passes += 1;
-            // `collapsed` was counted twice.
-            pass.collapsed /= 2;
-        }
-        match vertices {
-            Some(v) => finish_compact(&mut pass, passes, target, v),
-            None => finish_report(&mut pass, passes, target).map(|r| (r, 0)),
+            let small_table = pass.cells_missed > 0 && ac_now < CELLS;
+            let small_out = pass.out_missed > 0 && ao_now < out_len;
+            if small_table || small_out {
+                (ac, ao) = (CELLS, usize::MAX);
+                continue;
+            }
+            pass.check_full(Some(total))?;
+            if pass.quad.is_some() {
+                if !source.rewind() {
+                    return Err(ClusterError::NotRereadable);
+                }
+                pass.choose = true;
+                pass.read = 0;
+                run(&mut pass, source)?;
+                passes += 1;
+                // `collapsed` was counted twice.
+                pass.collapsed /= 2;
+            }
+            return match vertices.as_deref_mut() {
+                Some(v) => finish_compact(&mut pass, passes, target, v),
+                None => finish_report(&mut pass, passes, target).map(|r| (r, 0)),
+            };
         }
     }
 
@@ -1104,22 +1140,22 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             }
             let mut n = [0u32; PROBES];
             if pass == 0 {
-                // 0.625, 0.875, 1.125 and 1.5 times the estimate.
-                for (slot, m) in n.iter_mut().zip([10u32, 14, 18, 24]) {
+                // 0.5, 0.75, 1, 1.44, 2.1 and 3 times the estimate (ratio about 1.43).
+                for (slot, m) in n.iter_mut().zip([8u32, 12, 16, 23, 34, 48]) {
                     *slot = (est.saturating_mul(m) / 16).clamp(1, MAX_RESOLUTION);
                 }
             } else if hi > MAX_RESOLUTION {
-                // Open above: 1.5, 2.25, 3.375 and 5.06 times the bracket's bottom.
+                // Open above: steps of 3/2 (at least 1) from the bracket's bottom.
                 let mut x = u64::from(lo.max(1));
                 for slot in n.iter_mut() {
-                    x = (x * 3).div_ceil(2);
+                    x = (x * 3).div_ceil(2).max(x + 1);
                     *slot = x.min(u64::from(MAX_RESOLUTION)) as u32;
                 }
             } else if lo == 0 {
-                // Open below: the top divided by 1.5, 2.25, ...
+                // Open below: steps of 2/3 (at least 1) from the top.
                 let mut x = u64::from(hi);
                 for slot in n.iter_mut() {
-                    x = x * 2 / 3;
+                    x = (x * 2 / 3).min(x.saturating_sub(1));
                     *slot = x.max(1) as u32;
                 }
             } else {
@@ -1155,7 +1191,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
 }
 
 /// Resolutions probed per counting pass of the target search.
-pub const PROBES: usize = 4;
+pub const PROBES: usize = 6;
 
 /// One counting pass: for each grid, the triangles whose corners fall into distinct cells.
 fn count<S: Source>(
