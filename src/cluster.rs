@@ -1428,7 +1428,8 @@ fn isqrt(n: usize) -> u32 {
     let mut y = x.div_ceil(2);
     while y < x {
         x = y;
-        y = (x + n / x) / 2;
+        // `checked_div`: x >= 1 here, but no division-by-zero path may link.
+        y = (x + n.checked_div(x).unwrap_or(n)) / 2;
     }
     x.min(u32::MAX as usize) as u32
 }
