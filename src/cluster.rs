@@ -19,8 +19,10 @@
 //!
 //! * **nearest** (no [`Quadrics`]): the vertex nearest the cell's centre, ties to the lower
 //!   index. One pass; [`Clusterer::BYTES_PER_CELL`] = 12 bytes per cell.
-//! * **quadric** (with [`Quadrics`]): Lindstrom's one plane quadric per cell (each triangle's
-//!   area-weighted plane added to the cells of its three corners), then, in a second pass, the
+//! * **quadric** (with [`Quadrics`]): Lindstrom's one plane quadric per cell (the area-weighted
+//!   plane of each triangle that survives, i.e. whose corners fall into three distinct cells,
+//!   added to those three cells; Lindstrom also adds the planes of the triangles that vanish,
+//!   this does not), then, in a second pass, the
 //!   vertex of the cell with the least quadric error, ties to the lower index.
 //!   12 + [`Quadrics::BYTES_PER_CELL`] = 52 bytes per cell.
 //!
