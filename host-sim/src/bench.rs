@@ -110,6 +110,10 @@ pub struct Args {
     /// Metro face samples per triangle of the larger mesh.
     #[arg(long, default_value_t = 10.0)]
     pub samples_per_triangle: f64,
+    /// Streaming vertex clustering (`tinydecimate::cluster`, quadric representative) against
+    /// meshoptimizer's `simplifySloppy` instead (table to --out only; default ratios 0.2,0.05).
+    #[arg(long)]
+    pub cluster: bool,
 }
 
 /// What one benchmark run does (the resolved [`Args`]).
@@ -1309,6 +1313,13 @@ fn command_line() -> String {
 
 /// `host-sim bench`. Always exit code 0 when it ran: a benchmark reports, it does not judge.
 pub fn run(args: &Args) -> Result<ExitCode> {
+    if args.cluster {
+        let (mut opts, _, _) = args.options();
+        if args.ratios.is_none() {
+            opts.ratios = vec![0.2, 0.05];
+        }
+        return crate::cluster::bench_run(&opts, args.out.as_deref());
+    }
     let (opts, out, json) = args.options();
     let results = bench(&opts, &command_line())?;
     let md = markdown(&results);

@@ -50,6 +50,7 @@ pub fn exit_code_for_io(e: &std::io::Error) -> i32 {
 
 pub mod bench;
 pub mod check;
+pub mod cluster;
 pub mod demo;
 pub mod golden;
 pub mod io;

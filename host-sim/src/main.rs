@@ -7,7 +7,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::{bench, check, demo, golden, metro, pm, qemu, render, simplify};
+use host_sim::{bench, check, cluster, demo, golden, metro, pm, qemu, render, simplify};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
@@ -20,6 +20,9 @@ struct Cli {
 enum Command {
     /// Simplify a mesh file with tinydecimate, then check and measure the result.
     Simplify(simplify::Args),
+    /// Streaming vertex clustering of a mesh file (by target count or cell size), optionally
+    /// followed by the collapse engine; prints counts, grid, table bytes, time, Metro error.
+    Cluster(cluster::Args),
     /// Metro surface distance between an original and a simplified mesh.
     Metro(metro::Args),
     /// Topology of both meshes and whether the second is a valid simplification of the first.
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Simplify(a) => simplify::run(a),
+        Command::Cluster(a) => cluster::run(a),
         Command::Metro(a) => metro::run(a),
         Command::Check(a) => check::run(a),
         Command::Render(a) => render::run(a),

@@ -14,6 +14,10 @@ use core::fmt::Write;
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
+use tinydecimate::cluster::{
+    cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
+    Quadrics, SliceSource, Source, ThenCollapseError,
+};
 use tinydecimate::cost::{Builtin, Cost, Move, NormalVariation, Quadric};
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
@@ -324,6 +328,147 @@ fn progressive<I: Index, const V: usize, const T: usize>() {
     d.progressive().set_level(input(12) as usize);
     black_box(d.mesh().triangles());
     black_box(stream::crc32(&bytes));
+/// A re-readable source whose triangles and positions are opaque, read in chunks of opaque
+/// size (the clusterer's entry points on input the optimiser cannot see).
+struct Opaque {
+    at: u32,
+}
+
+impl Source for Opaque {
+    fn rewind(&mut self) -> bool {
+        self.at = 0;
+        input(14) & 1 == 0
+    }
+    fn read(&mut self, buf: &mut [[u32; 3]]) -> usize {
+        let n = (input(self.at as usize) as usize).min(buf.len());
+        for (i, t) in buf.iter_mut().take(n).enumerate() {
+            *t = [input(i), input(i + 1), input(i + 2)];
+        }
+        self.at = self.at.wrapping_add(1);
+        n
+    }
+    fn position(&mut self, vertex: usize) -> Option<[f32; 3]> {
+        (vertex < input(3) as usize).then(|| {
+            [
+                opaque_f32(vertex),
+                opaque_f32(vertex + 1),
+                opaque_f32(vertex + 2),
+            ]
+        })
+    }
+}
+
+fn cluster_error(e: &ClusterError) {
+    let mut sink = Sink {
+        buf: [0; 160],
+        len: 0,
+    };
+    let _ = black_box(write!(sink, "{e}"));
+    black_box(&sink.buf);
+}
+
+fn run_cluster<I: Index, L: Index, const C: usize>() {
+    let mut table = black_box(Clusterer::<C>::new());
+    let mut quads = black_box(Quadrics::<C>::new());
+    black_box((Clusterer::<C>::BYTES, Clusterer::<C>::BYTES_PER_CELL));
+    let mut out: [[I; 3]; 64] = black_box([[I::ZERO; 3]; 64]);
+    let mut src = Opaque { at: 0 };
+    let grid = match input(5) & 3 {
+        0 => GridChoice::CellSize(opaque_f32(6)),
+        1 => GridChoice::Resolution(input(7)),
+        _ => GridChoice::TargetTriangles(input(8) as usize),
+    };
+    let mut config = ClusterConfig::target(input(9) as usize);
+    config.grid = grid;
+    config.refine_passes = input(10);
+    if input(11) & 1 == 0 {
+        config = config.with_bbox(
+            [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
+            [opaque_f32(4), opaque_f32(5), opaque_f32(6)],
+        );
+    }
+    black_box(ClusterConfig::cell_size(opaque_f32(12)));
+    let q = if input(12) & 1 == 0 {
+        Some(&mut quads)
+    } else {
+        None
+    };
+    match table.cluster(&mut src, q, &config, &mut out) {
+        Ok(r) => {
+            black_box(r);
+        }
+        Err(e) => cluster_error(&e),
+    }
+    // A slice source, and the single-pass stream with an accessor.
+    let positions: [[f32; 3]; 16] = black_box([[0.0; 3]; 16]);
+    let tris: [[I; 3]; 16] = black_box([[I::ZERO; 3]; 16]);
+    let (np, nt) = (input(3) as usize, input(4) as usize);
+    let (Some(p), Some(t)) = (positions.get(..np), tris.get(..nt)) else {
+        return;
+    };
+    let mut s = SliceSource::new(p, t);
+    match table.cluster(&mut s, None, &config, &mut out) {
+        Ok(r) => {
+            black_box(r);
+        }
+        Err(e) => cluster_error(&e),
+    }
+    let g = Grid::with_cell_size(
+        [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
+        [opaque_f32(4), opaque_f32(5), opaque_f32(6)],
+        opaque_f32(7),
+    );
+    let g = match g {
+        Ok(g) => g,
+        Err(e) => {
+            cluster_error(&e);
+            match Grid::with_resolution([0.0; 3], [opaque_f32(8); 3], input(9)) {
+                Ok(g) => g,
+                Err(e) => return cluster_error(&e),
+            }
+        }
+    };
+    black_box((g.resolution(), g.key([opaque_f32(10), opaque_f32(11), 0.0])));
+    let chunk: [[u32; 3]; 8] = black_box([[0; 3]; 8]);
+    let mut acc = PositionFn(|v: usize| p.get(v).copied());
+    match table.stream(g, &mut out) {
+        Ok(mut st) => {
+            let _ = st.push(chunk.get(..input(13) as usize).unwrap_or(&[]), &mut acc);
+            let mut pp = p;
+            let _ = st.push(&chunk, &mut pp);
+            match st.finish() {
+                Ok(r) => {
+                    black_box(r);
+                }
+                Err(e) => cluster_error(&e),
+            }
+        }
+        Err(e) => cluster_error(&e),
+    }
+    // Cluster, then collapse.
+    let mut ws = black_box(Workspace::<L, 48, 64>::new());
+    let mut vertices = [0u32; 48];
+    let mut pos = [[0.0f32; 3]; 48];
+    let ccfg = opaque_config();
+    match cluster_then_collapse(
+        &mut table,
+        None,
+        &mut ws,
+        &mut src,
+        &config,
+        &ccfg,
+        &mut out,
+        &mut vertices,
+        &mut pos,
+    ) {
+        Ok((c, r)) => {
+            black_box(c);
+            use_report(&r);
+        }
+        Err(ThenCollapseError::Cluster(e)) => cluster_error(&e),
+        Err(ThenCollapseError::Collapse(e)) => display(&e),
+    }
+    black_box(&out);
 }
 
 #[cfg(feature = "defmt")]
@@ -353,6 +498,8 @@ fn main() -> ! {
     run::<u32, u16, 96, 160>();
     progressive::<u16, 48, 80>();
     progressive::<u32, 48, 80>();
+    run_cluster::<u16, u16, 64>();
+    run_cluster::<u32, u32, 64>();
     loop {
         black_box(());
     }
