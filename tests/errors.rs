@@ -212,6 +212,30 @@ fn coordinates_near_f32_limits_simplify_like_small_ones() {
     assert_eq!(a.triangles.len(), b.triangles.len());
 }
 
+/// Positions are read through a power-of-two-exact normalisation, so scaling the input by a
+/// power of two (far from overflow and underflow) must give exactly the same triangles.
+#[test]
+fn power_of_two_scales_give_identical_bytes() {
+    for (name, m) in [("sphere", icosphere(3)), ("cow", load_obj("cow.obj"))] {
+        for c in [
+            Config::new().with_ratio(0.2),
+            Config::paper().with_ratio(0.2),
+        ] {
+            let (a, ra) = simplify(&m, &c);
+            for k in [-60i32, -8, 1, 20, 100] {
+                let f = 2f32.powi(k);
+                let scaled = MeshData {
+                    positions: m.positions.iter().map(|p| p.map(|x| x * f)).collect(),
+                    triangles: m.triangles.clone(),
+                };
+                let (b, rb) = simplify(&scaled, &c);
+                assert_eq!(a.triangles, b.triangles, "{name} at 2^{k}");
+                assert_eq!(ra, rb, "{name} at 2^{k}");
+            }
+        }
+    }
+}
+
 #[test]
 fn non_manifold_input_is_simplified_around_locked_vertices() {
     let mut m = grid(8, 8, 0.1);

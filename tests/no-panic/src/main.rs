@@ -328,6 +328,8 @@ fn progressive<I: Index, const V: usize, const T: usize>() {
     d.progressive().set_level(input(12) as usize);
     black_box(d.mesh().triangles());
     black_box(stream::crc32(&bytes));
+}
+
 /// A re-readable source whose triangles and positions are opaque, read in chunks of opaque
 /// size (the clusterer's entry points on input the optimiser cannot see).
 struct Opaque {
