@@ -45,14 +45,18 @@
 //!
 //! // A 16x16 grid of quads on z = 0: 512 triangles.
 //! let n = 17;
-//! let positions: Vec<[f32; 3]> =
-//!     (0..n * n).map(|i| [(i % n) as f32, (i / n) as f32, 0.0]).collect();
-//! let mut triangles = Vec::new();
+//! // Fixed arrays, as on a device (no heap anywhere).
+//! let mut positions = [[0.0f32; 3]; 17 * 17];
+//! for (i, p) in positions.iter_mut().enumerate() {
+//!     *p = [(i % n) as f32, (i / n) as f32, 0.0];
+//! }
+//! let mut triangles = [[0u32; 3]; 512];
 //! for y in 0..16u32 {
 //!     for x in 0..16u32 {
 //!         let v = y * 17 + x;
-//!         triangles.push([v, v + 1, v + 18]);
-//!         triangles.push([v, v + 18, v + 17]);
+//!         let q = ((y * 16 + x) * 2) as usize;
+//!         triangles[q] = [v, v + 1, v + 18];
+//!         triangles[q + 1] = [v, v + 18, v + 17];
 //!     }
 //! }
 //! let mut table = Clusterer::<256>::new();

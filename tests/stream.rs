@@ -34,9 +34,8 @@ impl Store {
     }
 }
 
-/// Simplifies `m` to `ratio` with a log, builds the progressive mesh and encodes it.
-/// Returns the stream, the levels' triangles by level, and the renumbered positions.
-fn encoded(m: &MeshData, ratio: f32, quantised: bool) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
+/// The simplifier's collapse log for `m` at `ratio`.
+fn collapse_log(m: &MeshData, ratio: f32) -> Vec<[u32; 2]> {
     let mut tris = m.triangles.clone();
     let mut log = vec![[0u32; 2]; m.positions.len()];
     let n = {
@@ -51,6 +50,13 @@ fn encoded(m: &MeshData, ratio: f32, quantised: bool) -> (Vec<u8>, Vec<Vec<Tri>>
         n
     };
     log.truncate(n);
+    log
+}
+
+/// Simplifies `m` to `ratio` with a log, builds the progressive mesh and encodes it.
+/// Returns the stream, the levels' triangles by level, and the renumbered positions.
+fn encoded(m: &MeshData, ratio: f32, quantised: bool) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
+    let log = collapse_log(m, ratio);
     let (v, t) = (m.positions.len(), m.triangles.len());
     let mut st = Store::new(v, t);
     let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
@@ -227,20 +233,7 @@ fn damaged_streams_fail_typed_and_keep_the_last_valid_level() {
 #[test]
 fn split_records_are_small() {
     let m = load_obj("cow.obj");
-    let mut tris = m.triangles.clone();
-    let mut log = vec![[0u32; 2]; m.positions.len()];
-    let n = {
-        let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
-        let mut s = ws
-            .start(&m.positions, &mut tris, &Config::new().with_ratio(0.02))
-            .unwrap()
-            .record_into(&mut log);
-        while !s.step(u32::MAX) {}
-        let n = s.records().len();
-        s.finish();
-        n
-    };
-    log.truncate(n);
+    let log = collapse_log(&m, 0.02);
     let (v, t) = (m.positions.len(), m.triangles.len());
     let mut st = Store::new(v, t);
     let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
