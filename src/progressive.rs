@@ -18,12 +18,15 @@
 //!   only moves the end of the prefix and rewrites the corners that change vertex.
 //!
 //! # Adjacency
-//! Each vertex keeps a singly linked list of its triangles *sorted by slot*. The order is a
-//! function of the current triangles alone (not of the history), which is what lets a split
-//! name the corners that move by their positions in the kept vertex's list: [`Split::moved`]
-//! is a bit mask over that list. A split takes the masked corners out of `s`'s list (they stay
-//! sorted) and appends the restored triangles (their slots are the largest). A collapse is
-//! the merge of two sorted lists. Both are O(valence).
+//! Each vertex keeps a singly linked list of its triangles *sorted by slot, largest first*.
+//! The order is a function of the current triangles alone (not of the history), which is what
+//! lets a split name the corners that move by their positions in the kept vertex's list:
+//! [`Split::moved`] is a bit mask over that list. A split takes the masked corners out of
+//! `s`'s list (they stay sorted) and puts the restored triangles, whose slots are the largest,
+//! at the heads of their corners' lists: O(1) each, where an ascending order would walk every
+//! list to its end. A collapse unlinks those same triangles from the heads, and merges two
+//! sorted lists. Both are O(valence); the largest-first order took the emulated M4F from 1 490
+//! to 821 instructions per split (`host-sim pm stream`).
 //!
 //! Memory: the triangle buffer, one link per corner and one list head per vertex (for `u16`:
 //! 12 bytes per input triangle and 2 per vertex), plus 16 bytes per [`Split`].
@@ -41,8 +44,8 @@ pub struct Split<I> {
     /// Triangles the split restores: 2 for an interior edge, 1 for a boundary edge. They sit
     /// in the buffer right after the level's prefix.
     pub restored: u8,
-    /// Which of `kept`'s triangles, counted in its list (by slot), go to the new vertex: bit
-    /// `p` for the `p`-th.
+    /// Which of `kept`'s triangles, counted in its list (by slot, largest first), go to the
+    /// new vertex: bit `p` for the `p`-th.
     pub moved: u64,
 }
 
@@ -81,8 +84,10 @@ pub enum ProgressiveError {
         /// The entry.
         entry: usize,
     },
-    /// The kept vertex of log entry `entry` has more than 64 triangles when the split is
-    /// undone, more than [`Split::moved`] can name.
+    /// The kept vertex of log entry `entry` has more than 64 triangles after the collapse and
+    /// one that the split moves lies past the 64th of its list, which [`Split::moved`] cannot
+    /// name. (A kept vertex of any valence is fine while the moved triangles are among its
+    /// first 64.)
     ValenceTooHigh {
         /// The entry.
         entry: usize,
@@ -106,7 +111,7 @@ impl core::fmt::Display for ProgressiveError {
             ProgressiveError::ValenceTooHigh { entry } => {
                 write!(
                     f,
-                    "log entry {entry}: the kept vertex has over 64 triangles"
+                    "log entry {entry}: a triangle the split moves lies past the 64th of the kept vertex's"
                 )
             }
         }
@@ -125,7 +130,7 @@ pub struct Storage<'a, I: Index> {
     pub splits: &'a mut [Split<I>],
 }
 
-/// Triangle lists per vertex, sorted by slot (see the module comment).
+/// Triangle lists per vertex, sorted by slot, largest first (see the module comment).
 pub(crate) struct Lists<'a, I: Index> {
     pub(crate) tris: &'a mut [[I; 3]],
     next: &'a mut [[I; 3]],
@@ -205,7 +210,7 @@ impl<'a, I: Index> Lists<'a, I> {
         let mut prev = NIL;
         let mut c = self.first(v);
         let mut guard = 0;
-        while c != NIL && c < t && guard <= self.tris.len() {
+        while c != NIL && c > t && guard <= self.tris.len() {
             prev = c;
             c = self.after(c, v);
             guard += 1;
@@ -264,7 +269,7 @@ impl<'a, I: Index> Lists<'a, I> {
         let mut fits = true;
         let mut pos = 0usize;
         while (a != NIL || b != NIL) && pos <= self.tris.len() {
-            let node = if b != NIL && (a == NIL || b < a) {
+            let node = if b != NIL && (a == NIL || b > a) {
                 let node = b;
                 b = self.after(b, t);
                 self.rename(node, t, s);
@@ -598,9 +603,9 @@ impl<'a, I: Index> Progressive<'a, I> {
         // removes the last triangles of the prefix and yields the split that undoes it.
         head.fill(I::NIL);
         let mut lists = Lists::new(tris, next, head);
-        for u in (0..full_triangles).rev() {
+        for u in 0..full_triangles {
             for v in lists.tri(u) {
-                // Pushing in front, slots descending: sorted.
+                // Pushing in front, slots ascending: largest first.
                 let first = lists.first(v);
                 lists.set_after(u, v, first);
                 lists.set_first(v, u);

@@ -29,7 +29,7 @@
 //! and the CRC-32 of all of that. Kinds, in this order: 1 base positions, 2 base triangles,
 //! 3 vertex splits. Payloads are bit-packed, least significant bit first; `bits(n)` is the
 //! width of a number below `n`.
-//! - **Position**: 3 × f32, or 3 × 16-bit `q` with `p = min + q·(max − min)/65535`.
+//! - **Position**: 3 × f32, or 3 × 16-bit `q` with `p = min·(1 − f) + max·f`, `f = q/65535`.
 //! - **Base triangle**: 3 vertex numbers, `bits(m₀)` each.
 //! - **Vertex split** creating vertex `t = m₀ + j`: a mode bit, the kept vertex `s`
 //!   (`bits(t)`), restored triangles − 1 (1 bit); `L` is the length of `s`'s list, known to
@@ -55,6 +55,10 @@ use crate::progressive::{Progressive, Split, Storage};
 pub const HEADER: usize = 56;
 /// Chunk header (`len`, `kind`, `count`) plus checksum: bytes around each payload.
 pub const CHUNK_OVERHEAD: usize = 9;
+/// The smallest chunk payload [`encode`] writes with: an upper bound on one record (a vertex
+/// split in explicit mode with 32-bit vertex numbers and an f32 position is at most 34 bytes).
+/// A smaller `max_payload` would let a record overflow its chunk.
+pub const MIN_PAYLOAD: u16 = 48;
 const MAGIC: [u8; 4] = *b"TDPM";
 const VERSION: u8 = 1;
 const KIND_POSITIONS: u8 = 1;
@@ -360,12 +364,19 @@ impl Header {
         }
     }
 
+    /// `q = round((x − min) / (max − min) · 65535)`. A box wider than the largest f32 (say
+    /// −3e38 to 3e38) is measured in halves, so its span does not overflow to infinity.
     fn quantise(&self, p: [f32; 3]) -> [u32; 3] {
         let mut q = [0; 3];
         for (((q, &x), &lo), &hi) in q.iter_mut().zip(&p).zip(&self.min).zip(&self.max) {
             let span = hi - lo;
+            let f = if span.is_finite() {
+                (x - lo) / span
+            } else {
+                (x * 0.5 - lo * 0.5) / (hi * 0.5 - lo * 0.5)
+            };
             if span > 0.0 {
-                let x = (x - lo) / span * 65535.0 + 0.5;
+                let x = f * 65535.0 + 0.5;
                 *q = if x >= 65535.0 {
                     65535
                 } else if x > 0.0 {
@@ -378,11 +389,15 @@ impl Header {
         q
     }
 
-    /// The position a decoder sees for quantised `q`.
+    /// The position a decoder sees for quantised `q`: `min·(1 − f) + max·f`, `f = q / 65535`.
+    /// The same point as `min + q·(max − min)/65535`, but exact at both ends, never an
+    /// overflow for a box wider than the largest f32, and as fine as the f32 grid allows for a
+    /// box of subnormal size (found by the `roundtrip` fuzz target).
     fn dequantise(&self, q: [u32; 3]) -> [f32; 3] {
         let mut p = [0.0; 3];
         for (((p, &q), &lo), &hi) in p.iter_mut().zip(&q).zip(&self.min).zip(&self.max) {
-            *p = lo + q as f32 * ((hi - lo) / 65535.0);
+            let f = q as f32 / 65535.0;
+            *p = lo * (1.0 - f) + hi * f;
         }
         p
     }
@@ -475,7 +490,8 @@ pub struct Encoded {
 
 /// Writes `pm`'s progressive stream into `out` and returns its sizes. `positions` are the
 /// input's, `order` maps new vertex numbers to them (both as [`Progressive::from_log`] left
-/// them). `max_payload` (16..=65535) bounds each chunk. `pm` ends at full resolution.
+/// them). `max_payload` bounds each chunk's payload; it is raised to [`MIN_PAYLOAD`], the
+/// largest single record, so every record fits a chunk. `pm` ends at full resolution.
 pub fn encode<I: Index>(
     pm: &mut Progressive<'_, I>,
     positions: &[[f32; 3]],
@@ -503,7 +519,7 @@ pub fn encode<I: Index>(
         base_vertices: pm.base_vertices() as u32,
         base_triangles: pm.base_triangles() as u32,
         triangles: pm.full_triangles() as u32,
-        max_payload: max_payload.max(16),
+        max_payload: max_payload.max(MIN_PAYLOAD),
         min: [f32::INFINITY; 3],
         max: [f32::NEG_INFINITY; 3],
     };
@@ -532,7 +548,7 @@ pub fn encode<I: Index>(
     chunks.raw(&head)?;
     pm.set_level(0);
     // Base positions and triangles.
-    let mut rec = [0u8; 48];
+    let mut rec = [0u8; MIN_PAYLOAD as usize];
     for v in 0..pm.base_vertices() {
         let mut w = BitWriter {
             out: &mut rec,
@@ -1017,10 +1033,10 @@ impl<'a, I: Index> Decoder<'a, I> {
         }
         let restored = r.get(1).ok_or(short)? as u8 + 1;
         let lists = &self.pm.lists;
+        // A kept vertex may have more than 64 triangles; the split's moved ones lie among the
+        // first 64 of its list (`Progressive::from_log` refuses a log where they do not), and
+        // the explicit mask has min(L, 64) bits, as the encoder writes it.
         let len = lists.len(s);
-        if len > 64 {
-            return Err(bad);
-        }
         let mut tris = [[I::ZERO; 3]; 2];
         let moved;
         if !explicit {
@@ -1036,7 +1052,7 @@ impl<'a, I: Index> Decoder<'a, I> {
                 tris[1] = arrange(ks2, !tn1, s, t, last.ok_or(bad)?).ok_or(bad)?;
             }
         } else {
-            moved = r.get(len as u32).ok_or(short)?;
+            moved = r.get(len.min(64) as u32).ok_or(short)?;
             for tri in tris.iter_mut().take(restored as usize) {
                 let ks = r.get(2).ok_or(short)? as usize;
                 let t_next = r.get(1).ok_or(short)? == 1;

@@ -56,6 +56,16 @@ fn collapse_log(m: &MeshData, ratio: f32) -> Vec<[u32; 2]> {
 /// Simplifies `m` to `ratio` with a log, builds the progressive mesh and encodes it.
 /// Returns the stream, the levels' triangles by level, and the renumbered positions.
 fn encoded(m: &MeshData, ratio: f32, quantised: bool) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
+    encoded_in_chunks(m, ratio, quantised, 256)
+}
+
+/// [`encoded`] with chunk payloads of at most `chunk` bytes.
+fn encoded_in_chunks(
+    m: &MeshData,
+    ratio: f32,
+    quantised: bool,
+    chunk: u16,
+) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
     let log = collapse_log(m, ratio);
     let (v, t) = (m.positions.len(), m.triangles.len());
     let mut st = Store::new(v, t);
@@ -70,7 +80,7 @@ fn encoded(m: &MeshData, ratio: f32, quantised: bool) -> (Vec<u8>, Vec<Vec<Tri>>
     )
     .unwrap();
     let mut out = vec![0u8; 64 * t + 4096];
-    let e = stream::encode(&mut pm, &m.positions, &order, quantised, 256, &mut out).unwrap();
+    let e = stream::encode(&mut pm, &m.positions, &order, quantised, chunk, &mut out).unwrap();
     out.truncate(e.bytes);
     pm.set_level(0);
     let mut levels = vec![pm.triangles().to_vec()];
@@ -139,29 +149,146 @@ fn round_trip_is_exact_at_every_level_and_any_chunking() {
     }
 }
 
+/// A chunk smaller than one record: the encoder raises it to `MIN_PAYLOAD`. Found by the
+/// `roundtrip` fuzz target (`fuzz/regressions/roundtrip-record-overflows-its-chunk`): a disc
+/// of 20 triangles around one centre, simplified to a single triangle, has explicit-mode
+/// splits of up to 20 mask bits, and with f32 positions one record outgrew a 16-byte chunk,
+/// which the decoder then rightly refused (`BadChunk`).
+#[test]
+fn records_larger_than_the_asked_chunk_still_fit() {
+    let mut positions = vec![[0.0f32; 3]];
+    let mut triangles = Vec::new();
+    for k in 0..20u32 {
+        let a = k as f32 * std::f32::consts::TAU / 20.0;
+        positions.push([a.cos(), a.sin(), 0.0]);
+        triangles.push([0, 1 + k, 1 + (k + 1) % 20]);
+    }
+    let disc = MeshData {
+        positions,
+        triangles,
+    };
+    let mut meshes = vec![("disc", disc, 0.0)];
+    for name in ["cow.obj", "plate_holes.obj"] {
+        meshes.push((name, load_obj(name), 0.05));
+    }
+    for (name, m, ratio) in meshes {
+        let (v, t) = (m.positions.len(), m.triangles.len());
+        let (bytes, levels, _) = encoded_in_chunks(&m, ratio, false, 16);
+        assert_eq!(
+            u16::from_le_bytes([bytes[24], bytes[25]]),
+            stream::MIN_PAYLOAD,
+            "{name}: max payload in the header"
+        );
+        let (r, level, _) = decode(&bytes, 13, &levels, v, t);
+        assert_eq!(r, Ok(()), "{name}");
+        assert_eq!(level, levels.len() - 1, "{name}");
+    }
+}
+
+/// A kept vertex with more than 64 triangles: the two apexes of a double cone over a rim of
+/// 68. Found by the `roundtrip` fuzz target
+/// (`fuzz/regressions/roundtrip-kept-vertex-over-64-triangles`): the encoder wrote the split
+/// (its moved triangles are among the first 64 of the list, so the mask names them) but the
+/// decoder refused any list longer than 64 (`BadSplit`).
+#[test]
+fn kept_vertices_of_high_valence_decode() {
+    let n = 68u32;
+    let mut positions = vec![[0.0f32, 0.0, 1.0]];
+    let mut triangles = Vec::new();
+    for k in 0..n {
+        let a = k as f32 * std::f32::consts::TAU / n as f32;
+        positions.push([a.cos(), a.sin(), 0.0]);
+        triangles.push([0, 1 + k, 1 + (k + 1) % n]);
+    }
+    // The bottom cone after the top one: the triangles a split moves to the rim vertex (its
+    // bottom ones) have the largest slots, so they head the apex's list.
+    for k in 0..n {
+        triangles.push([n + 1, 1 + (k + 1) % n, 1 + k]);
+    }
+    positions.push([0.0, 0.0, -1.0]);
+    let cone = MeshData {
+        positions,
+        triangles,
+    };
+    let (v, t) = (cone.positions.len(), cone.triangles.len());
+    // Rim vertex 5 onto the top apex (68 triangles before and after), then rim vertex 9.
+    let log = [[5u32, 0], [9, 0]];
+    let mut st = Store::new(v, t);
+    let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
+    let mut pm = Progressive::from_log(
+        &cone.triangles,
+        v,
+        &log,
+        st.storage(),
+        &mut order,
+        &mut scratch,
+    )
+    .unwrap();
+    let mut out = vec![0u8; 64 * t + 4096];
+    let e = stream::encode(&mut pm, &cone.positions, &order, false, 256, &mut out).unwrap();
+    out.truncate(e.bytes);
+    pm.set_level(0);
+    let mut levels = vec![pm.triangles().to_vec()];
+    while pm.refine(1) == 1 {
+        levels.push(pm.triangles().to_vec());
+    }
+    assert_eq!(levels.len(), 3);
+    let (r, level, _) = decode(&out, 5, &levels, v, t);
+    assert_eq!(r, Ok(()));
+    assert_eq!(level, 2);
+}
+
 #[test]
 fn quantised_positions_are_within_half_a_step() {
-    let m = load_obj("plate_holes.obj");
-    let (v, t) = (m.positions.len(), m.triangles.len());
-    let (bytes, levels, positions) = encoded(&m, 0.05, true);
-    let (r, _, pos) = decode(&bytes, 333, &levels, v, t);
-    assert_eq!(r, Ok(()));
+    let plate = load_obj("plate_holes.obj");
+    // As is; centred and blown up to ±3e38 (the box's span overflows f32); shrunk to
+    // subnormal size (the step is below the f32 grid). The last two were found by the
+    // `roundtrip` fuzz target.
+    let (mut c, mut r) = ([0f32; 3], 0f32);
+    let (lo0, hi0) = bbox(&plate.positions);
+    for k in 0..3 {
+        c[k] = 0.5 * (lo0[k] + hi0[k]);
+        r = r.max(0.5 * (hi0[k] - lo0[k]));
+    }
+    for scale in [None, Some(3e38f32), Some(1e-40f32)] {
+        let mut m = plate.clone();
+        if let Some(s) = scale {
+            for p in &mut m.positions {
+                for k in 0..3 {
+                    p[k] = (p[k] - c[k]) / r * s;
+                }
+            }
+        }
+        let (v, t) = (m.positions.len(), m.triangles.len());
+        let (bytes, levels, positions) = encoded(&m, 0.05, true);
+        let (res, _, pos) = decode(&bytes, 333, &levels, v, t);
+        assert_eq!(res, Ok(()), "scale {scale:?}");
+        let (lo, hi) = bbox(&positions);
+        for (a, b) in pos.iter().zip(&positions) {
+            for k in 0..3 {
+                // Half a step (the span taken in halves), plus rounding: a few ulps of the
+                // box's extent, and of the subnormal grid.
+                let tolerance = (hi[k] * 0.5 - lo[k] * 0.5) / 65535.0
+                    + 4.0 * f32::EPSILON * lo[k].abs().max(hi[k].abs())
+                    + 4.0 * f32::from_bits(1);
+                assert!(
+                    a[k].is_finite() && (a[k] - b[k]).abs() <= tolerance,
+                    "scale {scale:?}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}
+
+fn bbox(p: &[[f32; 3]]) -> ([f32; 3], [f32; 3]) {
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in &positions {
+    for p in p {
         for a in 0..3 {
             lo[a] = lo[a].min(p[a]);
             hi[a] = hi[a].max(p[a]);
         }
     }
-    for (a, b) in pos.iter().zip(&positions) {
-        for k in 0..3 {
-            let step = (hi[k] - lo[k]) / 65535.0;
-            assert!(
-                (a[k] - b[k]).abs() <= step * 0.5 + step * 1e-3,
-                "{a:?} vs {b:?}"
-            );
-        }
-    }
+    (lo, hi)
 }
 
 #[test]

@@ -27,8 +27,14 @@ fuzz_target!(|data: &[u8]| {
         let m = d.mesh();
         let nv = m.vertices();
         for t in m.triangles() {
-            assert!(t.iter().all(|&i| (i as usize) < nv), "{t:?} past {nv} vertices");
-            assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "degenerate {t:?}");
+            assert!(
+                t.iter().all(|&i| (i as usize) < nv),
+                "{t:?} past {nv} vertices"
+            );
+            assert!(
+                t[0] != t[1] && t[1] != t[2] && t[0] != t[2],
+                "degenerate {t:?}"
+            );
         }
         if r.is_err() {
             assert!(d.push(p).is_err(), "a failed decoder must stay failed");

@@ -257,6 +257,35 @@ impl CaseSpec {
 #[serde(deny_unknown_fields)]
 struct Manifest {
     case: Vec<CaseSpec>,
+    /// Progressive-stream cases (host-sim/src/streamcase.rs).
+    #[serde(default)]
+    stream: Vec<crate::streamcase::StreamSpec>,
+}
+
+/// The mesh of a case: a generator spec of [`meshfmt::golden`] or a file under `tests/`.
+pub fn load_mesh(name: &str, spec: &str) -> Result<meshfmt::golden::Mesh> {
+    Ok(match meshfmt::golden::generate(spec) {
+        Some(m) => m.map_err(|e| anyhow!("case {name}: {e:?}"))?,
+        None => {
+            let rel = Path::new(spec);
+            if rel.is_absolute() || !rel.starts_with("tests") {
+                bail!(
+                    "case {name}: mesh {spec:?} is neither a generator ({}) nor a file under tests/",
+                    meshfmt::golden::GENERATORS
+                        .iter()
+                        .map(|g| g.0)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                );
+            }
+            let m =
+                crate::io::load(repo_root().join(rel)).with_context(|| format!("case {name}"))?;
+            meshfmt::golden::Mesh {
+                positions: m.positions,
+                triangles: m.triangles,
+            }
+        }
+    })
 }
 
 /// A mesh and how to simplify it.
@@ -287,29 +316,7 @@ impl Case {
         {
             bail!("case name {name:?}: use letters, digits, '-' and '_'");
         }
-        let mut mesh = match meshfmt::golden::generate(&spec.mesh) {
-            Some(m) => m.map_err(|e| anyhow!("case {name}: {e:?}"))?,
-            None => {
-                let rel = Path::new(&spec.mesh);
-                if rel.is_absolute() || !rel.starts_with("tests") {
-                    bail!(
-                        "case {name}: mesh {:?} is neither a generator ({}) nor a file under tests/",
-                        spec.mesh,
-                        meshfmt::golden::GENERATORS
-                            .iter()
-                            .map(|g| g.0)
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    );
-                }
-                let m = crate::io::load(repo_root().join(rel))
-                    .with_context(|| format!("case {name}"))?;
-                meshfmt::golden::Mesh {
-                    positions: m.positions,
-                    triangles: m.triangles,
-                }
-            }
-        };
+        let mut mesh = load_mesh(name, &spec.mesh)?;
         let mut desc = spec.mesh.clone();
         if let Some(b) = spec.cut {
             let inside = |i: u32| {
@@ -365,21 +372,36 @@ pub fn load_cases(dir: &Path) -> Result<Vec<Case>> {
     load_specs(dir)?.iter().map(Case::from_spec).collect()
 }
 
-/// Reads the manifest `dir/cases.toml`.
+/// Reads the manifest `dir/cases.toml`: its simplification cases.
 pub fn load_specs(dir: &Path) -> Result<Vec<CaseSpec>> {
+    Ok(manifest(dir)?.case)
+}
+
+/// Reads the manifest `dir/cases.toml`: its progressive-stream cases.
+pub fn load_stream_specs(dir: &Path) -> Result<Vec<crate::streamcase::StreamSpec>> {
+    Ok(manifest(dir)?.stream)
+}
+
+fn manifest(dir: &Path) -> Result<Manifest> {
     let path = dir.join(MANIFEST);
     let text =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let m: Manifest = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
-    for (i, c) in m.case.iter().enumerate() {
-        if m.case[..i].iter().any(|d| d.name == c.name) {
-            bail!("{}: case {:?} twice", path.display(), c.name);
+    let names: Vec<&str> = m
+        .case
+        .iter()
+        .map(|c| c.name.as_str())
+        .chain(m.stream.iter().map(|c| c.name.as_str()))
+        .collect();
+    for (i, n) in names.iter().enumerate() {
+        if names[..i].contains(n) {
+            bail!("{}: case {n:?} twice", path.display());
         }
     }
     if m.case.is_empty() {
         bail!("{}: no cases", path.display());
     }
-    Ok(m.case)
+    Ok(m)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -818,6 +840,7 @@ pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
         );
     }
     let cases = load_cases(dir)?;
+    let streams = load_stream_specs(dir)?;
     let mut lines = Vec::new();
     for case in &cases {
         let new = Golden::of(case, backend, &reference(case)?)?;
@@ -849,7 +872,9 @@ pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
         .filter(|p| {
             let stem = p.file_stem().and_then(|s| s.to_str()).unwrap_or("");
             let ext = p.extension().and_then(|s| s.to_str()).unwrap_or("");
-            (ext == "txt" || ext == "bin") && !cases.iter().any(|c| c.name == stem)
+            (ext == "txt" || ext == "bin")
+                && !cases.iter().any(|c| c.name == stem)
+                && !streams.iter().any(|c| c.name == stem)
         })
         .collect();
     stale.sort();
@@ -894,6 +919,9 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         for l in bless(&a.dir, backend)? {
             crate::outln!("  {l}");
         }
+        for l in crate::streamcase::bless(&a.dir, backend)? {
+            crate::outln!("  {l}");
+        }
         return Ok(ExitCode::SUCCESS);
     }
     crate::outln!(
@@ -922,13 +950,29 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         }
         failed += usize::from(v.is_failure());
     }
+    let streams = crate::streamcase::check_host(&a.dir, backend)?;
+    for (case, v) in &streams {
+        crate::outln!(
+            "  {:<28} {:>4} V {:>5} T tdpm  {}",
+            case.name(),
+            case.vertices,
+            case.triangles,
+            v.cell()
+        );
+        match v {
+            Verdict::Diff(d) => d.iter().for_each(|l| crate::outln!("      {l}")),
+            Verdict::Failed(why) | Verdict::Skipped(why) => crate::outln!("      {why}"),
+            Verdict::Identical => {}
+        }
+        failed += usize::from(v.is_failure());
+    }
+    let total = results.len() + streams.len();
     if failed == 0 {
-        crate::outln!("{} cases identical", results.len());
+        crate::outln!("{total} cases identical");
         Ok(ExitCode::SUCCESS)
     } else {
         crate::outln!(
-            "{failed} of {} cases differ; if the change is intended: host-sim golden --bless --backend {backend}",
-            results.len()
+            "{failed} of {total} cases differ; if the change is intended: host-sim golden --bless --backend {backend}"
         );
         Ok(ExitCode::from(1))
     }

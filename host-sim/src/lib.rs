@@ -60,3 +60,4 @@ pub mod progress;
 pub mod qemu;
 pub mod render;
 pub mod simplify;
+pub mod streamcase;

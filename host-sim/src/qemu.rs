@@ -31,6 +31,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::{IndexType, Status};
 
 use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
+use crate::streamcase::StreamCase;
 
 /// An emulated board.
 #[derive(Clone, Copy, Debug)]
@@ -62,8 +63,13 @@ pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
     ("mps2-an500", &[]),
     ("mps2-an505", &[]),
 ];
-const MICROBIT_SKIPS: &[&str] = &["plate-new-u16", "cow-new-u16"];
-const LM3S_SKIPS: &[&str] = &["cow-new-u16"];
+const MICROBIT_SKIPS: &[&str] = &[
+    "plate-new-u16",
+    "cow-new-u16",
+    "pm-grid8",
+    "pm-cow-quantised",
+];
+const LM3S_SKIPS: &[&str] = &["cow-new-u16", "pm-cow-quantised"];
 
 /// Whether `board` is expected to skip `case` ([`EXPECTED_SKIPS`]).
 pub fn expected_skip(board: &str, case: &str) -> bool {
@@ -655,14 +661,37 @@ pub enum Expected {
     Host,
 }
 
-/// Runs `cases` on the host and on every board in `boards` and compares each output with the
-/// expectation. Prints a table cases × (host, boards) of identical / skipped / DIFF / FAILED,
+/// Runs one progressive stream through the firmware on `board` (it reads the stream in small
+/// pieces through semihosting); the output file (`meshfmt::pm`) is in `Run::result`.
+pub fn run_stream_bytes(
+    board: &Board,
+    elf: &Path,
+    stream: &[u8],
+    timeout: Duration,
+) -> Result<Run> {
+    let dir = scratch_dir(board.name)?;
+    std::fs::write(dir.join("stream.tdpm"), stream)?;
+    let run = run_in(
+        board,
+        elf,
+        &dir,
+        &["stream.tdpm", "out.bin"],
+        Some("out.bin"),
+        timeout,
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    run
+}
+
+/// Runs `cases` and the progressive `streams` on the host and on every board in `boards` and
+/// compares each output with the expectation. Prints a table cases × (host, boards) of identical / skipped / DIFF / FAILED,
 /// then a line for every cell that is not identical (board, case, first differing triangle or
 /// why it was skipped). Returns how many cells are DIFF or FAILED.
 pub fn check(
     boards: &[&'static Board],
     backend: Backend,
     cases: &[Case],
+    streams: &[StreamCase],
     expected: &Expected,
     timeout: Duration,
     verbose: bool,
@@ -692,6 +721,34 @@ pub fn check(
             }
         }
     }
+    // Stream cases: golden files only.
+    let mut stream_expect: Vec<Option<Golden>> = Vec::new();
+    for sc in streams {
+        let now = crate::streamcase::reference(sc);
+        let dir = match expected {
+            Expected::Golden(dir) => dir,
+            Expected::Host => bail!("stream cases are checked against golden files only"),
+        };
+        match Golden::load(dir, backend, sc.name())? {
+            Some(g) => {
+                host.push(crate::streamcase::judge(sc, backend, &g, &now));
+                stream_expect.push(Some(g));
+            }
+            None => {
+                host.push(Verdict::Failed(format!(
+                    "no golden files {}/{backend}/{}.txt|.bin",
+                    dir.display(),
+                    sc.name()
+                )));
+                stream_expect.push(None);
+            }
+        }
+    }
+    let names: Vec<&str> = cases
+        .iter()
+        .map(|c| c.name.as_str())
+        .chain(streams.iter().map(|c| c.name()))
+        .collect();
     let mut columns: Vec<(String, Vec<Verdict>)> = vec![("host".into(), host)];
     for b in boards {
         let t0 = Instant::now();
@@ -703,7 +760,7 @@ pub fn check(
                 eprintln!("{:<12} {why}", b.name);
                 columns.push((
                     b.name.to_string(),
-                    cases.iter().map(|_| Verdict::Failed(why.clone())).collect(),
+                    names.iter().map(|_| Verdict::Failed(why.clone())).collect(),
                 ));
                 continue;
             }
@@ -724,11 +781,27 @@ pub fn check(
             };
             col.push(against_expected_skips(b.name, &case.name, v));
         }
+        for (sc, exp) in streams.iter().zip(&stream_expect) {
+            let v = match (run_stream_bytes(b, &elf, &sc.stream, timeout), exp) {
+                (Err(e), _) => Verdict::Failed(format!("{e:#}")),
+                (Ok(run), Some(g)) => match (&run.result, run.ok()) {
+                    (Some(out), true) => {
+                        if verbose {
+                            crate::outln!("{} / {}: {}", b.name, sc.name(), run.describe());
+                        }
+                        crate::streamcase::judge(sc, backend, g, out)
+                    }
+                    _ => Verdict::Failed(format!("no result: {}", run.describe())),
+                },
+                (Ok(_), None) => Verdict::Failed("no golden files".into()),
+            };
+            col.push(against_expected_skips(b.name, sc.name(), v));
+        }
         eprintln!(
             "{:<12} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
             b.name,
             built.as_secs_f64(),
-            cases.len(),
+            names.len(),
             (t0.elapsed() - built).as_secs_f64()
         );
         columns.push((b.name.to_string(), col));
@@ -739,15 +812,15 @@ pub fn check(
         Expected::Host => format!("the library on the host ({backend})"),
     };
     crate::outln!("\ncases x boards, compared with {what}:\n");
-    let name_w = cases.iter().map(|c| c.name.len()).max().unwrap_or(4).max(4);
+    let name_w = names.iter().map(|n| n.len()).max().unwrap_or(4).max(4);
     let col_w: Vec<usize> = columns.iter().map(|(n, _)| n.len().max(9)).collect();
     let mut line = format!("{:<name_w$}", "case");
     for ((n, _), w) in columns.iter().zip(&col_w) {
         line.push_str(&format!("  {n:<w$}"));
     }
     crate::outln!("{}", line.trim_end());
-    for (i, case) in cases.iter().enumerate() {
-        let mut line = format!("{:<name_w$}", case.name);
+    for (i, name) in names.iter().enumerate() {
+        let mut line = format!("{name:<name_w$}");
         for ((_, col), w) in columns.iter().zip(&col_w) {
             line.push_str(&format!("  {:<w$}", col[i].cell()));
         }
@@ -756,26 +829,24 @@ pub fn check(
     let (mut same, mut skipped, mut failed) = (0, 0, 0);
     let mut details = Vec::new();
     for (n, col) in &columns {
-        for (case, v) in cases.iter().zip(col) {
+        for (case, v) in names.iter().zip(col) {
             match v {
                 Verdict::Identical => same += 1,
                 Verdict::Skipped(why) => {
                     skipped += 1;
-                    details.push(format!("skipped  {n} / {}: {why}", case.name));
+                    details.push(format!("skipped  {n} / {case}: {why}"));
                 }
                 Verdict::Diff(d) => {
                     failed += 1;
                     details.push(format!(
-                        "DIFF     {n} / {}: {}",
-                        case.name,
+                        "DIFF     {n} / {case}: {}",
                         d.join("\n           ")
                     ));
                 }
                 Verdict::Failed(why) => {
                     failed += 1;
                     details.push(format!(
-                        "FAILED   {n} / {}: {}",
-                        case.name,
+                        "FAILED   {n} / {case}: {}",
                         why.replace('\n', "\n           ")
                     ));
                 }
@@ -917,6 +988,28 @@ pub struct Measurement {
     pub cases: Vec<CaseMeasurement>,
     /// The largest mesh, per index type.
     pub largest: Vec<Largest>,
+    /// The golden progressive streams, decoded on the board.
+    pub streams: Vec<StreamMeasurement>,
+}
+
+/// One golden stream decoded on a board (`meshfmt::pm::run`).
+#[derive(Clone, Debug)]
+pub struct StreamMeasurement {
+    /// Case name.
+    pub name: String,
+    /// Vertex splits received, and the trailer's tick counts converted to instructions:
+    /// decoding, coarsening every level, refining every level.
+    pub splits: u32,
+    /// See `splits`.
+    pub decode: u64,
+    /// See `splits`.
+    pub coarsen: u64,
+    /// See `splits`.
+    pub refine: u64,
+    /// Stack of the run.
+    pub stack_bytes: u32,
+    /// identical / skipped / DIFF / FAILED against the golden files.
+    pub verdict: &'static str,
 }
 
 /// One measured case.
@@ -1069,6 +1162,7 @@ pub fn measure(
     board: &'static Board,
     backend: Backend,
     cases: &[Case],
+    stream_cases: &[StreamCase],
     timeout: Duration,
 ) -> Result<Measurement> {
     let without = build(board, backend, false)?;
@@ -1144,6 +1238,29 @@ pub fn measure(
         );
         largest.push(l);
     }
+    let mut streams = Vec::new();
+    for sc in stream_cases {
+        let expected =
+            crate::streamcase::golden_of(sc, backend, &crate::streamcase::reference(sc))?;
+        let run = run_stream_bytes(board, &elf, &sc.stream, timeout)?;
+        let (verdict, summary) = match (&run.result, run.ok()) {
+            (Some(o), true) => (
+                crate::streamcase::judge(sc, backend, &expected, o).cell(),
+                meshfmt::pm::parse(o).map(|(_, s)| s),
+            ),
+            _ => ("FAILED", None),
+        };
+        let s = summary.unwrap_or_default();
+        streams.push(StreamMeasurement {
+            name: sc.name().to_string(),
+            splits: s.splits,
+            decode: board.instructions(s.decode_ticks),
+            coarsen: board.instructions(s.coarsen_ticks),
+            refine: board.instructions(s.refine_ticks),
+            stack_bytes: s.stack_bytes,
+            verdict,
+        });
+    }
     Ok(Measurement {
         board,
         backend,
@@ -1155,6 +1272,7 @@ pub fn measure(
         capacity,
         cases: out,
         largest,
+        streams,
     })
 }
 
@@ -1266,6 +1384,32 @@ pub fn print_measurement(m: &Measurement) {
             l.wall.as_secs_f64()
         );
     }
+    crate::outln!(
+        "  {:<26} {:>6} {:>13} {:>13} {:>13} {:>9}  vs host   [progressive streams, instructions per split]",
+        "stream",
+        "splits",
+        "decode",
+        "collapse",
+        "split",
+        "stack"
+    );
+    for st in &m.streams {
+        if st.verdict != "identical" {
+            crate::outln!("  {:<26} {}", st.name, st.verdict);
+            continue;
+        }
+        let per = |x: u64| format!("{:.0}", x as f64 / f64::from(st.splits.max(1)));
+        crate::outln!(
+            "  {:<26} {:>6} {:>13} {:>13} {:>13} {:>9}  {}",
+            st.name,
+            st.splits,
+            per(st.decode),
+            per(st.coarsen),
+            per(st.refine),
+            st.stack_bytes,
+            st.verdict
+        );
+    }
 }
 
 /// The summary table of several boards' measurements.
@@ -1349,7 +1493,8 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["mesh", "measure", "smoke", "handlers"])]
     pub check: bool,
     /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
-    /// collapse and stack; per board the image sizes of the firmware and of the library alone,
+    /// collapse and stack; per golden progressive stream, instructions per split decoding and
+    /// per collapse / split moving the slider; per board the image sizes of the firmware and of the library alone,
     /// the flash of one instantiation (`tests/flash`, as `scripts/flash.sh` measures it) and the
     /// largest mesh it simplifies (bisection). Not pass/fail.
     #[arg(long)]
@@ -1407,9 +1552,10 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     let mut failed = 0usize;
     if a.measure {
         let cases = golden::load_cases(&a.dir)?;
+        let streams = crate::streamcase::load(&a.dir)?;
         let mut all = Vec::new();
         for b in &boards {
-            let m = measure(b, backend, &cases, timeout)?;
+            let m = measure(b, backend, &cases, &streams, timeout)?;
             print_measurement(&m);
             all.push(m);
         }
@@ -1487,7 +1633,14 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 },
             ),
         };
-        failed = check(&boards, backend, &cases, &expected, timeout, a.verbose)?;
+        // Stream cases only against the golden files (with --mesh there are none).
+        let streams = match (&a.mesh, &expected) {
+            (None, _) => crate::streamcase::load(&a.dir)?,
+            (Some(_), _) => Vec::new(),
+        };
+        failed = check(
+            &boards, backend, &cases, &streams, &expected, timeout, a.verbose,
+        )?;
     }
     Ok(if failed == 0 {
         ExitCode::SUCCESS
@@ -1553,6 +1706,7 @@ mod tests {
             ("mps2-an505", 53_000, 106_000, 4),
         ];
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
+        let streams = crate::streamcase::load(&golden::default_dir()).unwrap();
         for (board, v, t, link) in caps {
             let too_big: Vec<&str> = cases
                 .iter()
@@ -1562,6 +1716,21 @@ mod tests {
                     c.positions.len() > v || c.triangles.len() > fit
                 })
                 .map(|c| c.name.as_str())
+                .collect();
+            // Streams: PM_VERTICES vertices, half the triangle buffer of links, PM_BUFFER.
+            let (pv, pbuf) = match board {
+                "microbit" => (44, 80),
+                "lm3s6965evb" => (100, 272),
+                _ => (4_000, 4_096),
+            };
+            let too_big: Vec<&str> = too_big
+                .into_iter()
+                .chain(
+                    streams
+                        .iter()
+                        .filter(|c| !c.fits(pv, (t * 3 * link - pv * link) / (6 * link), pbuf))
+                        .map(|c| c.name()),
+                )
                 .collect();
             let listed: Vec<&str> = EXPECTED_SKIPS
                 .iter()

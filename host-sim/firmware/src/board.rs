@@ -17,6 +17,11 @@ mod sel {
     pub const MAX_VERTICES: usize = 240;
     pub const MAX_TRIANGLES: usize = 440;
     pub type Link = u16;
+    /// Progressive streams (`pm-*` cases): 44 vertex splits (704 B) and an 80 B chunk buffer
+    /// (chunks of up to 71 B), taken from the stack's slack; triangles, their links, the list
+    /// heads and the positions reuse the buffers above.
+    pub const PM_VERTICES: usize = 44;
+    pub const PM_BUFFER: usize = 80;
 }
 
 #[cfg(feature = "board-lm3s6965evb")]
@@ -27,6 +32,9 @@ mod sel {
     pub const MAX_VERTICES: usize = 1_250;
     pub const MAX_TRIANGLES: usize = 2_400;
     pub type Link = u16;
+    /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer.
+    pub const PM_VERTICES: usize = 100;
+    pub const PM_BUFFER: usize = 272;
 }
 
 #[cfg(any(
@@ -53,6 +61,10 @@ mod sel {
     pub const MAX_VERTICES: usize = 53_000;
     pub const MAX_TRIANGLES: usize = 106_000;
     pub type Link = u32;
+    /// Progressive streams: 4 000 vertex splits (64 000 B: the cow's 2 844 fit) and a 4 KB
+    /// chunk buffer.
+    pub const PM_VERTICES: usize = 4_000;
+    pub const PM_BUFFER: usize = 4_096;
 }
 
 pub use sel::*;
@@ -77,3 +89,29 @@ pub struct TriangleBytes(pub [u8; TRIANGLE_BYTES]);
 
 #[cfg(feature = "lib")]
 pub type Workspace = tinydecimate::Workspace<Link, MAX_VERTICES, MAX_TRIANGLES>;
+
+/// What a progressive stream needs beyond the triangle and position buffers (which it reuses:
+/// the triangle bytes hold a list head per vertex, then the triangles and their links): a split
+/// record per vertex and a chunk buffer. All zero, so a `static` of it is in `.bss`.
+#[cfg(feature = "lib")]
+pub struct PmArena {
+    pub splits: [tinydecimate::progressive::Split<Link>; PM_VERTICES],
+    pub buffer: [u8; PM_BUFFER],
+}
+
+#[cfg(feature = "lib")]
+impl PmArena {
+    pub const fn new() -> Self {
+        PmArena {
+            splits: [tinydecimate::progressive::Split::EMPTY; PM_VERTICES],
+            buffer: [0; PM_BUFFER],
+        }
+    }
+}
+
+/// Bytes of the list heads at the start of the triangle buffer (4-aligned).
+pub const PM_HEAD_BYTES: usize = (PM_VERTICES * core::mem::size_of::<Link>() + 3) & !3;
+/// Triangles of a progressive stream: what is left of the triangle buffer after the heads,
+/// halved (triangles, links).
+pub const PM_TRIANGLES: usize =
+    (TRIANGLE_BYTES - PM_HEAD_BYTES) / (2 * 3 * core::mem::size_of::<Link>());

@@ -89,6 +89,27 @@ pub fn create(path: &str) -> Result<File, IoError> {
     File::create(p.as_cstr()).map_err(|_| IoError::Open)
 }
 
+/// The first four bytes of a file (shorter files: zero-padded).
+#[inline(never)]
+pub fn magic(path: &str) -> Result<[u8; 4], IoError> {
+    let mut f = open(path)?;
+    let mut m = [0u8; 4];
+    let mut at = 0;
+    while at < m.len() {
+        let n = read_some(&mut f, m.get_mut(at..).unwrap_or(&mut []))?;
+        if n == 0 {
+            break;
+        }
+        at += n;
+    }
+    Ok(m)
+}
+
+/// Reads what is there, up to `buf.len()` bytes; 0 at the end of the file.
+pub fn read_some(f: &mut File, buf: &mut [u8]) -> Result<usize, IoError> {
+    f.read(buf).map_err(|_| IoError::Read)
+}
+
 pub fn read_exact(f: &mut File, buf: &mut [u8]) -> Result<(), IoError> {
     f.read_exact(buf).map_err(|_| IoError::Read)
 }

@@ -4,7 +4,9 @@
 //! `<program> <case file> <result file>`: the firmware reads the case (mesh + configuration,
 //! format in host-sim/meshfmt) through semihosting file I/O into static buffers sized per board
 //! (src/board.rs), simplifies it, and writes the result file. One image per board serves every
-//! case. Without arguments it simplifies a built-in grid (self-test, e.g. under `cargo run`).
+//! case. A progressive stream (`.tdpm`, magic `TDPM`) instead of a case is decoded as it is
+//! read, in small pieces, and the mesh written out as it refines (`meshfmt::pm`). Without
+//! arguments it simplifies a built-in grid (self-test, e.g. under `cargo run`).
 //!
 //! Logs are defmt frames on semihosting stdout (defmt-semihosting), decoded by the host with
 //! the image's ELF. Nothing else writes to stdout. Exit status through SYS_EXIT_EXTENDED:
@@ -75,7 +77,12 @@ fn main() -> ! {
             }
         },
         (Some(case), Some(out)) => {
-            match run_case(&mut cp.SYST, case, out, positions, triangles, result) {
+            let run = match hostio::magic(case) {
+                Ok(m) if m == *b"TDPM" => run_stream(&mut cp.SYST, case, out, positions, triangles),
+                Ok(_) => run_case(&mut cp.SYST, case, out, positions, triangles, result),
+                Err(e) => Err(e),
+            };
+            match run {
                 Ok(()) => 0,
                 Err(e) => {
                     defmt::error!("host file I/O failed: {}", e);
@@ -175,6 +182,131 @@ fn write_result(out_path: &str, result: &ResultHeader, triangles: &[u8]) -> Resu
     hostio::write_all(&mut out, triangles)?;
     defmt::info!("wrote {=str}", out_path);
     Ok(())
+}
+
+/// Decodes the progressive stream in `in_path` as it is read (pieces of 1 to 128 bytes), and
+/// writes the meshes along the way, the slider's round trip and the trailer to `out_path`
+/// (`meshfmt::pm::run`, the same code the host runs). The triangle buffer lends its bytes to
+/// the list heads, the triangles and their links; the positions buffer holds the positions.
+#[cfg(feature = "lib")]
+fn run_stream(
+    syst: &mut SYST,
+    in_path: &str,
+    out_path: &str,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [u8],
+) -> Result<(), IoError> {
+    static ARENA: ConstStaticCell<board::PmArena> = ConstStaticCell::new(board::PmArena::new());
+    let arena = ARENA.take();
+    let (heads, rest) = triangles.split_at_mut(board::PM_HEAD_BYTES);
+    let tri_bytes = board::PM_TRIANGLES * 3 * core::mem::size_of::<board::Link>();
+    let (tris, rest) = rest.split_at_mut(tri_bytes);
+    let links = rest.get_mut(..tri_bytes).ok_or(IoError::Read)?;
+    let heads =
+        bytemuck::try_cast_slice_mut::<u8, board::Link>(heads).map_err(|_| IoError::Read)?;
+    let tris =
+        bytemuck::try_cast_slice_mut::<u8, [board::Link; 3]>(tris).map_err(|_| IoError::Read)?;
+    let links =
+        bytemuck::try_cast_slice_mut::<u8, [board::Link; 3]>(links).map_err(|_| IoError::Read)?;
+    let half = tris.len();
+    let storage = tinydecimate::progressive::Storage {
+        triangles: tris,
+        links,
+        heads,
+        splits: &mut arena.splits,
+    };
+    let mut dev = StreamDevice {
+        input: hostio::open(in_path)?,
+        output: hostio::create(out_path)?,
+        syst,
+    };
+    defmt::info!(
+        "stream {=str}: room for {=usize} vertices, {=usize} triangles, chunks of {=usize} B",
+        in_path,
+        board::PM_VERTICES.min(positions.len()),
+        half,
+        board::PM_BUFFER - tinydecimate::stream::CHUNK_OVERHEAD
+    );
+    let sp = measure::paint();
+    let mut s = meshfmt::pm::run(&mut dev, storage, positions, &mut arena.buffer)?;
+    let low = measure::lowest_touched();
+    if measure::overflowed(low) {
+        defmt::panic!("stack overflow: no painted word left below the decoder's frames");
+    }
+    s.stack_bytes = sp.saturating_sub(low) as u32;
+    s.board = board::BOARD as u8;
+    match s.error {
+        None => defmt::info!(
+            "complete: {=u32} triangles, {=u32} vertices from {=u32} B",
+            s.triangles,
+            s.vertices,
+            s.bytes
+        ),
+        Some(e) => defmt::warn!(
+            "stream error {=u8} ({=u32}, {=u32}) after {=u32} B: the mesh stays at {=u32} triangles",
+            e.code,
+            e.a,
+            e.b,
+            s.bytes,
+            s.triangles
+        ),
+    }
+    defmt::info!(
+        "{=u64} ticks decoding, {=u64} coarsening and {=u64} refining {=u32} levels; stack {=u32} B",
+        s.decode_ticks,
+        s.coarsen_ticks,
+        s.refine_ticks,
+        s.splits,
+        s.stack_bytes
+    );
+    hostio::write_all(&mut dev.output, &s.to_bytes())?;
+    defmt::info!("wrote {=str}", out_path);
+    Ok(())
+}
+
+#[cfg(not(feature = "lib"))]
+fn run_stream(
+    _syst: &mut SYST,
+    _in_path: &str,
+    _out_path: &str,
+    _positions: &mut [[f32; 3]],
+    _triangles: &mut [u8],
+) -> Result<(), IoError> {
+    defmt::error!("no library linked: cannot decode a progressive stream");
+    Err(IoError::Read)
+}
+
+/// The stream's source, the output file and the timer, for `meshfmt::pm::run`.
+#[cfg(feature = "lib")]
+struct StreamDevice<'a> {
+    input: semihosting::fs::File,
+    output: semihosting::fs::File,
+    syst: &'a mut SYST,
+}
+
+#[cfg(feature = "lib")]
+impl meshfmt::pm::Device for StreamDevice<'_> {
+    type Error = IoError;
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, IoError> {
+        hostio::read_some(&mut self.input, buf)
+    }
+    fn write(&mut self, bytes: &[u8]) -> Result<(), IoError> {
+        hostio::write_all(&mut self.output, bytes)
+    }
+    fn start(&mut self) {
+        measure::start(self.syst);
+    }
+    fn stop(&mut self) -> u64 {
+        measure::stop(self.syst)
+    }
+    fn arrived(&mut self, bytes: usize, triangles: usize, vertices: usize) {
+        defmt::info!(
+            "{=usize} B in: {=usize} triangles, {=usize} vertices",
+            bytes,
+            triangles,
+            vertices
+        );
+    }
 }
 
 /// Instructions in [`calibrate`]'s loop: `cortex_m::asm::delay(n)` runs `subs; bne` n + 1 times.
