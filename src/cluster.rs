@@ -110,8 +110,9 @@ pub enum ClusterError {
         /// Vertices the buffer holds.
         capacity: usize,
     },
-    /// The table has more cells than the output index type can number (cell numbers are
-    /// stored in the output buffer while the stream runs).
+    /// The table (the part of it in use: [`ClusterConfig::table_cells`]) has more cells than
+    /// the output index type can number (cell numbers are stored in the output buffer while
+    /// the stream runs).
     TableTooWide {
         /// Cells in the table.
         cells: usize,
@@ -449,6 +450,10 @@ pub struct ClusterConfig {
     /// Counting passes of the search for [`GridChoice::TargetTriangles`], each probing [`PROBES`]
     /// resolutions (meshoptimizer's `simplifySloppy` makes 5 passes of one each).
     pub refine_passes: u32,
+    /// Use only the first `table_cells` cells of the table (0: all of it). The output depends
+    /// on the table's length (hash slots), so a device and a host with tables of different
+    /// sizes give the same bytes when both use the same `table_cells`.
+    pub table_cells: usize,
 }
 
 impl ClusterConfig {
@@ -458,6 +463,7 @@ impl ClusterConfig {
             grid: GridChoice::TargetTriangles(triangles),
             bbox: None,
             refine_passes: 2,
+            table_cells: 0,
         }
     }
     /// Cells of edge `size`.
@@ -466,11 +472,17 @@ impl ClusterConfig {
             grid: GridChoice::CellSize(size),
             bbox: None,
             refine_passes: 0,
+            table_cells: 0,
         }
     }
     /// With a known bounding box.
     pub const fn with_bbox(mut self, min: [f32; 3], max: [f32; 3]) -> Self {
         self.bbox = Some((min, max));
+        self
+    }
+    /// Using only the first `cells` cells of the table (0: all).
+    pub const fn with_table_cells(mut self, cells: usize) -> Self {
+        self.table_cells = cells;
         self
     }
 }
@@ -967,18 +979,19 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &'a mut [[I; 3]],
         active: usize,
     ) -> Result<Pass<'a, I>, ClusterError> {
-        if CELLS > I::COUNT || CELLS > u32::MAX as usize - 1 {
-            return Err(ClusterError::TableTooWide {
-                cells: CELLS,
-                index_count: I::COUNT,
-            });
-        }
-        // Only the first `active` cells take part (fewer cache lines for a small output).
+        // Only the first `active` cells take part (fewer cache lines for a small output, or
+        // the caller's `table_cells`).
         let active = if active > 0 && active < CELLS {
             active
         } else {
             CELLS
         };
+        if active > I::COUNT || active > u32::MAX as usize - 1 {
+            return Err(ClusterError::TableTooWide {
+                cells: active,
+                index_count: I::COUNT,
+            });
+        }
         let slots = self.slots.get_mut(..active).unwrap_or(&mut []);
         slots.iter_mut().for_each(|x| x.key = EMPTY);
         for e in out.iter_mut() {
@@ -1083,22 +1096,27 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                 target.saturating_add(target / 4).saturating_add(16),
             )
         } else {
-            (CELLS, out.len())
+            (usize::MAX, out.len())
         };
         let out_len = out.len();
+        let cells = if config.table_cells > 0 {
+            config.table_cells.min(CELLS)
+        } else {
+            CELLS
+        };
         loop {
             if passes > 0 && !source.rewind() {
                 return Err(ClusterError::NotRereadable);
             }
-            let (ac_now, ao_now) = (ac.min(CELLS), ao.min(out_len));
+            let (ac_now, ao_now) = (ac.min(cells), ao.min(out_len));
             let o = out.get_mut(..ao_now).unwrap_or(&mut []);
             let mut pass = self.pass(grid, quad.as_deref_mut(), o, ac_now)?;
             let total = run(&mut pass, source)?;
             passes += 1;
-            let small_table = pass.cells_missed > 0 && ac_now < CELLS;
+            let small_table = pass.cells_missed > 0 && ac_now < cells;
             let small_out = pass.out_missed > 0 && ao_now < out_len;
             if small_table || small_out {
-                (ac, ao) = (CELLS, usize::MAX);
+                (ac, ao) = (cells, usize::MAX);
                 continue;
             }
             pass.check_full(Some(total))?;

@@ -58,5 +58,6 @@ pub mod metro;
 pub mod pm;
 pub mod progress;
 pub mod qemu;
+pub mod qemu_cluster;
 pub mod render;
 pub mod simplify;
