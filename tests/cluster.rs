@@ -293,7 +293,7 @@ proptest! {
         which in 0u8..2,
     ) {
         let m = if which == 0 { jitter(icosphere(4), seed, 0.3) } else { jitter(grid(40, 30, 0.5), seed, 0.2) };
-        let config = ClusterConfig { grid: GridChoice::Resolution(res), bbox: None, refine_passes: 0, table_cells: 0 };
+        let config = ClusterConfig { grid: GridChoice::Resolution(res), bbox: None, refine_passes: 0, table_cells: 0, cleanup: false };
         let (out, r) = cluster(&m, &config, quadric);
         check("prop", &m, &out, &r);
     }
