@@ -4,7 +4,10 @@
 #   2. golden outputs on the host, with both math backends (libm, micromath);
 #   3. the same golden files under QEMU on five Cortex-M cores, both backends: the same bytes
 #      on every core and on the host;
-#   4. the firmware example (examples/cortex-m4f) under QEMU, as its README line runs it.
+#   4. streaming clustering of a mesh larger than RAM (the Stanford bunny, 69 451 triangles,
+#      read through semihosting on the 16 KB micro:bit) on the host and the five cores, both
+#      backends, against tests/golden/cluster.toml's golden files;
+#   5. the firmware example (examples/cortex-m4f) under QEMU, as its README line runs it.
 # The link-time proof that no panic path is left in the library (tests/no-panic/check.sh), the
 # fuzz smoke run and Miri are not run here: CI runs them after this script (see .ci/run).
 # It installs the rustup targets it needs; QEMU comes from `apt-get install qemu-system-arm`.
@@ -35,6 +38,10 @@ cargo run -q -p host-sim --release -- golden --check --backend micromath
 echo "== golden outputs under QEMU: Cortex-M0, M3, M4F, M7, M33 (libm, micromath)"
 cargo run -q -p host-sim --release -- qemu --check --backend libm
 cargo run -q -p host-sim --release -- qemu --check --backend micromath
+
+echo "== clustering a mesh larger than RAM under QEMU: the bunny on the micro:bit and every core (libm, micromath)"
+cargo run -q -p host-sim --release -- qemu --cluster --backend libm
+cargo run -q -p host-sim --release -- qemu --cluster --backend micromath
 
 echo "== the firmware example under QEMU: examples/cortex-m4f, cargo run --example simplify_in_flash"
 example_log=$(cd examples/cortex-m4f && cargo run -q --release --example simplify_in_flash --target thumbv7em-none-eabihf)

@@ -110,8 +110,9 @@ pub enum ClusterError {
         /// Vertices the buffer holds.
         capacity: usize,
     },
-    /// The table has more cells than the output index type can number (cell numbers are
-    /// stored in the output buffer while the stream runs).
+    /// The table (the part of it in use: [`ClusterConfig::table_cells`]) has more cells than
+    /// the output index type can number (cell numbers are stored in the output buffer while
+    /// the stream runs).
     TableTooWide {
         /// Cells in the table.
         cells: usize,
@@ -449,6 +450,17 @@ pub struct ClusterConfig {
     /// Counting passes of the search for [`GridChoice::TargetTriangles`], each probing [`PROBES`]
     /// resolutions (meshoptimizer's `simplifySloppy` makes 5 passes of one each).
     pub refine_passes: u32,
+    /// Use only the first `table_cells` cells of the table (0: all of it). The output depends
+    /// on the table's length (hash slots), so a device and a host with tables of different
+    /// sizes give the same bytes when both use the same `table_cells`.
+    pub table_cells: usize,
+    /// Remove what a renderer shows as defects, after the representatives are chosen: output
+    /// triangles of zero area (their three representatives collinear: height below 1e-6 of
+    /// the longest edge) and, with the quadric representative, triangles flipped against
+    /// their cells' surface (normal opposite the sum of the area-weighted normals of the
+    /// input triangles touching their three cells; one more pass, accumulated in the quadric
+    /// table, which is free by then). No memory beyond the table.
+    pub cleanup: bool,
 }
 
 impl ClusterConfig {
@@ -458,6 +470,8 @@ impl ClusterConfig {
             grid: GridChoice::TargetTriangles(triangles),
             bbox: None,
             refine_passes: 2,
+            table_cells: 0,
+            cleanup: false,
         }
     }
     /// Cells of edge `size`.
@@ -466,11 +480,23 @@ impl ClusterConfig {
             grid: GridChoice::CellSize(size),
             bbox: None,
             refine_passes: 0,
+            table_cells: 0,
+            cleanup: false,
         }
     }
     /// With a known bounding box.
     pub const fn with_bbox(mut self, min: [f32; 3], max: [f32; 3]) -> Self {
         self.bbox = Some((min, max));
+        self
+    }
+    /// With the cleanup of zero-area and flipped triangles ([`ClusterConfig::cleanup`]).
+    pub const fn with_cleanup(mut self) -> Self {
+        self.cleanup = true;
+        self
+    }
+    /// Using only the first `cells` cells of the table (0: all).
+    pub const fn with_table_cells(mut self, cells: usize) -> Self {
+        self.table_cells = cells;
         self
     }
 }
@@ -497,6 +523,10 @@ pub struct ClusterReport {
     pub passes: u32,
     /// The target of [`GridChoice::TargetTriangles`] (0: none).
     pub target_triangles: usize,
+    /// Output triangles removed by [`ClusterConfig::cleanup`] for zero area.
+    pub slivers_removed: usize,
+    /// Output triangles removed by [`ClusterConfig::cleanup`] as flipped.
+    pub flipped_removed: usize,
 }
 
 /// Plane quadrics per cell, for the quadric representative: 40 bytes per cell.
@@ -562,6 +592,8 @@ struct Pass<'a, I: Index> {
     /// Failures counted past a full table or buffer (for the `needed_at_least` figures).
     cells_missed: usize,
     out_missed: usize,
+    slivers: usize,
+    flipped: usize,
 }
 
 #[inline]
@@ -793,6 +825,111 @@ impl<I: Index> Pass<'_, I> {
     }
 }
 
+/// The cleanup's extra pass: the sum of the area-weighted normals of the input triangles
+/// touching each cell, in the first three floats of the cell's quadric (no longer needed once
+/// the representatives are chosen).
+fn cell_normals<S: Source, I: Index>(
+    pass: &mut Pass<'_, I>,
+    source: &mut S,
+) -> Result<(), ClusterError> {
+    if let Some(q) = pass.quad.as_deref_mut() {
+        for e in q.iter_mut() {
+            *e = [0.0; 10];
+        }
+    }
+    pass.choose = true;
+    let mut buf = [[0u32; 3]; CHUNK];
+    let mut index = 0usize;
+    loop {
+        let n = source.read(&mut buf);
+        let Some(chunk) = buf.get(..n) else { break };
+        if chunk.is_empty() {
+            break;
+        }
+        for t in chunk {
+            let p = corners(&mut SourcePositions(&mut *source), t, index)?;
+            index += 1;
+            let nrm = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
+            let mut last = [usize::MAX; 3];
+            for (c, &pc) in p.iter().enumerate() {
+                let k = pass.grid.key(pc);
+                let Some(s) = pass.cell(k) else { continue };
+                if last.contains(&s) {
+                    continue;
+                }
+                if let Some(l) = last.get_mut(c) {
+                    *l = s;
+                }
+                if let Some(e) = pass.quad.as_deref_mut().and_then(|q| q.get_mut(s)) {
+                    e[0] += nrm[0];
+                    e[1] += nrm[1];
+                    e[2] += nrm[2];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+impl<I: Index> Pass<'_, I> {
+    /// Removes zero-area output triangles and (with cell normals in the quadric table)
+    /// flipped ones, before [`Pass::finish`] compacts the output.
+    fn cleanup<S: Source>(&mut self, source: &mut S) {
+        for e in self.out.iter_mut() {
+            if e[0] == I::NIL {
+                continue;
+            }
+            let s = [e[0].to_usize(), e[1].to_usize(), e[2].to_usize()];
+            let mut p = [[0.0f32; 3]; 3];
+            let mut ok = true;
+            for (pp, &sc) in p.iter_mut().zip(&s) {
+                match self
+                    .slots
+                    .get(sc)
+                    .and_then(|x| source.position(x.rep as usize))
+                {
+                    Some(v) => *pp = v,
+                    None => ok = false,
+                }
+            }
+            if !ok {
+                continue;
+            }
+            // In cell units (representatives lie a few cells apart), so that the products
+            // below neither overflow nor underflow for coordinates near the f32 limits.
+            let inv = 1.0 / self.grid.cell;
+            let scaled = |v: V3| [v[0] * inv, v[1] * inv, v[2] * inv];
+            let a = scaled(math::sub(p[1], p[0]));
+            let b = scaled(math::sub(p[2], p[0]));
+            let c = scaled(math::sub(p[2], p[1]));
+            let nrm = math::cross(a, b);
+            let l2 = math::dot(nrm, nrm);
+            let emax = math::dot(a, a).max(math::dot(b, b)).max(math::dot(c, c));
+            if !(l2.is_finite() && emax.is_finite()) {
+                continue;
+            }
+            // |n| = 2 area = longest edge x height: height <= 1e-6 longest edge.
+            if l2 <= 4e-12 * emax * emax {
+                *e = [I::NIL; 3];
+                self.slivers += 1;
+                continue;
+            }
+            if let Some(q) = self.quad.as_deref() {
+                let mut sum = [0.0f32; 3];
+                for &sc in &s {
+                    if let Some(x) = q.get(sc) {
+                        sum = [sum[0] + x[0], sum[1] + x[1], sum[2] + x[2]];
+                    }
+                }
+                if math::dot(nrm, sum) < 0.0 {
+                    *e = [I::NIL; 3];
+                    self.flipped += 1;
+                }
+            }
+        }
+    }
+}
+
 /// Adds the area-weighted plane of the triangle `p` to the quadrics of its three cells
 /// (coordinates relative to each cell's corner, for precision).
 #[inline]
@@ -892,6 +1029,8 @@ fn finish_report<I: Index>(
         grid: pass.grid,
         passes,
         target_triangles: target,
+        slivers_removed: pass.slivers,
+        flipped_removed: pass.flipped,
     })
 }
 
@@ -938,6 +1077,8 @@ fn finish_compact<I: Index>(
             grid: pass.grid,
             passes,
             target_triangles: target,
+            slivers_removed: pass.slivers,
+            flipped_removed: pass.flipped,
         },
         nv,
     ))
@@ -967,18 +1108,19 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &'a mut [[I; 3]],
         active: usize,
     ) -> Result<Pass<'a, I>, ClusterError> {
-        if CELLS > I::COUNT || CELLS > u32::MAX as usize - 1 {
-            return Err(ClusterError::TableTooWide {
-                cells: CELLS,
-                index_count: I::COUNT,
-            });
-        }
-        // Only the first `active` cells take part (fewer cache lines for a small output).
+        // Only the first `active` cells take part (fewer cache lines for a small output, or
+        // the caller's `table_cells`).
         let active = if active > 0 && active < CELLS {
             active
         } else {
             CELLS
         };
+        if active > I::COUNT || active > u32::MAX as usize - 1 {
+            return Err(ClusterError::TableTooWide {
+                cells: active,
+                index_count: I::COUNT,
+            });
+        }
         let slots = self.slots.get_mut(..active).unwrap_or(&mut []);
         slots.iter_mut().for_each(|x| x.key = EMPTY);
         for e in out.iter_mut() {
@@ -998,6 +1140,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             choose: false,
             cells_missed: 0,
             out_missed: 0,
+            slivers: 0,
+            flipped: 0,
         })
     }
 
@@ -1083,22 +1227,27 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                 target.saturating_add(target / 4).saturating_add(16),
             )
         } else {
-            (CELLS, out.len())
+            (usize::MAX, out.len())
         };
         let out_len = out.len();
+        let cells = if config.table_cells > 0 {
+            config.table_cells.min(CELLS)
+        } else {
+            CELLS
+        };
         loop {
             if passes > 0 && !source.rewind() {
                 return Err(ClusterError::NotRereadable);
             }
-            let (ac_now, ao_now) = (ac.min(CELLS), ao.min(out_len));
+            let (ac_now, ao_now) = (ac.min(cells), ao.min(out_len));
             let o = out.get_mut(..ao_now).unwrap_or(&mut []);
             let mut pass = self.pass(grid, quad.as_deref_mut(), o, ac_now)?;
             let total = run(&mut pass, source)?;
             passes += 1;
-            let small_table = pass.cells_missed > 0 && ac_now < CELLS;
+            let small_table = pass.cells_missed > 0 && ac_now < cells;
             let small_out = pass.out_missed > 0 && ao_now < out_len;
             if small_table || small_out {
-                (ac, ao) = (CELLS, usize::MAX);
+                (ac, ao) = (cells, usize::MAX);
                 continue;
             }
             pass.check_full(Some(total))?;
@@ -1112,6 +1261,16 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                 passes += 1;
                 // `collapsed` was counted twice.
                 pass.collapsed /= 2;
+            }
+            if config.cleanup {
+                if pass.quad.is_some() {
+                    if !source.rewind() {
+                        return Err(ClusterError::NotRereadable);
+                    }
+                    cell_normals(&mut pass, source)?;
+                    passes += 1;
+                }
+                pass.cleanup(source);
             }
             return match vertices.as_deref_mut() {
                 Some(v) => finish_compact(&mut pass, passes, target, v),

@@ -293,7 +293,7 @@ proptest! {
         which in 0u8..2,
     ) {
         let m = if which == 0 { jitter(icosphere(4), seed, 0.3) } else { jitter(grid(40, 30, 0.5), seed, 0.2) };
-        let config = ClusterConfig { grid: GridChoice::Resolution(res), bbox: None, refine_passes: 0 };
+        let config = ClusterConfig { grid: GridChoice::Resolution(res), bbox: None, refine_passes: 0, table_cells: 0, cleanup: false };
         let (out, r) = cluster(&m, &config, quadric);
         check("prop", &m, &out, &r);
     }
@@ -337,4 +337,111 @@ fn cluster_then_collapse_fits_a_small_workspace() {
     let a = meshcheck::analyse(&m.positions, &tris);
     assert_eq!(a.topology.duplicate_triangles, 0);
     assert!(a.out_of_range.is_empty() && a.degenerate.is_empty());
+}
+
+/// `cleanup` removes exactly the zero-area triangles and, with quadrics, the triangles whose
+/// normal opposes the summed area-weighted normals of the input triangles touching their three
+/// cells (recomputed here independently, in f64); everything else is the output without it,
+/// in the same order.
+#[test]
+fn cleanup_removes_exactly_zero_area_and_flipped_triangles() {
+    let mut flipped_seen = 0;
+    for name in [
+        "wuson.obj",
+        "cow.obj",
+        "pr2_sensor_mount.obj",
+        "stanford_bunny.obj",
+    ] {
+        let m = load_obj(name);
+        for quadric in [false, true] {
+            let target = m.triangles.len() / 20;
+            let (plain, r0) = cluster(&m, &ClusterConfig::target(target), quadric);
+            let (clean, r) = cluster(&m, &ClusterConfig::target(target).with_cleanup(), quadric);
+            assert_eq!(r.grid, r0.grid, "{name}");
+            assert_eq!(
+                clean.len() + r.slivers_removed + r.flipped_removed,
+                plain.len(),
+                "{name}"
+            );
+            if !quadric {
+                assert_eq!(r.flipped_removed, 0, "{name}");
+            }
+            flipped_seen += r.flipped_removed;
+            // Cell normals, independently.
+            let g = &r.grid;
+            let p64 = |v: u32| m.positions[v as usize].map(f64::from);
+            let mut normal: HashMap<u32, [f64; 3]> = HashMap::new();
+            for t in &m.triangles {
+                let [a, b, c] = [p64(t[0]), p64(t[1]), p64(t[2])];
+                let n = cross64(sub64(b, a), sub64(c, a));
+                let mut seen = Vec::new();
+                for &v in t {
+                    let k = key(g, m.positions[v as usize]);
+                    if !seen.contains(&k) {
+                        seen.push(k);
+                        let e = normal.entry(k).or_insert([0.0; 3]);
+                        for i in 0..3 {
+                            e[i] += n[i];
+                        }
+                    }
+                }
+            }
+            let mut kept = clean.iter().peekable();
+            for t in &plain {
+                let [a, b, c] = [p64(t[0]), p64(t[1]), p64(t[2])];
+                let n = cross64(sub64(b, a), sub64(c, a));
+                let emax = [sub64(b, a), sub64(c, a), sub64(c, b)]
+                    .iter()
+                    .map(|e| dot64(*e, *e))
+                    .fold(0.0, f64::max);
+                let mut sum = [0.0; 3];
+                for &v in t {
+                    let s = normal[&key(g, m.positions[v as usize])];
+                    for i in 0..3 {
+                        sum[i] += s[i];
+                    }
+                }
+                let zero_area = dot64(n, n) <= 4e-12 * emax * emax * 1.01;
+                let flipped = quadric && dot64(n, sum) < 0.0;
+                if kept.peek() == Some(&t) {
+                    kept.next();
+                    assert!(
+                        !flipped && dot64(n, n) > 4e-12 * emax * emax * 0.99,
+                        "{name}: kept {t:?}"
+                    );
+                } else {
+                    assert!(zero_area || flipped, "{name}: removed {t:?}");
+                }
+            }
+            assert!(
+                kept.next().is_none(),
+                "{name}: the cleaned output is not a subsequence"
+            );
+            eprintln!(
+                "{name} quadric={quadric}: {} -> {} (cleanup: {} zero-area, {} flipped)",
+                plain.len(),
+                clean.len(),
+                r.slivers_removed,
+                r.flipped_removed
+            );
+        }
+    }
+    assert!(
+        flipped_seen > 0,
+        "no flipped triangle on any mesh: the test tests nothing"
+    );
+}
+
+fn sub64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot64(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }

@@ -45,6 +45,10 @@ pub struct Args {
     /// one (52 B per cell, two passes).
     #[arg(long)]
     pub nearest: bool,
+    /// Remove zero-area and (quadric representative) flipped output triangles
+    /// (`ClusterConfig::cleanup`).
+    #[arg(long)]
+    pub cleanup: bool,
     /// Skip the Metro measurement.
     #[arg(long)]
     pub no_measure: bool,
@@ -159,6 +163,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     };
     let config = ClusterConfig {
         grid,
+        cleanup: args.cleanup,
         ..ClusterConfig::target(0)
     };
     let quadric = !args.nearest;
@@ -194,6 +199,12 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         r.grid.dims[0], r.grid.dims[1], r.grid.dims[2], r.grid.cell, r.grid.origin
     );
     println!("passes           {}", r.passes);
+    if args.cleanup {
+        println!(
+            "cleanup          {} zero-area, {} flipped triangles removed",
+            r.slivers_removed, r.flipped_removed
+        );
+    }
     println!(
         "table            {} occupied cells x {} B = {} B (+ output {} triangles x 12 B with u32, 6 B with u16)",
         r.cells,

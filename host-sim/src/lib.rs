@@ -58,6 +58,7 @@ pub mod metro;
 pub mod pm;
 pub mod progress;
 pub mod qemu;
+pub mod qemu_cluster;
 pub mod render;
 pub mod simplify;
 pub mod streamcase;

@@ -190,7 +190,8 @@ pub fn build(board: &Board, backend: Backend, with_library: bool) -> Result<Path
     let mut cmd = Command::new(cargo);
     cmd.current_dir(firmware_dir())
         .args(["build", "--release", "--target", board.target])
-        .args(["--features", &features])
+        // Only the collapse image (the clustering one is `qemu_cluster::build`'s).
+        .args(["--bin", "tinydecimate-firmware", "--features", &features])
         .arg("--target-dir")
         .arg(firmware_target_dir())
         // Library debug logs stay out: they would cost instructions inside the measurement.
@@ -1490,8 +1491,17 @@ pub struct Args {
     /// Compare every board's output (and the host's) with the golden files; print a table
     /// cases x boards. Exit 1 on any DIFF or failure. Without it, the boards are compared with
     /// a fresh host run.
-    #[arg(long, conflicts_with_all = ["mesh", "measure", "smoke", "handlers"])]
+    #[arg(long, conflicts_with_all = ["mesh", "measure", "smoke", "handlers", "cluster"])]
     pub check: bool,
+    /// Streaming clustering of meshes larger than RAM (the bunny on the micro:bit) on the host
+    /// and the boards, against the golden files of `cluster.toml`; prints instructions per
+    /// input triangle, position reads and stack per board. Exit 1 on any DIFF or failure.
+    #[arg(long, conflicts_with_all = ["mesh", "measure", "smoke", "handlers"])]
+    pub cluster: bool,
+    /// With --cluster: write the golden files of cases that have none (existing ones are
+    /// never rewritten).
+    #[arg(long, requires = "cluster")]
+    pub bless: bool,
     /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
     /// collapse and stack; per golden progressive stream, instructions per split decoding and
     /// per collapse / split moving the slider; per board the image sizes of the firmware and of the library alone,
@@ -1550,7 +1560,9 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     }
     let timeout = Duration::from_secs(a.timeout);
     let mut failed = 0usize;
-    if a.measure {
+    if a.cluster {
+        failed = crate::qemu_cluster::check(&boards, backend, &a.dir, a.bless, timeout, a.verbose)?;
+    } else if a.measure {
         let cases = golden::load_cases(&a.dir)?;
         let streams = crate::streamcase::load(&a.dir)?;
         let mut all = Vec::new();
@@ -1676,7 +1688,7 @@ pub fn mesh_case(path: &Path, ratio: f32, passes: bool, u32: bool) -> Result<Cas
 
 /// Removes the variables that would leak from a cargo that runs host-sim into a nested firmware
 /// build (its own target directory, target and flags).
-fn isolate(cmd: &mut std::process::Command) {
+pub fn isolate(cmd: &mut std::process::Command) {
     for var in [
         "CARGO_TARGET_DIR",
         "CARGO_BUILD_TARGET",

@@ -69,6 +69,9 @@ extern crate std;
 #[cfg(feature = "std")]
 pub mod golden;
 
+/// The clustering case and result files.
+pub mod cluster;
+
 /// Case file magic.
 pub const CASE_MAGIC: [u8; 4] = *b"TDCS";
 /// Result file magic.

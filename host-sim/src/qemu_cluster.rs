@@ -1,0 +1,491 @@
+//! `host-sim qemu --cluster`: streaming vertex clustering of meshes larger than the board's RAM
+//! (the Stanford bunny, 69 451 triangles, on the 16 KB micro:bit), on the host and on every
+//! emulated board, compared byte for byte with the golden files of
+//! `tests/golden/cluster.toml` (`<backend>/<name>.bin`: the compared result header and the
+//! output triangles; `<name>.txt`: the same in words).
+//!
+//! The firmware image is `tinydecimate-cluster` (host-sim/firmware/src/bin/cluster.rs). It reads
+//! the case file through semihosting: the triangles in chunks of 32 through one file handle, each
+//! corner's position on demand (seek + 12-byte read) through another; RAM holds the cell table
+//! and the output buffer only. The host runs the same library call (same `table_cells`, same
+//! output buffer length, so the same hash slots) on the mesh in memory.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
+use meshfmt::cluster::{
+    ClusterCase, ClusterResult, CLUSTER_CASE_LEN, CLUSTER_COMPARED_LEN, CLUSTER_RESULT_LEN,
+};
+use meshfmt::{Board as BoardId, IndexType, Status};
+use serde::Deserialize;
+use tinydecimate::cluster::{ClusterReport, Clusterer, Quadrics, SliceSource};
+
+use crate::golden::{self, Backend};
+use crate::qemu::{self, Board};
+
+/// The case list inside the golden directory.
+pub const MANIFEST: &str = "cluster.toml";
+
+/// One `[[case]]` of `cluster.toml`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Spec {
+    /// Golden file name.
+    pub name: String,
+    /// What the case is for.
+    #[serde(default)]
+    pub about: String,
+    /// A mesh file relative to the repository root (`../shared/meshes/...` is beside it).
+    pub mesh: String,
+    /// Target triangle count (0: `resolution`).
+    #[serde(default)]
+    pub target_triangles: u32,
+    /// Cells along the longest side when there is no target.
+    #[serde(default)]
+    pub resolution: u32,
+    /// Cells of the table the call uses (`ClusterConfig::table_cells`).
+    pub table_cells: u32,
+    /// Length of the output buffer, in triangles.
+    pub output_slots: u32,
+    /// Refine passes of the target search.
+    #[serde(default = "two")]
+    pub refine_passes: u32,
+    /// `nearest` or `quadric`.
+    pub representative: String,
+    /// `u16` or `u32` output.
+    pub index: String,
+    /// Load the mesh into RAM first (measures the library without the semihosting reads).
+    #[serde(default)]
+    pub in_ram: bool,
+    /// The boards the case is too big for (skipped there, and only there).
+    #[serde(default)]
+    pub skip: Vec<String>,
+}
+
+fn two() -> u32 {
+    2
+}
+
+#[derive(Deserialize)]
+struct Manifest {
+    case: Vec<Spec>,
+}
+
+/// Reads `dir/cluster.toml`.
+pub fn load_specs(dir: &Path) -> Result<Vec<Spec>> {
+    let path = dir.join(MANIFEST);
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let m: Manifest = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
+    Ok(m.case)
+}
+
+impl Spec {
+    /// The case header (vertex and triangle counts from the mesh).
+    pub fn header(&self, vertices: usize, triangles: usize) -> Result<ClusterCase> {
+        Ok(ClusterCase {
+            index_type: match self.index.as_str() {
+                "u16" => IndexType::U16,
+                "u32" => IndexType::U32,
+                x => bail!("case {}: index {x:?} (u16 or u32)", self.name),
+            },
+            quadric: match self.representative.as_str() {
+                "nearest" => false,
+                "quadric" => true,
+                x => bail!(
+                    "case {}: representative {x:?} (nearest or quadric)",
+                    self.name
+                ),
+            },
+            vertices: meshfmt::narrow(vertices),
+            triangles: meshfmt::narrow(triangles),
+            target_triangles: self.target_triangles,
+            resolution: self.resolution,
+            table_cells: self.table_cells,
+            output_slots: self.output_slots,
+            refine_passes: self.refine_passes,
+            in_ram: self.in_ram,
+        })
+    }
+}
+
+/// A loaded case: header and mesh.
+pub struct Case {
+    pub spec: Spec,
+    pub header: ClusterCase,
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Case {
+    /// Loads the mesh of `spec`.
+    pub fn load(spec: &Spec) -> Result<Case> {
+        let path = golden::repo_root().join(&spec.mesh);
+        let m = crate::io::load(&path).with_context(|| format!("case {}", spec.name))?;
+        Ok(Case {
+            header: spec.header(m.positions.len(), m.triangles.len())?,
+            spec: spec.clone(),
+            positions: m.positions,
+            triangles: m.triangles,
+        })
+    }
+
+    /// The case file.
+    pub fn encode(&self) -> Vec<u8> {
+        let mut b = Vec::with_capacity(
+            CLUSTER_CASE_LEN + 12 * self.positions.len() + 12 * self.triangles.len(),
+        );
+        b.extend_from_slice(&self.header.to_bytes());
+        for p in &self.positions {
+            for c in p {
+                b.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        for t in &self.triangles {
+            for i in t {
+                b.extend_from_slice(&i.to_le_bytes());
+            }
+        }
+        b
+    }
+}
+
+/// The host's table: as large as any board's (the case's `table_cells` picks the part used).
+const HOST_CELLS: usize = 1 << 16;
+static TABLE: Mutex<Clusterer<HOST_CELLS>> = Mutex::new(Clusterer::new());
+static QUADS: Mutex<Quadrics<HOST_CELLS>> = Mutex::new(Quadrics::new());
+
+/// The same library call as the firmware's, on the host: the result header (measurement block
+/// zero) and the output triangles in the case's index type, little-endian.
+pub fn reference(case: &Case) -> Result<(ClusterResult, Vec<u8>)> {
+    let h = &case.header;
+    let config = meshfmt::cluster::lib::config(h);
+    let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
+    let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
+    let q = if h.quadric { Some(&mut *quads) } else { None };
+    let mut src = SliceSource::new(&case.positions, &case.triangles);
+    let n = h.output_slots as usize;
+    let (outcome, bytes): (Result<ClusterReport, _>, Vec<u8>) = match h.index_type {
+        IndexType::U16 => {
+            let mut out = vec![[0u16; 3]; n];
+            let r = table.cluster(&mut src, q, &config, &mut out);
+            let k = r.as_ref().map_or(0, |r| r.triangles_out);
+            let b = out[..k]
+                .iter()
+                .flatten()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
+            (r, b)
+        }
+        IndexType::U32 => {
+            let mut out = vec![[0u32; 3]; n];
+            let r = table.cluster(&mut src, q, &config, &mut out);
+            let k = r.as_ref().map_or(0, |r| r.triangles_out);
+            let b = out[..k]
+                .iter()
+                .flatten()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
+            (r, b)
+        }
+    };
+    Ok((
+        meshfmt::cluster::lib::result(h.index_type, &outcome, BoardId::Host),
+        bytes,
+    ))
+}
+
+/// What is compared: the result header's first [`CLUSTER_COMPARED_LEN`] bytes, then the
+/// triangles.
+pub fn compared(r: &ClusterResult, triangles: &[u8]) -> Vec<u8> {
+    let mut b = r.to_bytes()[..CLUSTER_COMPARED_LEN].to_vec();
+    b.extend_from_slice(triangles);
+    b
+}
+
+/// The golden result in words (`<name>.txt`).
+pub fn summary(case: &Case, r: &ClusterResult, triangles: &[u8]) -> String {
+    format!(
+        "# host-sim qemu --cluster: {name}\nmesh = {mesh:?}\nstatus = {status:?}\nerror = {kind:?} {err:?}\n\
+         triangles_in = {tin}\ntriangles_out = {tout}\ncollapsed = {col}\nduplicates = {dup}\n\
+         opposite_duplicates = {opp}\ncells = {cells}\npasses = {passes}\ntarget_triangles = {target}\n\
+         grid = {n} ({dx} x {dy} x {dz} cells of {cell})\ntriangles_sha256 = {sha:?}\n",
+        name = case.spec.name,
+        mesh = case.spec.mesh,
+        status = r.status,
+        kind = r.error_kind,
+        err = r.error,
+        tin = r.triangles_in,
+        tout = r.triangles_out,
+        col = r.collapsed,
+        dup = r.duplicates,
+        opp = r.opposite_duplicates,
+        cells = r.cells,
+        passes = r.passes,
+        target = r.target_triangles,
+        n = r.grid_n,
+        dx = r.grid_dims[0],
+        dy = r.grid_dims[1],
+        dz = r.grid_dims[2],
+        cell = r.grid_cell,
+        sha = golden::sha256_hex(triangles),
+    )
+}
+
+fn golden_paths(dir: &Path, backend: Backend, name: &str) -> (PathBuf, PathBuf) {
+    let d = dir.join(backend.to_string());
+    (d.join(format!("{name}.bin")), d.join(format!("{name}.txt")))
+}
+
+/// Builds the clustering image for `board`; returns it (copied to
+/// `target/images/<board>-<backend>-cluster.elf`).
+pub fn build(board: &Board, backend: Backend) -> Result<PathBuf> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut features = format!("board-{}", board.name);
+    if backend == Backend::Micromath {
+        features.push_str(",micromath");
+    }
+    let mut cmd = Command::new(cargo);
+    cmd.current_dir(qemu::firmware_dir())
+        .args(["build", "--release", "--target", board.target])
+        .args(["--bin", "tinydecimate-cluster", "--features", &features])
+        .arg("--target-dir")
+        .arg(qemu::firmware_target_dir())
+        .env("DEFMT_LOG", "info");
+    qemu::isolate(&mut cmd);
+    let status = cmd
+        .status()
+        .context("running cargo for the cluster firmware")?;
+    if !status.success() {
+        bail!(
+            "cluster firmware build for {} ({backend}) failed",
+            board.name
+        );
+    }
+    let built = qemu::firmware_target_dir()
+        .join(board.target)
+        .join("release")
+        .join("tinydecimate-cluster");
+    let elf = qemu::firmware_target_dir()
+        .join("images")
+        .join(format!("{}-{backend}-cluster.elf", board.name));
+    std::fs::create_dir_all(elf.parent().expect("has a parent"))?;
+    std::fs::copy(&built, &elf)?;
+    Ok(elf)
+}
+
+/// One board's run of one case.
+pub struct BoardRun {
+    pub result: Option<(ClusterResult, Vec<u8>)>,
+    pub run: qemu::Run,
+}
+
+/// Runs `case` (already encoded) on `board`.
+pub fn run_on(board: &Board, elf: &Path, case_file: &Path, timeout: Duration) -> Result<BoardRun> {
+    let dir = case_file.parent().context("case file directory")?;
+    let name = case_file
+        .file_name()
+        .and_then(|n| n.to_str())
+        .context("case file name")?;
+    let out = format!("{name}.{}.result", board.name);
+    let run = qemu::run_in(board, elf, dir, &[name, &out], Some(&out), timeout)?;
+    let _ = std::fs::remove_file(dir.join(&out));
+    let result = match (&run.result, run.ok()) {
+        (Some(b), true) if b.len() >= CLUSTER_RESULT_LEN => {
+            let head: &[u8; CLUSTER_RESULT_LEN] = b[..CLUSTER_RESULT_LEN].try_into()?;
+            let r = ClusterResult::from_bytes(head).map_err(|e| anyhow!("result: {e:?}"))?;
+            let t = b
+                .get(CLUSTER_RESULT_LEN..CLUSTER_RESULT_LEN + r.triangles_len())
+                .context("result file truncated")?
+                .to_vec();
+            Some((r, t))
+        }
+        _ => None,
+    };
+    Ok(BoardRun { result, run })
+}
+
+/// Runs every cluster case on the host and on `boards`, compares with the golden files (or
+/// writes the missing ones with `bless`), prints a table and the measurements. Returns the
+/// number of failures.
+pub fn check(
+    boards: &[&'static Board],
+    backend: Backend,
+    dir: &Path,
+    bless: bool,
+    timeout: Duration,
+    verbose: bool,
+) -> Result<usize> {
+    let specs = load_specs(dir)?;
+    let work = std::env::temp_dir().join(format!("tinydecimate-cluster-{}", std::process::id()));
+    std::fs::create_dir_all(&work)?;
+    let mut failed = 0usize;
+    let mut cases = Vec::new();
+    crate::outln!(
+        "clustering cases ({backend}), compared with {}/{backend}:",
+        dir.display()
+    );
+    for spec in &specs {
+        let case = Case::load(spec)?;
+        let t0 = Instant::now();
+        let (r, tri) = reference(&case)?;
+        let host_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let got = compared(&r, &tri);
+        let (bin, txt) = golden_paths(dir, backend, &spec.name);
+        let verdict = match std::fs::read(&bin) {
+            Ok(g) if g == got => "identical".to_string(),
+            Ok(_) => {
+                failed += 1;
+                "DIFF".to_string()
+            }
+            Err(_) if bless => {
+                std::fs::write(&bin, &got)?;
+                std::fs::write(&txt, summary(&case, &r, &tri))?;
+                "written (new)".to_string()
+            }
+            Err(_) => {
+                failed += 1;
+                format!("no golden file {}", bin.display())
+            }
+        };
+        crate::outln!(
+            "  {:<28} host: {} -> {} triangles ({:?}), {} cells, grid {}, {:.1} ms: {verdict}",
+            spec.name,
+            r.triangles_in,
+            r.triangles_out,
+            r.status,
+            r.cells,
+            r.grid_n,
+            host_ms
+        );
+        let file = work.join(format!("{}.case", spec.name));
+        std::fs::write(&file, case.encode())?;
+        cases.push((case, got, file));
+    }
+    for b in boards {
+        let t0 = Instant::now();
+        let elf = match build(b, backend) {
+            Ok(e) => e,
+            Err(e) => {
+                failed += cases.len();
+                crate::outln!("{:<12} FAILED: {e:#}", b.name);
+                continue;
+            }
+        };
+        let built = t0.elapsed().as_secs_f64();
+        for (case, want, file) in &cases {
+            let expect_skip = case.spec.skip.iter().any(|s| s == b.name);
+            let br = run_on(b, &elf, file, timeout)?;
+            let line = match &br.result {
+                Some((r, _)) if r.status == Status::TooBig => {
+                    if expect_skip {
+                        "skipped (too big for the board, expected)".to_string()
+                    } else {
+                        failed += 1;
+                        "FAILED: skipped, but not listed in the case's `skip`".to_string()
+                    }
+                }
+                Some((r, tri)) => {
+                    let same = compared(r, tri) == *want;
+                    if !same || expect_skip {
+                        failed += 1;
+                    }
+                    let instr = b.instructions(r.ticks);
+                    format!(
+                        "{}{}: {} -> {} triangles; {} instructions ({:.0} per input triangle); {} position reads; table {} B + output {} B; stack {} B in the call, high-water {} B; {:.1} s",
+                        if same { "identical" } else { "DIFF" },
+                        if expect_skip { " (but listed in `skip`)" } else { "" },
+                        r.triangles_in,
+                        r.triangles_out,
+                        instr,
+                        instr as f64 / f64::from(r.triangles_in.max(1)),
+                        r.position_reads,
+                        r.table_bytes,
+                        r.output_bytes,
+                        r.stack_bytes,
+                        r.stack_high_water,
+                        br.run.wall.as_secs_f64()
+                    )
+                }
+                None => {
+                    failed += 1;
+                    format!("FAILED: {}", br.run.describe())
+                }
+            };
+            crate::outln!("  {:<12} {:<28} {line}", b.name, case.spec.name);
+            if verbose {
+                crate::outln!("    {}", br.run.describe().replace('\n', "\n    "));
+            }
+        }
+        eprintln!(
+            "{:<12} cluster firmware ({backend}) built in {built:.1} s",
+            b.name
+        );
+    }
+    let _ = std::fs::remove_dir_all(&work);
+    crate::outln!("{backend}: clustering, {failed} DIFF or FAILED");
+    Ok(failed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The host's run of every clustering case equals its golden file (the boards are checked
+    /// by `host-sim qemu --cluster`). Needs `../shared/meshes` beside the checkout.
+    #[test]
+    fn host_matches_the_cluster_goldens() {
+        let dir = golden::default_dir();
+        let backend = Backend::compiled();
+        for spec in load_specs(&dir).unwrap() {
+            if !golden::repo_root().join(&spec.mesh).exists() {
+                eprintln!("{}: {} missing, not checked", spec.name, spec.mesh);
+                continue;
+            }
+            let case = Case::load(&spec).unwrap();
+            let (r, tri) = reference(&case).unwrap();
+            let (bin, _) = golden_paths(&dir, backend, &spec.name);
+            let want = std::fs::read(&bin).unwrap();
+            assert!(
+                compared(&r, &tri) == want,
+                "{}: differs from {}",
+                spec.name,
+                bin.display()
+            );
+            assert_eq!(r.status, Status::Ok, "{}", spec.name);
+        }
+    }
+
+    #[test]
+    fn case_files_round_trip() {
+        let spec = Spec {
+            name: "t".into(),
+            about: String::new(),
+            mesh: "tests/fixtures/cow.obj".into(),
+            target_triangles: 100,
+            resolution: 0,
+            table_cells: 200,
+            output_slots: 150,
+            refine_passes: 2,
+            representative: "nearest".into(),
+            index: "u32".into(),
+            in_ram: false,
+            skip: vec![],
+        };
+        let case = Case::load(&spec).unwrap();
+        let b = case.encode();
+        let h = ClusterCase::from_bytes(b[..CLUSTER_CASE_LEN].try_into().unwrap()).unwrap();
+        assert_eq!(h, case.header);
+        assert_eq!(
+            b.len() as u64,
+            h.triangles_at() + 12 * u64::from(h.triangles)
+        );
+        let (r, tri) = reference(&case).unwrap();
+        assert_eq!(r.status, Status::Ok);
+        assert!(r.triangles_out > 0 && r.triangles_out <= 100);
+        assert_eq!(tri.len(), 12 * r.triangles_out as usize);
+    }
+}
