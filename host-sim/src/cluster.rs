@@ -177,7 +177,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             (out, r, dt, Some(c))
         }
     };
-    println!(
+    crate::outln!(
         "representative   {}",
         if quadric {
             "quadric (least cell-quadric error)"
@@ -185,39 +185,46 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             "nearest to the cell centre"
         }
     );
-    println!("triangles in     {}", r.triangles_in);
-    println!("clustered        {}", r.triangles_out);
+    crate::outln!("triangles in     {}", r.triangles_in);
+    crate::outln!("clustered        {}", r.triangles_out);
     if let Some(c) = &collapse {
-        println!("then collapsed   {}", c.triangles_out);
+        crate::outln!("then collapsed   {}", c.triangles_out);
     }
-    println!(
+    crate::outln!(
         "dropped          {} collapsed into < 3 cells, {} duplicates ({} opposite winding)",
-        r.collapsed, r.duplicates, r.opposite_duplicates
+        r.collapsed,
+        r.duplicates,
+        r.opposite_duplicates
     );
-    println!(
+    crate::outln!(
         "grid             {} x {} x {} cells of {} (origin {:?})",
-        r.grid.dims[0], r.grid.dims[1], r.grid.dims[2], r.grid.cell, r.grid.origin
+        r.grid.dims[0],
+        r.grid.dims[1],
+        r.grid.dims[2],
+        r.grid.cell,
+        r.grid.origin
     );
-    println!("passes           {}", r.passes);
+    crate::outln!("passes           {}", r.passes);
     if args.cleanup {
-        println!(
+        crate::outln!(
             "cleanup          {} zero-area, {} flipped triangles removed",
-            r.slivers_removed, r.flipped_removed
+            r.slivers_removed,
+            r.flipped_removed
         );
     }
-    println!(
+    crate::outln!(
         "table            {} occupied cells x {} B = {} B (+ output {} triangles x 12 B with u32, 6 B with u16)",
         r.cells,
         table_bytes(1, quadric),
         table_bytes(r.cells, quadric),
         r.triangles_out
     );
-    println!("time             {:.3} ms", dt.as_secs_f64() * 1e3);
+    crate::outln!("time             {:.3} ms", dt.as_secs_f64() * 1e3);
     let (dup, deg, nme, comp) = defects(&out);
-    println!("duplicates       {dup}");
-    println!("degenerate       {deg}");
-    println!("non-manifold     {nme} edges");
-    println!("components       {comp}");
+    crate::outln!("duplicates       {dup}");
+    crate::outln!("degenerate       {deg}");
+    crate::outln!("non-manifold     {nme} edges");
+    crate::outln!("components       {comp}");
     if !args.no_measure {
         let m = metro(
             &mesh,
@@ -227,9 +234,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
                 ..MetroOptions::default()
             },
         );
-        println!(
+        crate::outln!(
             "Metro            mean {:.4} % of the diagonal, Hausdorff {:.4} %",
-            m.symmetric_mean_pct, m.hausdorff_pct
+            m.symmetric_mean_pct,
+            m.hausdorff_pct
         );
     }
     crate::io::save(&args.output, &out)?;
@@ -409,7 +417,7 @@ pub fn bench_run(opts: &crate::bench::Options, out: Option<&Path>) -> Result<Exi
         *a = "host-sim".into();
     }
     let md = markdown(&rows, &args.join(" "));
-    print!("{md}");
+    crate::out!("{md}");
     if let Some(p) = out {
         std::fs::write(p, &md).with_context(|| format!("{}: cannot write", p.display()))?;
         eprintln!("wrote {}", p.display());

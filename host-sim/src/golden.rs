@@ -841,6 +841,8 @@ pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
     }
     let cases = load_cases(dir)?;
     let streams = load_stream_specs(dir)?;
+    // The clustering cases (`cluster.toml`, `host-sim qemu --cluster`) share the directories.
+    let clusters = crate::qemu_cluster::load_specs(dir)?;
     let mut lines = Vec::new();
     for case in &cases {
         let new = Golden::of(case, backend, &reference(case)?)?;
@@ -875,6 +877,7 @@ pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
             (ext == "txt" || ext == "bin")
                 && !cases.iter().any(|c| c.name == stem)
                 && !streams.iter().any(|c| c.name == stem)
+                && !clusters.iter().any(|c| c.name == stem)
         })
         .collect();
     stale.sort();
