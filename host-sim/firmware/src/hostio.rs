@@ -90,6 +90,7 @@ pub fn create(path: &str) -> Result<File, IoError> {
 }
 
 /// The first four bytes of a file (shorter files: zero-padded).
+#[allow(dead_code)] // the cluster image (src/bin/cluster.rs) shares this file
 #[inline(never)]
 pub fn magic(path: &str) -> Result<[u8; 4], IoError> {
     let mut f = open(path)?;
@@ -106,6 +107,7 @@ pub fn magic(path: &str) -> Result<[u8; 4], IoError> {
 }
 
 /// Reads what is there, up to `buf.len()` bytes; 0 at the end of the file.
+#[allow(dead_code)] // the cluster image (src/bin/cluster.rs) shares this file
 pub fn read_some(f: &mut File, buf: &mut [u8]) -> Result<usize, IoError> {
     f.read(buf).map_err(|_| IoError::Read)
 }
