@@ -66,19 +66,22 @@ fn encoded_in_chunks(
     quantised: bool,
     chunk: u16,
 ) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
-    let log = collapse_log(m, ratio);
+    encode_log(m, &collapse_log(m, ratio), quantised, chunk)
+}
+
+/// The stream of `m` with the collapses of `log`, its levels and renumbered positions.
+fn encode_log(
+    m: &MeshData,
+    log: &[[u32; 2]],
+    quantised: bool,
+    chunk: u16,
+) -> (Vec<u8>, Vec<Vec<Tri>>, Vec<[f32; 3]>) {
     let (v, t) = (m.positions.len(), m.triangles.len());
     let mut st = Store::new(v, t);
     let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
-    let mut pm = Progressive::from_log(
-        &m.triangles,
-        v,
-        &log,
-        st.storage(),
-        &mut order,
-        &mut scratch,
-    )
-    .unwrap();
+    let mut pm =
+        Progressive::from_log(&m.triangles, v, log, st.storage(), &mut order, &mut scratch)
+            .unwrap();
     let mut out = vec![0u8; 64 * t + 4096];
     let e = stream::encode(&mut pm, &m.positions, &order, quantised, chunk, &mut out).unwrap();
     out.truncate(e.bytes);
@@ -212,26 +215,7 @@ fn kept_vertices_of_high_valence_decode() {
     };
     let (v, t) = (cone.positions.len(), cone.triangles.len());
     // Rim vertex 5 onto the top apex (68 triangles before and after), then rim vertex 9.
-    let log = [[5u32, 0], [9, 0]];
-    let mut st = Store::new(v, t);
-    let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
-    let mut pm = Progressive::from_log(
-        &cone.triangles,
-        v,
-        &log,
-        st.storage(),
-        &mut order,
-        &mut scratch,
-    )
-    .unwrap();
-    let mut out = vec![0u8; 64 * t + 4096];
-    let e = stream::encode(&mut pm, &cone.positions, &order, false, 256, &mut out).unwrap();
-    out.truncate(e.bytes);
-    pm.set_level(0);
-    let mut levels = vec![pm.triangles().to_vec()];
-    while pm.refine(1) == 1 {
-        levels.push(pm.triangles().to_vec());
-    }
+    let (out, levels, _) = encode_log(&cone, &[[5, 0], [9, 0]], false, 256);
     assert_eq!(levels.len(), 3);
     let (r, level, _) = decode(&out, 5, &levels, v, t);
     assert_eq!(r, Ok(()));

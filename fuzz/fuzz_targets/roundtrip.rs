@@ -6,8 +6,8 @@
 //! must be the input's (bit for bit with f32, within half a quantisation step otherwise).
 #![no_main]
 
+use host_sim::pm::Store;
 use libfuzzer_sys::fuzz_target;
-use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{Progressive, Workspace};
 
@@ -110,29 +110,3 @@ fuzz_target!(|data: &[u8]| {
         }
     }
 });
-
-struct Store {
-    tris: Vec<[u32; 3]>,
-    links: Vec<[u32; 3]>,
-    heads: Vec<u32>,
-    splits: Vec<Split<u32>>,
-}
-
-impl Store {
-    fn new(v: usize, t: usize) -> Self {
-        Store {
-            tris: vec![[0; 3]; t],
-            links: vec![[0; 3]; t],
-            heads: vec![0; v],
-            splits: vec![Split::EMPTY; v],
-        }
-    }
-    fn storage(&mut self) -> Storage<'_, u32> {
-        Storage {
-            triangles: &mut self.tris,
-            links: &mut self.links,
-            heads: &mut self.heads,
-            splits: &mut self.splits,
-        }
-    }
-}

@@ -779,28 +779,30 @@ pub fn diff(it: IndexType, expected: &Golden, got: &Golden) -> Verdict {
             )),
         }
     }
-    if expected.txt != got.txt {
-        let (el, gl): (Vec<_>, Vec<_>) =
-            (expected.txt.lines().collect(), got.txt.lines().collect());
-        for i in 0..el.len().max(gl.len()) {
-            let (a, b) = (el.get(i).copied(), gl.get(i).copied());
-            if a != b {
-                d.push(format!(
-                    "expected `{}`, got `{}`",
-                    a.unwrap_or("<end>"),
-                    b.unwrap_or("<end>")
-                ));
-            }
-            if d.len() >= 8 {
-                d.push("...".into());
-                break;
-            }
-        }
-    }
+    text_diff(&expected.txt, &got.txt, &mut d);
     if d.is_empty() {
         Verdict::Identical
     } else {
         Verdict::Diff(d)
+    }
+}
+
+/// Appends the lines of `got` that differ from `expected` to `d`, and `...` once it holds 8.
+pub fn text_diff(expected: &str, got: &str, d: &mut Vec<String>) {
+    let (el, gl): (Vec<_>, Vec<_>) = (expected.lines().collect(), got.lines().collect());
+    for i in 0..el.len().max(gl.len()) {
+        let (a, b) = (el.get(i).copied(), gl.get(i).copied());
+        if a != b {
+            d.push(format!(
+                "expected `{}`, got `{}`",
+                a.unwrap_or("<end>"),
+                b.unwrap_or("<end>")
+            ));
+        }
+        if d.len() >= 8 {
+            d.push("...".into());
+            break;
+        }
     }
 }
 

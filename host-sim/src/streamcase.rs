@@ -246,21 +246,7 @@ pub fn diff(expected: &Golden, got: &Golden) -> Verdict {
             got.bin.len()
         ));
     }
-    let (el, gl): (Vec<_>, Vec<_>) = (expected.txt.lines().collect(), got.txt.lines().collect());
-    for i in 0..el.len().max(gl.len()) {
-        let (a, b) = (el.get(i).copied(), gl.get(i).copied());
-        if a != b {
-            d.push(format!(
-                "expected `{}`, got `{}`",
-                a.unwrap_or("<end>"),
-                b.unwrap_or("<end>")
-            ));
-        }
-        if d.len() >= 8 {
-            d.push("...".into());
-            break;
-        }
-    }
+    golden::text_diff(&expected.txt, &got.txt, &mut d);
     if d.is_empty() {
         Verdict::Identical
     } else {
