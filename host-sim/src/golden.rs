@@ -554,6 +554,7 @@ fn error_text(h: &ResultHeader) -> String {
         ErrorKind::IndexOutOfRange => format!("index out of range: triangle {a}, index {b}"),
         ErrorKind::NonFinitePosition => format!("non-finite position: vertex {a}"),
         ErrorKind::InvalidConfig => format!("invalid config: field {a}"),
+        ErrorKind::CapacityQuadrics => format!("capacity: {a} quadrics needed, {b} available"),
     }
 }
 

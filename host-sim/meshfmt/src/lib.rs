@@ -354,6 +354,7 @@ pub enum ErrorKind {
     IndexOutOfRange = 3,
     NonFinitePosition = 4,
     InvalidConfig = 5,
+    CapacityQuadrics = 6,
 }
 
 /// Which board produced a result (0 for the host).
@@ -503,6 +504,7 @@ impl ResultHeader {
             3 => ErrorKind::IndexOutOfRange,
             4 => ErrorKind::NonFinitePosition,
             5 => ErrorKind::InvalidConfig,
+            6 => ErrorKind::CapacityQuadrics,
             _ => return Err(FormatError::Code),
         };
         r.skip(3);
@@ -691,6 +693,7 @@ pub mod lib {
                         match what {
                             tinydecimate::Capacity::Vertices => ErrorKind::CapacityVertices,
                             tinydecimate::Capacity::Triangles => ErrorKind::CapacityTriangles,
+                            tinydecimate::Capacity::Quadrics => ErrorKind::CapacityQuadrics,
                         },
                         narrow(needed),
                         narrow(available),
