@@ -672,7 +672,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if !args.no_measure {
         // The library drops degenerate and duplicate triangles before it starts; the check
         // compares the output with the input as the library saw it (`meshcheck::clean`).
-        let validity = crate::check::compare(&mesh, &out);
+        let moved = stored && args.placement == PlacementArg::Optimal;
+        let validity = crate::check::compare_with(&mesh, &out, moved);
         valid = validity.is_valid();
         let _ = writeln!(
             text,
