@@ -240,6 +240,12 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         self.mesh.has(v, flag::FEATURE)
     }
 
+    /// Vertex `v`'s current position in the input's units (moved by optimal placement);
+    /// `None` past the end.
+    pub fn position(&self, v: usize) -> Option<[f32; 3]> {
+        self.mesh.raw(v)
+    }
+
     /// Whether vertex `v` currently has triangles.
     pub fn is_used(&self, v: usize) -> bool {
         self.mesh.first(v) != NIL
@@ -423,7 +429,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             if l2 > math::TINY2 && l2.is_finite() {
                 let r = math::rsqrt(l2);
                 let unit = math::scale(n, r);
-                self.cost.plane(v, unit, -math::dot(unit, pv), l2 * r);
+                // Planes through v, in v's own frame (d = 0).
+                self.cost.plane(v, unit, 0.0, l2 * r);
                 if f & flag::BOUNDARY != 0 {
                     // The first triangle's edge v-x and the last one's v-y have no twin.
                     for (is, e) in [(c == first, math::sub(px, pv)), (c == last, math::sub(py, pv))] {
@@ -434,8 +441,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                         let m2 = math::dot(m, m);
                         if m2 > math::TINY2 && m2.is_finite() {
                             let m = math::scale(m, math::rsqrt(m2));
-                            self.cost
-                                .boundary_plane(v, m, -math::dot(m, pv), math::dot(e, e));
+                            self.cost.boundary_plane(v, m, 0.0, math::dot(e, e));
                         }
                     }
                 }
@@ -748,12 +754,15 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
 
     /// Collapses `a -> b` in the mesh, moves `b` to its placement and merges the cost's state.
     fn apply(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
+        let (pa, pb) = (self.mesh.p(a), self.mesh.p(b));
         self.mesh.collapse(a, b);
-        if let Some((q, _)) = at {
+        let mut p_new = pb;
+        if let Some((q, p)) = at {
             self.mesh.place(b, q);
+            p_new = p;
         }
         if self.cost.stores() {
-            self.cost.merge(a, b);
+            self.cost.merge(a, b, pa, pb, p_new);
         }
     }
 

@@ -64,13 +64,17 @@ pub trait Cost {
         false
     }
     /// Adds `weight · (n·x + d)²` to vertex `v`'s state (only if [`Cost::stores`]): the plane
-    /// of one of its triangles (weight: twice its area), or a boundary plane.
+    /// of one of its triangles (weight: twice its area), or a boundary plane. `x` is relative
+    /// to `v`'s position (the engine passes planes through `v`, so `d` is zero): a cost may keep
+    /// each vertex's state in a frame centred on it, which keeps `f32` sums of nearby planes
+    /// free of the cancellation a global origin causes.
     fn plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
     /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle
     /// (seed 000 §3.3); `weight` is the squared edge length, the cost applies its own factor.
     fn boundary_plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
-    /// Vertex `from` was collapsed onto `to` (only if [`Cost::stores`]).
-    fn merge(&mut self, _from: usize, _to: usize) {}
+    /// Vertex `from` (at `p_from`) was collapsed onto `to` (at `p_to`), which is now at `p_new`
+    /// (only if [`Cost::stores`]).
+    fn merge(&mut self, _from: usize, _to: usize, _p_from: V3, _p_to: V3, _p_new: V3) {}
     /// Where the kept vertex goes for this move, if it moves at all (optimal placement); the
     /// engine checks the legality rules there and writes it to the caller's mutable positions.
     /// `None` by default: the kept vertex stays (subset placement).
@@ -305,7 +309,10 @@ pub enum Placement {
 /// §3.3), weighted by `boundary_weight` times the squared edge length.
 ///
 /// The matrices live in a caller-provided slice, one [`VertexQuadric`] (40 bytes) per vertex, at
-/// least as long as the positions. All in the engine's normalised units.
+/// least as long as the positions. All in the engine's normalised units, and each vertex's
+/// matrix in a frame centred on that vertex (moved to the kept vertex's new position on a
+/// collapse): in `f32`, `vᵀQv` with a global origin loses the small errors of early collapses
+/// to cancellation between terms of order one.
 pub struct StoredQuadric<'q> {
     q: &'q mut [VertexQuadric],
     boundary_weight: f32,
@@ -340,55 +347,91 @@ impl<'q> StoredQuadric<'q> {
         self.q.get(v).copied().unwrap_or([0.0; 10])
     }
 
-    fn sum(&self, a: usize, b: usize) -> VertexQuadric {
-        let (x, y) = (self.quadric(a), self.quadric(b));
-        let mut s = x;
-        for (s, y) in s.iter_mut().zip(y) {
-            *s += y;
-        }
-        s
+    /// The edge's quadric `Q_from + Q_to` in the frame centred on `p_to`.
+    fn edge(&self, m: &Move) -> VertexQuadric {
+        add(
+            &translate(&self.quadric(m.from), math::sub(m.p_to, m.p_from)),
+            &self.quadric(m.to),
+        )
     }
 
-    /// The best position for `m` and its error: the solution of the 3×3 system if it is
+    /// The best position for `m` relative to `p_to`, and its error: the solution of the 3×3 system if it is
     /// well conditioned and near the edge, else (and if better) an endpoint or the midpoint.
     /// Candidates are compared in a fixed order with `<`, so ties go to the earlier one.
-    fn best(&self, q: &VertexQuadric, m: &Move) -> (V3, f32) {
-        let mid = math::scale(math::add(m.p_from, m.p_to), 0.5);
-        let mut best = (m.p_to, error(q, m.p_to));
-        if m.keep || self.placement == Placement::Subset {
-            return best;
-        }
-        let e = math::sub(m.p_to, m.p_from);
-        let l2 = math::dot(e, e);
-        if let Some(p) = solve(q) {
-            let d = math::sub(p, mid);
-            if math::dot(d, d) <= l2 {
-                let c = error(q, p);
-                if c < best.1 {
-                    best = (p, c);
+    fn best(&self, m: &Move) -> (V3, f32) {
+        let q = self.edge(m);
+        // Relative to p_to: the kept end is 0, the removed one -d.
+        let mut best = ([0.0; 3], error(&q, [0.0; 3]));
+        if !(m.keep || self.placement == Placement::Subset) {
+            let back = math::scale(m.d, -1.0);
+            let mid = math::scale(m.d, -0.5);
+            let l2 = math::dot(m.d, m.d);
+            if let Some(x) = solve(&q) {
+                let off = math::sub(x, mid);
+                if math::dot(off, off) <= l2 {
+                    let c = error(&q, x);
+                    if c < best.1 {
+                        best = (x, c);
+                    }
                 }
             }
-        }
-        for p in [m.p_from, mid] {
-            let c = error(q, p);
-            if c < best.1 {
-                best = (p, c);
+            for x in [back, mid] {
+                let c = error(&q, x);
+                if c < best.1 {
+                    best = (x, c);
+                }
             }
         }
         best
     }
 }
 
-/// `vᵀ Q v` for `v = (p, 1)`, clamped at zero.
+/// Element-wise sum.
+fn add(x: &VertexQuadric, y: &VertexQuadric) -> VertexQuadric {
+    let mut s = *x;
+    for (s, y) in s.iter_mut().zip(y) {
+        *s += y;
+    }
+    s
+}
+
+/// `q` (in a frame centred on `o`) in the frame centred on `o + s`: with `x = x' + s`,
+/// `b' = b + A s` and `c' = q(s)`.
+fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
+    let [x, y, z] = s;
+    let b0 = q[3] + q[0] * x + q[1] * y + q[2] * z;
+    let b1 = q[6] + q[1] * x + q[4] * y + q[5] * z;
+    let b2 = q[8] + q[2] * x + q[5] * y + q[7] * z;
+    [
+        q[0],
+        q[1],
+        q[2],
+        b0,
+        q[4],
+        q[5],
+        b1,
+        q[7],
+        b2,
+        form(q, s),
+    ]
+}
+
+/// `vᵀ Q v` for `v = (p, 1)`, unclamped.
 #[inline]
-pub fn error(q: &VertexQuadric, p: V3) -> f32 {
+fn form(q: &VertexQuadric, p: V3) -> f32 {
     let [x, y, z] = p;
-    let e = q[0] * x * x
+    q[0] * x * x
         + q[4] * y * y
         + q[7] * z * z
         + 2.0 * (q[1] * x * y + q[2] * x * z + q[5] * y * z)
         + 2.0 * (q[3] * x + q[6] * y + q[8] * z)
-        + q[9];
+        + q[9]
+}
+
+/// `vᵀ Q v` for `v = (p, 1)`, clamped at zero (`p` in the quadric's frame).
+#[inline]
+pub fn error(q: &VertexQuadric, p: V3) -> f32 {
+    let e = form(q, p);
     if e > 0.0 {
         e
     } else {
@@ -437,8 +480,7 @@ impl Cost for StoredQuadric<'_> {
 
     #[inline]
     fn price(&self, _: &(), m: &Move) -> f32 {
-        let q = self.sum(m.from, m.to);
-        self.best(&q, m).1
+        self.best(m).1
     }
 
     fn needs_turn(&self) -> bool {
@@ -474,8 +516,11 @@ impl Cost for StoredQuadric<'_> {
         self.plane(v, n, d, w * self.boundary_weight)
     }
 
-    fn merge(&mut self, from: usize, to: usize) {
-        let s = self.sum(from, to);
+    fn merge(&mut self, from: usize, to: usize, p_from: V3, p_to: V3, p_new: V3) {
+        let s = add(
+            &translate(&self.quadric(from), math::sub(p_new, p_from)),
+            &translate(&self.quadric(to), math::sub(p_new, p_to)),
+        );
         if let Some(q) = self.q.get_mut(to) {
             *q = s;
         }
@@ -485,7 +530,11 @@ impl Cost for StoredQuadric<'_> {
         if m.keep || self.placement == Placement::Subset {
             return None;
         }
-        let q = self.sum(m.from, m.to);
-        Some(self.best(&q, m).0)
+        let x = self.best(m).0;
+        if x == [0.0; 3] {
+            // The kept end stays where it is.
+            return None;
+        }
+        Some(math::add(m.p_to, x))
     }
 }

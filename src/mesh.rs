@@ -371,6 +371,11 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
+    /// `v`'s position as stored (input units).
+    pub(crate) fn raw(&self, v: usize) -> Option<[f32; 3]> {
+        self.pos.get(v).copied()
+    }
+
     /// Whether positions may be written ([`Mesh::place`]).
     pub(crate) fn movable(&self) -> bool {
         matches!(self.pos, Positions::Write(_))
