@@ -433,7 +433,10 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                 self.cost.plane(v, unit, 0.0, l2 * r);
                 if f & flag::BOUNDARY != 0 {
                     // The first triangle's edge v-x and the last one's v-y have no twin.
-                    for (is, e) in [(c == first, math::sub(px, pv)), (c == last, math::sub(py, pv))] {
+                    for (is, e) in [
+                        (c == first, math::sub(px, pv)),
+                        (c == last, math::sub(py, pv)),
+                    ] {
                         if !is {
                             continue;
                         }
@@ -586,7 +589,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         match legality::check(&self.mesh, &self.rules, from, to, at.map(|x| x.1)) {
             Ok(()) => Ok((c, at)),
             Err(r) => {
-                if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok() {
+                if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok()
+                {
                     if let Some(kept) = self.price_kept(from, w, to, true) {
                         return Ok((kept, None));
                     }

@@ -321,7 +321,11 @@ pub struct StoredQuadric<'q> {
 
 impl<'q> StoredQuadric<'q> {
     /// A stored quadric over `storage` (zeroed here; the engine fills it).
-    pub fn new(storage: &'q mut [VertexQuadric], boundary_weight: f32, placement: Placement) -> Self {
+    pub fn new(
+        storage: &'q mut [VertexQuadric],
+        boundary_weight: f32,
+        placement: Placement,
+    ) -> Self {
         for q in storage.iter_mut() {
             *q = [0.0; 10];
         }
@@ -402,18 +406,7 @@ fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
     let b0 = q[3] + q[0] * x + q[1] * y + q[2] * z;
     let b1 = q[6] + q[1] * x + q[4] * y + q[5] * z;
     let b2 = q[8] + q[2] * x + q[5] * y + q[7] * z;
-    [
-        q[0],
-        q[1],
-        q[2],
-        b0,
-        q[4],
-        q[5],
-        b1,
-        q[7],
-        b2,
-        form(q, s),
-    ]
+    [q[0], q[1], q[2], b0, q[4], q[5], b1, q[7], b2, form(q, s)]
 }
 
 /// `vᵀ Q v` for `v = (p, 1)`, unclamped.

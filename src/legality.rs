@@ -194,7 +194,13 @@ pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
 /// The shape of live triangle `t` once `a` and `b` are both at `p` (`b` moved, `a` merged
 /// into it).
 #[inline]
-fn shape_moved<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, t: usize, a: usize, b: usize, p: V3) -> Shape {
+fn shape_moved<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    t: usize,
+    a: usize,
+    b: usize,
+    p: V3,
+) -> Shape {
     Shape::of(
         mesh.tri(t)
             .map(|v| if v == a || v == b { p } else { mesh.p(v) }),

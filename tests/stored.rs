@@ -168,7 +168,10 @@ fn both_placements_give_valid_simplifications() {
                 let (out, r) = stored(&m, &config, placement);
                 let label = format!("{name} {ratio} {placement:?}");
                 assert_eq!(r.triangles_out, out.triangles.len(), "{label}");
-                assert!(r.triangles_out < m.triangles.len(), "{label}: nothing removed");
+                assert!(
+                    r.triangles_out < m.triangles.len(),
+                    "{label}: nothing removed"
+                );
                 assert_valid(&label, &m, &out, placement == Placement::Optimal);
                 if placement == Placement::Subset {
                     assert_eq!(out.positions, m.positions, "{label}: subset moved a vertex");
@@ -196,7 +199,10 @@ fn optimal_placement_lowers_the_error_against_subset() {
             let (s, _) = stored(&m, &config, Placement::Subset);
             let (o, _) = stored(&m, &config, Placement::Optimal);
             let (es, eo) = (error(&m, &s), error(&m, &o));
-            assert!(eo < es, "{name} {ratio}: optimal {eo:e} not below subset {es:e}");
+            assert!(
+                eo < es,
+                "{name} {ratio}: optimal {eo:e} not below subset {es:e}"
+            );
         }
     }
 }
@@ -212,7 +218,10 @@ fn optimal_placement_is_not_worse_than_the_memoryless_default() {
         let (d, _) = memoryless(&m, &config);
         let (o, _) = stored(&m, &config, Placement::Optimal);
         let (ed, eo) = (error(&m, &d), error(&m, &o));
-        assert!(eo <= ed, "cow {ratio}: optimal {eo:e} above memoryless {ed:e}");
+        assert!(
+            eo <= ed,
+            "cow {ratio}: optimal {eo:e} above memoryless {ed:e}"
+        );
     }
 }
 
@@ -225,7 +234,8 @@ fn runs_are_exactly_repeatable_and_stepping_gives_the_same_bytes() {
         let (b, rb) = stored(&m, &config, placement);
         assert_eq!(a.triangles, b.triangles, "{placement:?}");
         assert_eq!(ra, rb);
-        let bits = |p: &[[f32; 3]]| -> Vec<u32> { p.iter().flatten().map(|x| x.to_bits()).collect() };
+        let bits =
+            |p: &[[f32; 3]]| -> Vec<u32> { p.iter().flatten().map(|x| x.to_bits()).collect() };
         assert_eq!(bits(&a.positions), bits(&b.positions), "{placement:?}");
         // Stepping with small budgets: the same bytes as one shot.
         let mut ws = WS.lock().unwrap_or_else(|e| e.into_inner());
@@ -320,7 +330,8 @@ fn feature_vertices_are_never_removed_nor_moved_while_they_are_features() {
                 .filter(|&v| s.is_feature(v) && s.is_used(v))
                 .filter_map(|v| s.position(v).map(|p| (v, p)))
                 .collect();
-            let all: Vec<Option<[f32; 3]>> = (0..m.positions.len()).map(|v| s.position(v)).collect();
+            let all: Vec<Option<[f32; 3]>> =
+                (0..m.positions.len()).map(|v| s.position(v)).collect();
             let done = s.step(1);
             for &(v, p) in &before {
                 assert!(s.is_used(v), "{name}: feature {v} removed");

@@ -672,7 +672,10 @@ pub fn meshopt_simplify_with_update(
         (n, start.elapsed())
     });
     indices.truncate(n);
-    let triangles = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let triangles = indices
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
     let result = MeshData {
         positions,
         triangles,

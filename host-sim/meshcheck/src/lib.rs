@@ -954,10 +954,14 @@ mod tests {
             margin: 0.0,
             min_quality: 0.0,
         };
-        let a = analyse_with(&f, &t, &Options {
+        let a = analyse_with(
+            &f,
+            &t,
+            &Options {
                 view: Some(view),
                 allow_moved: false,
-            });
+            },
+        );
         assert_eq!((a.folded.len(), a.folded_true.len()), (0, 1));
     }
 }
