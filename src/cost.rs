@@ -444,7 +444,9 @@ fn solve(q: &VertexQuadric) -> Option<V3> {
     let det = a00 * c00 + a01 * c01 + a02 * c02;
     let t = (a00 + a11 + a22) * (1.0 / 3.0);
     let abs = if det < 0.0 { -det } else { det };
-    if !(t > 0.0) || !(abs > 1e-5 * t * t * t) {
+    // Written so that NaN fails too.
+    let conditioned = t > 0.0 && abs > 1e-5 * t * t * t;
+    if !conditioned {
         return None;
     }
     let c11 = a00 * a22 - a02 * a02;
