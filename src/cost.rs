@@ -390,6 +390,24 @@ impl<'q> StoredQuadric<'q> {
     }
 }
 
+/// The quadric `p pᵀ` of the plane `p = (n, d)` (seed 000 eq. 3, `K_p`), upper triangle.
+#[inline]
+pub(crate) fn outer(n: V3, d: f32) -> VertexQuadric {
+    let [a, b, c] = n;
+    [
+        a * a,
+        a * b,
+        a * c,
+        a * d,
+        b * b,
+        b * c,
+        b * d,
+        c * c,
+        c * d,
+        d * d,
+    ]
+}
+
 /// Element-wise sum.
 fn add(x: &VertexQuadric, y: &VertexQuadric) -> VertexQuadric {
     let mut s = *x;
@@ -488,20 +506,7 @@ impl Cost for StoredQuadric<'_> {
 
     fn plane(&mut self, v: usize, n: V3, d: f32, w: f32) {
         if let Some(q) = self.q.get_mut(v) {
-            let [a, b, c] = n;
-            let k = [
-                a * a,
-                a * b,
-                a * c,
-                a * d,
-                b * b,
-                b * c,
-                b * d,
-                c * c,
-                c * d,
-                d * d,
-            ];
-            for (q, k) in q.iter_mut().zip(k) {
+            for (q, k) in q.iter_mut().zip(outer(n, d)) {
                 *q += w * k;
             }
         }

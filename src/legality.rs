@@ -164,6 +164,22 @@ fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
     }
 }
 
+/// The sliver and normal-turn rules on one surviving triangle, `was` before the collapse and
+/// `now` after it.
+#[inline]
+fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
+    if on::SLIVER
+        && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
+    {
+        return Err(Reject::Sliver);
+    }
+    // A zero-area triangle has no direction to turn from.
+    if on::NORMAL_TURN && was.quality > 0.0 && turned(was, now, rules.cos_turn, rules.cos_turn2) {
+        return Err(Reject::NormalTurn);
+    }
+    Ok(())
+}
+
 /// Whether two triangles sharing an edge are folded onto each other.
 #[inline]
 fn folded(u: &Shape, v: &Shape) -> bool {
@@ -316,18 +332,7 @@ pub(crate) fn check<L: Index, I: Index>(
         }
         let was = Shape::of(q);
         let now = Shape::of(r);
-        if on::SLIVER
-            && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
-        {
-            return Err(Reject::Sliver);
-        }
-        // A zero-area triangle has no direction to turn from.
-        if on::NORMAL_TURN
-            && was.quality > 0.0
-            && turned(&was, &now, rules.cos_turn, rules.cos_turn2)
-        {
-            return Err(Reject::NormalTurn);
-        }
+        shape_rules(rules, &was, &now)?;
         if on::FOLD {
             let mut fold = false;
             if let Some((py, ps)) = prev {
@@ -388,17 +393,7 @@ fn check_moved_b<L: Index, I: Index>(
         }
         let was = Shape::of(q);
         let now = Shape::of(r);
-        if on::SLIVER
-            && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
-        {
-            return Err(Reject::Sliver);
-        }
-        if on::NORMAL_TURN
-            && was.quality > 0.0
-            && turned(&was, &now, rules.cos_turn, rules.cos_turn2)
-        {
-            return Err(Reject::NormalTurn);
-        }
+        shape_rules(rules, &was, &now)?;
         if on::FOLD {
             for (u, w) in [(old[0], old[1]), (old[1], old[2]), (old[2], old[0])] {
                 // Triangles holding u (for b: a's too), other than t and the removed ones.

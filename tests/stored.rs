@@ -45,22 +45,6 @@ fn stored(m: &MeshData, config: &Config, placement: Placement) -> (MeshData, Rep
     )
 }
 
-fn memoryless(m: &MeshData, config: &Config) -> (MeshData, Report) {
-    let mut ws = WS.lock().unwrap_or_else(|e| e.into_inner());
-    let mut tris = m.triangles.clone();
-    let r = ws
-        .simplify(&m.positions, &mut tris, config)
-        .expect("simplify");
-    tris.truncate(r.triangles_out);
-    (
-        MeshData {
-            positions: m.positions.clone(),
-            triangles: tris,
-        },
-        r,
-    )
-}
-
 fn assert_valid(name: &str, input: &MeshData, output: &MeshData, moved: bool) {
     meshcheck::check_with(
         meshcheck::MeshRef {
@@ -215,7 +199,7 @@ fn optimal_placement_is_not_worse_than_the_memoryless_default() {
     let m = fixture("cow.obj");
     for ratio in [0.5, 0.25, 0.1] {
         let config = Config::new().with_ratio(ratio);
-        let (d, _) = memoryless(&m, &config);
+        let (d, _) = common::simplify(&m, &config);
         let (o, _) = stored(&m, &config, Placement::Optimal);
         let (ed, eo) = (error(&m, &d), error(&m, &o));
         assert!(
