@@ -789,12 +789,17 @@ pub fn judge(
     let h = &actual.header;
     if h.status == Status::TooBig {
         return Ok(Verdict::Skipped(format!(
-            "too big for this board: {} vertices, {} {} triangles; it holds {} vertices, {} triangles",
+            "too big for this board: {} vertices, {} {} triangles; it holds {} vertices, {} triangles{}",
             h.error_a,
             h.error_b,
             if case.index_type == IndexType::U16 { "u16" } else { "u32" },
             h.capacity_vertices,
-            h.capacity_triangles
+            h.capacity_triangles,
+            if case.stored.is_some() {
+                " (stored quadrics: the firmware's QUADRIC_VERTICES may be lower)"
+            } else {
+                ""
+            }
         )));
     }
     let got = Golden::of(case, backend, actual)?;
