@@ -301,7 +301,7 @@ pub enum Placement {
     Optimal,
 }
 
-/// Accumulated (Garland-Heckbert) quadric error metric with per-vertex storage: seed 000 §2.3-2.5
+/// Accumulated quadric error metric (Garland's, seed 000 ref. 5) with per-vertex storage: seed 000 §2.3-2.5
 /// (Cheng, Pan and Shi: `K_p = p pᵀ`, `Q_s` the sum over the vertex's triangles, `Q = Q_s + Q_t`
 /// on a collapse, `Δ = vᵀ Q v` and an error-cost queue) and seed 003 (an implementation of
 /// Garland's edge collapse). Planes are area-weighted; a boundary vertex also gets, for each
