@@ -46,21 +46,7 @@ fn stored(m: &MeshData, config: &Config, placement: Placement) -> (MeshData, Rep
 }
 
 fn assert_valid(name: &str, input: &MeshData, output: &MeshData, moved: bool) {
-    meshcheck::check_with(
-        meshcheck::MeshRef {
-            positions: &input.positions,
-            triangles: &input.triangles,
-        },
-        meshcheck::MeshRef {
-            positions: &output.positions,
-            triangles: &output.triangles,
-        },
-        &meshcheck::Options {
-            view: None,
-            allow_moved: moved,
-        },
-    )
-    .assert_valid(name);
+    common::verdict_with(input, output, moved).assert_valid(name);
 }
 
 /// Squared distance (f64) from `p` to triangle `a b c`.
