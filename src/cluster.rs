@@ -941,7 +941,6 @@ fn add_plane(q: &mut [[f32; 10]], grid: &Grid, s: [usize; 3], k: [u32; 3], p: [V
     }
     // n nᵀ / |n| = area-weighted unit-normal quadric (times 2).
     let w = math::rsqrt(l2);
-    let [a, b, c] = n;
     for j in 0..3 {
         let (Some(&sj), Some(&kj)) = (s.get(j), k.get(j)) else {
             continue;
@@ -949,19 +948,7 @@ fn add_plane(q: &mut [[f32; 10]], grid: &Grid, s: [usize; 3], k: [u32; 3], p: [V
         let o = grid.corner(kj);
         let d = -math::dot(n, math::sub(p[0], o));
         if let Some(e) = q.get_mut(sj) {
-            let add = [
-                a * a,
-                a * b,
-                a * c,
-                a * d,
-                b * b,
-                b * c,
-                b * d,
-                c * c,
-                c * d,
-                d * d,
-            ];
-            for (x, y) in e.iter_mut().zip(add) {
+            for (x, y) in e.iter_mut().zip(crate::cost::outer(n, d)) {
                 *x += y * w;
             }
         }

@@ -71,6 +71,8 @@ enum Phase {
     Mean,
     /// Setting feature flags.
     Flags,
+    /// Once, for a cost that stores per-vertex state: handing it every vertex's planes.
+    Init,
     /// Greedy: classifying every vertex and computing its key.
     Keys,
     /// Greedy: collapsing from the queue.
@@ -118,6 +120,8 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     log: &'a mut [[I; 2]],
     logging: bool,
     logged: usize,
+    /// The cost's per-vertex state has been filled (costs that store it only).
+    initialised: bool,
 }
 
 impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
@@ -160,6 +164,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             log: &mut [],
             logging: false,
             logged: 0,
+            initialised: false,
         }
     }
 
@@ -233,6 +238,12 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// Whether vertex `v` is currently a feature vertex (never removed while it is one).
     pub fn is_feature(&self, v: usize) -> bool {
         self.mesh.has(v, flag::FEATURE)
+    }
+
+    /// Vertex `v`'s current position in the input's units (moved by optimal placement);
+    /// `None` past the end.
+    pub fn position(&self, v: usize) -> Option<[f32; 3]> {
+        self.mesh.raw(v)
     }
 
     /// Whether vertex `v` currently has triangles.
@@ -340,8 +351,21 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     self.features = 0;
                     self.passes += 1;
                     self.pass_collapses = 0;
-                    let passes = self.config.schedule == Schedule::Passes;
-                    self.phase = if passes { Phase::Flags } else { Phase::Keys };
+                    self.phase = if self.cost.stores() && !self.initialised {
+                        Phase::Init
+                    } else {
+                        self.after_init()
+                    };
+                }
+            }
+            Phase::Init => {
+                if self.v < nv {
+                    self.init_vertex(self.v);
+                    self.v += 1;
+                } else {
+                    self.initialised = true;
+                    self.v = 0;
+                    self.phase = self.after_init();
                 }
             }
             Phase::Flags => {
@@ -371,6 +395,61 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             }
             Phase::Queue => self.pop(),
             Phase::Pairs => self.pair(),
+        }
+    }
+
+    /// The phase that starts a round's work.
+    fn after_init(&self) -> Phase {
+        if self.config.schedule == Schedule::Passes {
+            Phase::Flags
+        } else {
+            Phase::Keys
+        }
+    }
+
+    /// Hands the cost `v`'s planes (costs that store per-vertex state): each triangle's plane
+    /// weighted by twice its area, and for a boundary vertex the plane through each of its two
+    /// boundary edges perpendicular to the edge's triangle (seed 000 §3.3).
+    fn init_vertex(&mut self, v: usize) {
+        let f = self.mesh.flags(v);
+        if f & flag::USED == 0 {
+            return;
+        }
+        let pv = self.mesh.p(v);
+        let (first, last) = (self.mesh.first(v), self.mesh.last(v));
+        let mut c = first;
+        let mut guard = self.mesh.triangle_count();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let tri = self.mesh.tri(c >> 2);
+            let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+            let (px, py) = (self.mesh.p(x), self.mesh.p(y));
+            let n = math::cross(math::sub(px, pv), math::sub(py, pv));
+            let l2 = math::dot(n, n);
+            if l2 > math::TINY2 && l2.is_finite() {
+                let r = math::rsqrt(l2);
+                let unit = math::scale(n, r);
+                // Planes through v, in v's own frame (d = 0).
+                self.cost.plane(v, unit, 0.0, l2 * r);
+                if f & flag::BOUNDARY != 0 {
+                    // The first triangle's edge v-x and the last one's v-y have no twin.
+                    for (is, e) in [
+                        (c == first, math::sub(px, pv)),
+                        (c == last, math::sub(py, pv)),
+                    ] {
+                        if !is {
+                            continue;
+                        }
+                        let m = math::cross(e, unit);
+                        let m2 = math::dot(m, m);
+                        if m2 > math::TINY2 && m2.is_finite() {
+                            let m = math::scale(m, math::rsqrt(m2));
+                            self.cost.boundary_plane(v, m, 0.0, math::dot(e, e));
+                        }
+                    }
+                }
+            }
+            c = self.mesh.after(c);
         }
     }
 
@@ -428,6 +507,22 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// The price of moving `from` (walked as `w`) onto `to`, if the flag and boundary rules
     /// allow it: the cheap half of legality, enough for a lower bound.
     fn price(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<f32> {
+        self.price_kept(from, w, to, false)
+    }
+
+    /// [`Self::price`]; with `keep`, at `to`'s own position even for a placing cost.
+    fn price_kept(&self, from: usize, w: &Walk<C::Fan>, to: usize, keep: bool) -> Option<f32> {
+        let m = self.make_move(from, w, to, keep)?;
+        let c = self.cost.price(&w.fan, &m);
+        if c.is_finite() {
+            Some(if c > 0.0 { c } else { 0.0 })
+        } else {
+            None
+        }
+    }
+
+    /// The move `from -> to` as a cost sees it, if the flag and boundary rules allow it.
+    fn make_move(&self, from: usize, w: &Walk<C::Fan>, to: usize, keep: bool) -> Option<Move> {
         let mesh = &self.mesh;
         let ff = mesh.flags(from);
         legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
@@ -450,12 +545,58 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         } else {
             0.0
         };
-        let d = math::sub(mesh.p(to), w.p);
-        let c = self.cost.price(&w.fan, &Move { d, retreat2, turn });
-        if c.is_finite() {
-            Some(if c > 0.0 { c } else { 0.0 })
-        } else {
-            None
+        let p_to = mesh.p(to);
+        Some(Move {
+            d: math::sub(p_to, w.p),
+            retreat2,
+            turn,
+            from,
+            to,
+            p_from: w.p,
+            p_to,
+            keep: keep || !mesh.movable() || mesh.has(to, flag::FEATURE),
+        })
+    }
+
+    /// Where the kept vertex of `from -> to` goes if the cost places it (optimal placement on
+    /// mutable positions): its input-unit coordinates and the normalised position they read
+    /// back as. `None`: it stays.
+    fn placement(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<([f32; 3], V3)> {
+        if !self.mesh.movable() {
+            return None;
+        }
+        let m = self.make_move(from, w, to, false)?;
+        if m.keep {
+            return None;
+        }
+        let p = self.cost.place(&m)?;
+        self.mesh.stored_form(p)
+    }
+
+    /// The legality rules for `from -> to` priced `c`, at the cost's placement if it places
+    /// the kept vertex. If the rules refuse the placed position but allow the kept vertex to
+    /// stay, the collapse goes ahead at `to`'s own position and price. Returns the price and
+    /// the placement.
+    #[allow(clippy::type_complexity)]
+    fn legal(
+        &self,
+        from: usize,
+        w: &Walk<C::Fan>,
+        to: usize,
+        c: f32,
+    ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
+        let at = self.placement(from, w, to);
+        match legality::check(&self.mesh, &self.rules, from, to, at.map(|x| x.1)) {
+            Ok(()) => Ok((c, at)),
+            Err(r) => {
+                if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok()
+                {
+                    if let Some(kept) = self.price_kept(from, w, to, true) {
+                        return Ok((kept, None));
+                    }
+                }
+                Err(r)
+            }
         }
     }
 
@@ -558,14 +699,14 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let n = self.candidates(v, &w, &mut cand);
         let cand = cand.get_mut(..n).unwrap_or(&mut []);
         while let Some((c, to)) = take_cheapest(cand) {
-            match legality::check(&self.mesh, &self.rules, v, to) {
-                Ok(()) => {
+            match self.legal(v, &w, to, c) {
+                Ok((c, at)) => {
                     if c > key {
                         // Its cheapest candidate was illegal: back in at its true price.
                         self.heap.set(v, c);
                     } else {
                         self.heap.remove(v);
-                        self.collapse_greedy(v, to);
+                        self.collapse_greedy(v, to, at);
                     }
                     return;
                 }
@@ -584,13 +725,19 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// Greedy: collapse `a -> b`, then re-key the vertices whose fan changed: `b` and `a`'s
     /// other neighbours (marked before the collapse). Nothing else changes: the other
     /// neighbours of `b` keep their fans, so their prices stand.
-    fn collapse_greedy(&mut self, a: usize, b: usize) {
+    ///
+    /// A cost that stores per-vertex state changed `b`'s quadric (and a placement may have
+    /// moved `b`), so all of `b`'s neighbours are re-keyed.
+    fn collapse_greedy(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
         if !self.note(a, b) {
             return;
         }
         let mesh = &self.mesh;
         mesh.for_each_neighbour(a, |x| mesh.mark(x, true));
-        self.mesh.collapse(a, b);
+        if self.cost.stores() || at.is_some() {
+            mesh.for_each_neighbour(b, |x| mesh.mark(x, true));
+        }
+        self.apply(a, b, at);
         self.collapses += 1;
         self.pass_collapses += 1;
         self.mesh.mark(b, false);
@@ -606,6 +753,20 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         if last != NIL {
             let y = self.mesh.tri(last >> 2)[prev3(last & 3)];
             self.refresh(y);
+        }
+    }
+
+    /// Collapses `a -> b` in the mesh, moves `b` to its placement and merges the cost's state.
+    fn apply(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
+        let (pa, pb) = (self.mesh.p(a), self.mesh.p(b));
+        self.mesh.collapse(a, b);
+        let mut p_new = pb;
+        if let Some((q, p)) = at {
+            self.mesh.place(b, q);
+            p_new = p;
+        }
+        if self.cost.stores() {
+            self.cost.merge(a, b, pa, pb, p_new);
         }
     }
 
@@ -659,6 +820,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
         let mut n = 0;
         let wv = self.walk(v);
+        let movable = self.mesh.movable();
         for y in wv.neighbours() {
             if self.mesh.has(y, flag::DONE) {
                 continue;
@@ -687,8 +849,15 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             if let Some(slot) = cand.get_mut(i) {
                 slot.1 = NIL;
             }
-            match legality::check(&self.mesh, &self.rules, from, to) {
-                Ok(()) => {
+            let checked = if movable {
+                // A placing cost: place with `from`'s own walk.
+                let w = self.walk(from);
+                self.legal(from, &w, to, c)
+            } else {
+                legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None))
+            };
+            match checked {
+                Ok((c, at)) => {
                     if c > self.config.max_cost {
                         self.over_cost = true;
                         return;
@@ -696,7 +865,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                     if !self.note(from, to) {
                         return;
                     }
-                    self.mesh.collapse(from, to);
+                    self.apply(from, to, at);
                     self.mesh.set_flag(to, flag::DONE, true);
                     self.collapses += 1;
                     self.pass_collapses += 1;

@@ -26,6 +26,17 @@ pub struct Move {
     /// Σ ‖N_new − N_old‖² over the surviving triangles (unit normals; seed 004 eq. 2), when
     /// [`Cost::needs_turn`]; zero otherwise.
     pub turn: f32,
+    /// The moving vertex (removed by the collapse).
+    pub from: usize,
+    /// The kept vertex.
+    pub to: usize,
+    /// Their positions (normalised units).
+    pub p_from: V3,
+    /// See `p_from`.
+    pub p_to: V3,
+    /// The kept vertex must stay where it is (it is a feature vertex, or positions are
+    /// read-only): a placing cost prices the move at `p_to`.
+    pub keep: bool,
 }
 
 /// A collapse cost. Lower is better; the engine never performs a collapse whose price is not
@@ -45,6 +56,31 @@ pub trait Cost {
     /// Called at the start of every round with the mean of twice the triangle area over the
     /// current mesh (the scale of its triangles). Nothing by default.
     fn round(&mut self, _mean_area2: f32) {}
+    /// Whether the cost keeps state per vertex (stored quadrics). If so the engine, once before
+    /// the first keys, hands it every used vertex's planes ([`Cost::plane`]); after each
+    /// collapse it calls [`Cost::merge`] and re-keys the kept vertex's whole ring (every
+    /// neighbour's price onto it changed), not only the removed vertex's former neighbours.
+    fn stores(&self) -> bool {
+        false
+    }
+    /// Adds `weight · (n·x + d)²` to vertex `v`'s state (only if [`Cost::stores`]): the plane
+    /// of one of its triangles (weight: twice its area), or a boundary plane. `x` is relative
+    /// to `v`'s position (the engine passes planes through `v`, so `d` is zero): a cost may keep
+    /// each vertex's state in a frame centred on it, which keeps `f32` sums of nearby planes
+    /// free of the cancellation a global origin causes.
+    fn plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
+    /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle
+    /// (seed 000 §3.3); `weight` is the squared edge length, the cost applies its own factor.
+    fn boundary_plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
+    /// Vertex `from` (at `p_from`) was collapsed onto `to` (at `p_to`), which is now at `p_new`
+    /// (only if [`Cost::stores`]).
+    fn merge(&mut self, _from: usize, _to: usize, _p_from: V3, _p_to: V3, _p_new: V3) {}
+    /// Where the kept vertex goes for this move, if it moves at all (optimal placement); the
+    /// engine checks the legality rules there and writes it to the caller's mutable positions.
+    /// `None` by default: the kept vertex stays (subset placement).
+    fn place(&self, _m: &Move) -> Option<V3> {
+        None
+    }
 }
 
 /// Memoryless quadric error (Lindstrom and Turk's "memoryless" simplification, 1998; the
@@ -246,5 +282,259 @@ impl Cost for Builtin {
         if let Builtin::Quadric(q) = self {
             q.round(mean_area2)
         }
+    }
+}
+
+/// Per-vertex storage of [`StoredQuadric`]: a symmetric 4×4 matrix as its upper triangle, row by
+/// row (`a², ab, ac, ad, b², bc, bd, c², cd, d²` for one plane), 40 bytes.
+pub type VertexQuadric = [f32; 10];
+
+/// Where a collapse with stored quadrics leaves the kept vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Placement {
+    /// At one of the two endpoints (positions are only read, flash is fine).
+    Subset,
+    /// At the minimiser of Δ over the edge's summed quadric (seed 000 §2.3 and Garland),
+    /// written into the caller's mutable positions; the best of the endpoints and the midpoint
+    /// when the 3×3 system is ill-conditioned or its solution lies far from the edge.
+    Optimal,
+}
+
+/// Accumulated quadric error metric (Garland's, seed 000 ref. 5) with per-vertex storage: seed 000 §2.3-2.5
+/// (Cheng, Pan and Shi: `K_p = p pᵀ`, `Q_s` the sum over the vertex's triangles, `Q = Q_s + Q_t`
+/// on a collapse, `Δ = vᵀ Q v` and an error-cost queue) and seed 003 (an implementation of
+/// Garland's edge collapse). Planes are area-weighted; a boundary vertex also gets, for each
+/// boundary edge it is on, the plane through that edge perpendicular to its triangle (seed 000
+/// §3.3), weighted by `boundary_weight` times the squared edge length.
+///
+/// The matrices live in a caller-provided slice, one [`VertexQuadric`] (40 bytes) per vertex, at
+/// least as long as the positions. All in the engine's normalised units, and each vertex's
+/// matrix in a frame centred on that vertex (moved to the kept vertex's new position on a
+/// collapse): in `f32`, `vᵀQv` with a global origin loses the small errors of early collapses
+/// to cancellation between terms of order one.
+pub struct StoredQuadric<'q> {
+    q: &'q mut [VertexQuadric],
+    boundary_weight: f32,
+    placement: Placement,
+}
+
+impl<'q> StoredQuadric<'q> {
+    /// A stored quadric over `storage` (zeroed here; the engine fills it).
+    pub fn new(
+        storage: &'q mut [VertexQuadric],
+        boundary_weight: f32,
+        placement: Placement,
+    ) -> Self {
+        for q in storage.iter_mut() {
+            *q = [0.0; 10];
+        }
+        StoredQuadric {
+            q: storage,
+            boundary_weight,
+            placement,
+        }
+    }
+
+    /// The boundary-plane weight.
+    pub fn boundary_weight(&self) -> f32 {
+        self.boundary_weight
+    }
+
+    /// The placement.
+    pub fn placement(&self) -> Placement {
+        self.placement
+    }
+
+    /// Vertex `v`'s quadric (zero if out of range).
+    pub fn quadric(&self, v: usize) -> VertexQuadric {
+        self.q.get(v).copied().unwrap_or([0.0; 10])
+    }
+
+    /// The edge's quadric `Q_from + Q_to` in the frame centred on `p_to`.
+    fn edge(&self, m: &Move) -> VertexQuadric {
+        add(
+            &translate(&self.quadric(m.from), math::sub(m.p_to, m.p_from)),
+            &self.quadric(m.to),
+        )
+    }
+
+    /// The best position for `m` relative to `p_to`, and its error: the solution of the 3×3 system if it is
+    /// well conditioned and near the edge, else (and if better) an endpoint or the midpoint.
+    /// Candidates are compared in a fixed order with `<`, so ties go to the earlier one.
+    fn best(&self, m: &Move) -> (V3, f32) {
+        let q = self.edge(m);
+        // Relative to p_to: the kept end is 0, the removed one -d.
+        let mut best = ([0.0; 3], error(&q, [0.0; 3]));
+        if !(m.keep || self.placement == Placement::Subset) {
+            let back = math::scale(m.d, -1.0);
+            let mid = math::scale(m.d, -0.5);
+            let l2 = math::dot(m.d, m.d);
+            if let Some(x) = solve(&q) {
+                let off = math::sub(x, mid);
+                if math::dot(off, off) <= l2 {
+                    let c = error(&q, x);
+                    if c < best.1 {
+                        best = (x, c);
+                    }
+                }
+            }
+            for x in [back, mid] {
+                let c = error(&q, x);
+                if c < best.1 {
+                    best = (x, c);
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The quadric `p pᵀ` of the plane `p = (n, d)` (seed 000 eq. 3, `K_p`), upper triangle.
+#[inline]
+pub(crate) fn outer(n: V3, d: f32) -> VertexQuadric {
+    let [a, b, c] = n;
+    [
+        a * a,
+        a * b,
+        a * c,
+        a * d,
+        b * b,
+        b * c,
+        b * d,
+        c * c,
+        c * d,
+        d * d,
+    ]
+}
+
+/// Element-wise sum.
+fn add(x: &VertexQuadric, y: &VertexQuadric) -> VertexQuadric {
+    let mut s = *x;
+    for (s, y) in s.iter_mut().zip(y) {
+        *s += y;
+    }
+    s
+}
+
+/// `q` (in a frame centred on `o`) in the frame centred on `o + s`: with `x = x' + s`,
+/// `b' = b + A s` and `c' = q(s)`.
+fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
+    let [x, y, z] = s;
+    let b0 = q[3] + q[0] * x + q[1] * y + q[2] * z;
+    let b1 = q[6] + q[1] * x + q[4] * y + q[5] * z;
+    let b2 = q[8] + q[2] * x + q[5] * y + q[7] * z;
+    [q[0], q[1], q[2], b0, q[4], q[5], b1, q[7], b2, form(q, s)]
+}
+
+/// `vᵀ Q v` for `v = (p, 1)`, unclamped.
+#[inline]
+fn form(q: &VertexQuadric, p: V3) -> f32 {
+    let [x, y, z] = p;
+    q[0] * x * x
+        + q[4] * y * y
+        + q[7] * z * z
+        + 2.0 * (q[1] * x * y + q[2] * x * z + q[5] * y * z)
+        + 2.0 * (q[3] * x + q[6] * y + q[8] * z)
+        + q[9]
+}
+
+/// `vᵀ Q v` for `v = (p, 1)`, clamped at zero (`p` in the quadric's frame).
+#[inline]
+pub fn error(q: &VertexQuadric, p: V3) -> f32 {
+    let e = form(q, p);
+    if e > 0.0 {
+        e
+    } else {
+        0.0
+    }
+}
+
+/// The minimiser of `vᵀ Q v`: `A p = −b` by Cramer's rule, `None` when `A` is ill-conditioned
+/// (|det A| below 1e-5 of (trace A / 3)³: a flat or creased neighbourhood, where the minimiser
+/// is a line or a plane) or the result is not finite.
+fn solve(q: &VertexQuadric) -> Option<V3> {
+    let (a00, a01, a02, a11, a12, a22) = (q[0], q[1], q[2], q[4], q[5], q[7]);
+    let (b0, b1, b2) = (-q[3], -q[6], -q[8]);
+    let c00 = a11 * a22 - a12 * a12;
+    let c01 = a02 * a12 - a01 * a22;
+    let c02 = a01 * a12 - a02 * a11;
+    let det = a00 * c00 + a01 * c01 + a02 * c02;
+    let t = (a00 + a11 + a22) * (1.0 / 3.0);
+    let abs = if det < 0.0 { -det } else { det };
+    // Written so that NaN fails too.
+    let conditioned = t > 0.0 && abs > 1e-5 * t * t * t;
+    if !conditioned {
+        return None;
+    }
+    let c11 = a00 * a22 - a02 * a02;
+    let c12 = a01 * a02 - a00 * a12;
+    let c22 = a00 * a11 - a01 * a01;
+    let inv = 1.0 / det;
+    let p = [
+        (c00 * b0 + c01 * b1 + c02 * b2) * inv,
+        (c01 * b0 + c11 * b1 + c12 * b2) * inv,
+        (c02 * b0 + c12 * b1 + c22 * b2) * inv,
+    ];
+    if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() {
+        Some(p)
+    } else {
+        None
+    }
+}
+
+impl Cost for StoredQuadric<'_> {
+    type Fan = ();
+
+    fn empty(&self) {}
+
+    #[inline]
+    fn add(&self, _: &mut (), _: V3, _: f32) {}
+
+    #[inline]
+    fn price(&self, _: &(), m: &Move) -> f32 {
+        self.best(m).1
+    }
+
+    fn needs_turn(&self) -> bool {
+        false
+    }
+
+    fn stores(&self) -> bool {
+        true
+    }
+
+    fn plane(&mut self, v: usize, n: V3, d: f32, w: f32) {
+        if let Some(q) = self.q.get_mut(v) {
+            for (q, k) in q.iter_mut().zip(outer(n, d)) {
+                *q += w * k;
+            }
+        }
+    }
+
+    fn boundary_plane(&mut self, v: usize, n: V3, d: f32, w: f32) {
+        self.plane(v, n, d, w * self.boundary_weight)
+    }
+
+    fn merge(&mut self, from: usize, to: usize, p_from: V3, p_to: V3, p_new: V3) {
+        let s = add(
+            &translate(&self.quadric(from), math::sub(p_new, p_from)),
+            &translate(&self.quadric(to), math::sub(p_new, p_to)),
+        );
+        if let Some(q) = self.q.get_mut(to) {
+            *q = s;
+        }
+    }
+
+    fn place(&self, m: &Move) -> Option<V3> {
+        if m.keep || self.placement == Placement::Subset {
+            return None;
+        }
+        let x = self.best(m).0;
+        if x == [0.0; 3] {
+            // The kept end stays where it is.
+            return None;
+        }
+        Some(math::add(m.p_to, x))
     }
 }

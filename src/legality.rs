@@ -164,6 +164,22 @@ fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
     }
 }
 
+/// The sliver and normal-turn rules on one surviving triangle, `was` before the collapse and
+/// `now` after it.
+#[inline]
+fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
+    if on::SLIVER
+        && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
+    {
+        return Err(Reject::Sliver);
+    }
+    // A zero-area triangle has no direction to turn from.
+    if on::NORMAL_TURN && was.quality > 0.0 && turned(was, now, rules.cos_turn, rules.cos_turn2) {
+        return Err(Reject::NormalTurn);
+    }
+    Ok(())
+}
+
 /// Whether two triangles sharing an edge are folded onto each other.
 #[inline]
 fn folded(u: &Shape, v: &Shape) -> bool {
@@ -191,13 +207,36 @@ pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
     Ok(())
 }
 
-/// Checks every rule for `a -> b`.
+/// The shape of live triangle `t` once `a` and `b` are both at `p` (`b` moved, `a` merged
+/// into it).
+#[inline]
+fn shape_moved<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    t: usize,
+    a: usize,
+    b: usize,
+    p: V3,
+) -> Shape {
+    Shape::of(
+        mesh.tri(t)
+            .map(|v| if v == a || v == b { p } else { mesh.p(v) }),
+    )
+}
+
+/// Checks every rule for `a -> b`; with `at`, for `b` moved to `at` (optimal placement): then
+/// `b`'s own surviving triangles change too and pass the same shape, turn and fold rules.
 pub(crate) fn check<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
     rules: &Rules,
     a: usize,
     b: usize,
+    at: Option<V3>,
 ) -> Result<(), Reject> {
+    // The shape after the collapse of a triangle that is not a's.
+    let after = |u: usize| match at {
+        None => shape_of(mesh, u),
+        Some(p) => shape_moved(mesh, u, a, b, p),
+    };
     let fa = mesh.flags(a);
     flags_allow(rules, fa, mesh.flags(b))?;
 
@@ -265,7 +304,10 @@ pub(crate) fn check<L: Index, I: Index>(
     // Each surviving triangle: duplicate, own shape and turn, folds with its neighbours
     // after the collapse (the next survivor across a spoke, b's triangles across (b, o1) and
     // (b, o2), and the unchanged triangles across its outer edge).
-    let pb = mesh.p(b);
+    let pb = match at {
+        Some(p) => p,
+        None => mesh.p(b),
+    };
     let mut first: Option<(usize, Shape)> = None;
     let mut prev: Option<(usize, Shape)> = None;
     for (t, k) in mesh.corners(a) {
@@ -290,18 +332,7 @@ pub(crate) fn check<L: Index, I: Index>(
         }
         let was = Shape::of(q);
         let now = Shape::of(r);
-        if on::SLIVER
-            && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
-        {
-            return Err(Reject::Sliver);
-        }
-        // A zero-area triangle has no direction to turn from.
-        if on::NORMAL_TURN
-            && was.quality > 0.0
-            && turned(&was, &now, rules.cos_turn, rules.cos_turn2)
-        {
-            return Err(Reject::NormalTurn);
-        }
+        shape_rules(rules, &was, &now)?;
         if on::FOLD {
             let mut fold = false;
             if let Some((py, ps)) = prev {
@@ -309,13 +340,13 @@ pub(crate) fn check<L: Index, I: Index>(
             }
             for (v, u) in [(o1, across_o1), (o2, across_o2)] {
                 if (x == v || y == v) && u != NIL {
-                    fold |= folded(&now, &shape_of(mesh, u));
+                    fold |= folded(&now, &after(u));
                 }
             }
             // Outer edge x-y: every other triangle holding both (one, on a manifold edge).
             for (u, _) in mesh.corners(x) {
                 if u != t && mesh.tri(u).contains(&y) {
-                    fold |= folded(&now, &shape_of(mesh, u));
+                    fold |= folded(&now, &after(u));
                 }
             }
             if fold {
@@ -331,6 +362,61 @@ pub(crate) fn check<L: Index, I: Index>(
     if let (true, Some((fx, fs)), Some((ly, ls))) = (on::FOLD, first, prev) {
         if fx == ly && fx != o1 && fx != o2 && folded(&fs, &ls) {
             return Err(Reject::Fold);
+        }
+    }
+    match at {
+        Some(p) => check_moved_b(mesh, rules, a, b, p),
+        None => Ok(()),
+    }
+}
+
+/// The shape, turn and fold rules on `b`'s surviving triangles with `b` at `p` (`a` merged
+/// into it). A fold is looked for across each of their edges, against the triangle there
+/// after the collapse.
+fn check_moved_b<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    a: usize,
+    b: usize,
+    p: V3,
+) -> Result<(), Reject> {
+    let merged = |v: usize| if v == a { b } else { v };
+    for (t, k) in mesh.corners(b) {
+        let old = mesh.tri(t);
+        if old.contains(&a) {
+            continue;
+        }
+        let q = old.map(|v| mesh.p(v));
+        let mut r = q;
+        if let Some(v) = r.get_mut(k) {
+            *v = p;
+        }
+        let was = Shape::of(q);
+        let now = Shape::of(r);
+        shape_rules(rules, &was, &now)?;
+        if on::FOLD {
+            for (u, w) in [(old[0], old[1]), (old[1], old[2]), (old[2], old[0])] {
+                // Triangles holding u (for b: a's too), other than t and the removed ones.
+                let mut fold = false;
+                let lists = if u == b { [b, a] } else { [u, NIL] };
+                for l in lists {
+                    if l == NIL {
+                        continue;
+                    }
+                    for (s, _) in mesh.corners(l) {
+                        let tri = mesh.tri(s);
+                        if s == t || (tri.contains(&a) && tri.contains(&b)) {
+                            continue;
+                        }
+                        if tri.iter().any(|&x| merged(x) == w) {
+                            fold |= folded(&now, &shape_moved(mesh, s, a, b, p));
+                        }
+                    }
+                }
+                if fold {
+                    return Err(Reject::Fold);
+                }
+            }
         }
     }
     Ok(())

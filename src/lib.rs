@@ -94,6 +94,8 @@ pub enum Capacity {
     Vertices,
     /// More triangles than the workspace (or its link type) can number.
     Triangles,
+    /// Fewer stored quadrics than positions ([`Workspace::simplify_stored`]).
+    Quadrics,
 }
 
 /// Which configuration field is out of range.

@@ -79,9 +79,33 @@ pub(crate) const fn prev3(k: usize) -> usize {
 /// Marks the end of a corner list.
 pub(crate) const NIL: usize = usize::MAX;
 
+/// Where the positions live: the caller's read-only slice (subset placement: flash is fine),
+/// or a mutable one that a placement may write (optimal placement of stored quadrics).
+pub(crate) enum Positions<'a> {
+    Read(&'a [[f32; 3]]),
+    Write(&'a mut [[f32; 3]]),
+}
+
+impl Positions<'_> {
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            Positions::Read(p) => p.len(),
+            Positions::Write(p) => p.len(),
+        }
+    }
+
+    #[inline]
+    fn get(&self, v: usize) -> Option<&[f32; 3]> {
+        match self {
+            Positions::Read(p) => p.get(v),
+            Positions::Write(p) => p.get(v),
+        }
+    }
+}
+
 /// The mesh under simplification.
 pub(crate) struct Mesh<'a, L: Index, I: Index> {
-    pos: &'a [[f32; 3]],
+    pos: Positions<'a>,
     pub(crate) tris: &'a mut [[I; 3]],
     head: &'a mut [L],
     next: &'a mut [[L; 3]],
@@ -106,7 +130,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// Validates the input (reading only), then drops degenerate and duplicate triangles,
     /// builds the corner lists and classifies vertices.
     pub(crate) fn build(
-        pos: &'a [[f32; 3]],
+        pos: Positions<'a>,
         tris: &'a mut [[I; 3]],
         head: &'a mut [L],
         next: &'a mut [[L; 3]],
@@ -344,6 +368,53 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
                 (q[2] * 0.5 - self.half_centre[2]) * self.inv_half,
             ],
             None => [0.0; 3],
+        }
+    }
+
+    /// `v`'s position as stored (input units).
+    pub(crate) fn raw(&self, v: usize) -> Option<[f32; 3]> {
+        self.pos.get(v).copied()
+    }
+
+    /// Whether positions may be written ([`Mesh::place`]).
+    pub(crate) fn movable(&self) -> bool {
+        matches!(self.pos, Positions::Write(_))
+    }
+
+    /// The input-unit coordinates of normalised position `p` (the inverse of [`Mesh::p`]).
+    #[inline]
+    fn denormalise(&self, p: V3) -> [f32; 3] {
+        let h = 1.0 / self.inv_half;
+        [
+            (p[0] * h + self.half_centre[0]) * 2.0,
+            (p[1] * h + self.half_centre[1]) * 2.0,
+            (p[2] * h + self.half_centre[2]) * 2.0,
+        ]
+    }
+
+    /// Normalised position `p` as it will be stored: its input-unit coordinates, and the
+    /// normalised position they read back as (the engine then works on exactly what it
+    /// wrote). `None` if they would not be finite.
+    pub(crate) fn stored_form(&self, p: V3) -> Option<([f32; 3], V3)> {
+        let q = self.denormalise(p);
+        if !(q[0].is_finite() && q[1].is_finite() && q[2].is_finite()) {
+            return None;
+        }
+        let r = [
+            (q[0] * 0.5 - self.half_centre[0]) * self.inv_half,
+            (q[1] * 0.5 - self.half_centre[1]) * self.inv_half,
+            (q[2] * 0.5 - self.half_centre[2]) * self.inv_half,
+        ];
+        Some((q, r))
+    }
+
+    /// Writes `q` (input units, from [`Mesh::stored_form`]) as `v`'s position; nothing if the
+    /// positions are read-only.
+    pub(crate) fn place(&mut self, v: usize, q: [f32; 3]) {
+        if let Positions::Write(pos) = &mut self.pos {
+            if let Some(x) = pos.get_mut(v) {
+                *x = q;
+            }
         }
     }
 

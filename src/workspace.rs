@@ -1,9 +1,9 @@
 //! The fixed-capacity working memory, sized at compile time.
 
 use crate::collapse::Simplifier;
-use crate::cost::{Builtin, Cost};
+use crate::cost::{Builtin, Cost, Placement, StoredQuadric, VertexQuadric};
 use crate::index::Index;
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Positions};
 use crate::{Config, Error, Report};
 
 /// All working state of the simplifier, with capacity fixed by const generics.
@@ -98,6 +98,66 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         config: &Config,
         cost: C,
     ) -> Result<Simplifier<'a, L, I, C>, Error> {
+        self.start_on(Positions::Read(positions), triangles, config, cost)
+    }
+
+    /// Like [`Workspace::start_with_cost`], on positions that a placing cost may move
+    /// ([`Cost::place`]; [`StoredQuadric`] with [`Placement::Optimal`]): the kept vertex of each
+    /// collapse is written there, in the input's units. Positions of vertices that no longer
+    /// have triangles keep their last value.
+    pub fn start_moving<'a, I: Index, C: Cost>(
+        &'a mut self,
+        positions: &'a mut [[f32; 3]],
+        triangles: &'a mut [[I; 3]],
+        config: &Config,
+        cost: C,
+    ) -> Result<Simplifier<'a, L, I, C>, Error> {
+        self.start_on(Positions::Write(positions), triangles, config, cost)
+    }
+
+    /// Simplifies with stored quadrics ([`StoredQuadric`], seed 000 §2.3-2.5 and §3.3) and
+    /// subset placement: positions are only read. `quadrics` holds one [`VertexQuadric`] (40
+    /// bytes) per position; too short a slice is [`Error::Capacity`] with
+    /// [`Capacity::Quadrics`](crate::Capacity::Quadrics). Boundary planes are weighted by
+    /// [`Config::boundary_weight`].
+    pub fn simplify_stored<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+        quadrics: &mut [VertexQuadric],
+    ) -> Result<Report, Error> {
+        quadrics_fit(positions.len(), quadrics.len())?;
+        let cost = StoredQuadric::new(quadrics, config.boundary_weight, Placement::Subset);
+        let mut s = self.start_with_cost(positions, triangles, config, cost)?;
+        while !s.step(u32::MAX) {}
+        Ok(s.finish())
+    }
+
+    /// Like [`Workspace::simplify_stored`] with optimal placement: each kept vertex moves to the
+    /// minimiser of its summed quadric (or the best of the endpoints and the midpoint), written
+    /// into `positions`. On error nothing has been written.
+    pub fn simplify_optimal<I: Index>(
+        &mut self,
+        positions: &mut [[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+        quadrics: &mut [VertexQuadric],
+    ) -> Result<Report, Error> {
+        quadrics_fit(positions.len(), quadrics.len())?;
+        let cost = StoredQuadric::new(quadrics, config.boundary_weight, Placement::Optimal);
+        let mut s = self.start_moving(positions, triangles, config, cost)?;
+        while !s.step(u32::MAX) {}
+        Ok(s.finish())
+    }
+
+    fn start_on<'a, I: Index, C: Cost>(
+        &'a mut self,
+        positions: Positions<'a>,
+        triangles: &'a mut [[I; 3]],
+        config: &Config,
+        cost: C,
+    ) -> Result<Simplifier<'a, L, I, C>, Error> {
         config.validate()?;
         if positions.len() > MAX_VERTICES || positions.len() > L::COUNT {
             return Err(Error::Capacity {
@@ -156,6 +216,18 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
             cost,
         ))
     }
+}
+
+/// `Error::Capacity` unless there is a quadric per position.
+fn quadrics_fit(positions: usize, quadrics: usize) -> Result<(), Error> {
+    if quadrics < positions {
+        return Err(Error::Capacity {
+            what: crate::Capacity::Quadrics,
+            needed: positions,
+            available: quadrics,
+        });
+    }
+    Ok(())
 }
 
 impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> Default

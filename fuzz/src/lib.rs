@@ -743,6 +743,7 @@ fn check_output<I: Idx>(
             margin: FOLD_MARGIN,
             min_quality: MIN_Q,
         }),
+        allow_moved: false,
     };
     let mesh = |triangles| meshcheck::MeshRef {
         positions: pos,

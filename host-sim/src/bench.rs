@@ -184,16 +184,40 @@ pub enum Method {
     Paper,
     /// meshoptimizer's `meshopt_simplify`.
     Meshopt,
+    /// tinydecimate, stored quadrics with subset placement (`Workspace::simplify_stored`).
+    Stored,
+    /// tinydecimate, stored quadrics with optimal placement (`Workspace::simplify_optimal`).
+    StoredOptimal,
+    /// meshoptimizer's `meshopt_simplifyWithUpdate` (positions moved, no attributes).
+    MeshoptUpdate,
 }
 
 impl Method {
-    /// All four, in table order.
-    pub const ALL: [Method; 4] = [
+    /// All of them, in table order.
+    pub const ALL: [Method; 7] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
         Method::Meshopt,
+        Method::Stored,
+        Method::StoredOptimal,
+        Method::MeshoptUpdate,
     ];
+
+    /// Stored-quadric placement of our stored modes.
+    pub fn placement(self) -> Option<tinydecimate::cost::Placement> {
+        use tinydecimate::cost::Placement;
+        match self {
+            Method::Stored => Some(Placement::Subset),
+            Method::StoredOptimal => Some(Placement::Optimal),
+            _ => None,
+        }
+    }
+
+    /// Whether the output's positions may differ from the input's.
+    pub fn moves(self) -> bool {
+        matches!(self, Method::StoredOptimal | Method::MeshoptUpdate)
+    }
 
     /// Name in the tables.
     pub fn label(self) -> &'static str {
@@ -202,6 +226,9 @@ impl Method {
             Method::GreedyW => "greedy W",
             Method::Paper => "paper passes",
             Method::Meshopt => "meshoptimizer",
+            Method::Stored => "stored quadric, subset",
+            Method::StoredOptimal => "stored quadric, optimal",
+            Method::MeshoptUpdate => "meshoptimizer simplifyWithUpdate",
         }
     }
 
@@ -211,7 +238,8 @@ impl Method {
             Method::Default => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
-            Method::Meshopt => None,
+            Method::Stored | Method::StoredOptimal => Some(Config::new()),
+            Method::Meshopt | Method::MeshoptUpdate => None,
         }
     }
 
@@ -222,12 +250,15 @@ impl Method {
             Method::GreedyW => "`Config::new().with_cost(CostKind::NormalVariation)`",
             Method::Paper => "`Config::paper()`",
             Method::Meshopt => "`meshopt::simplify`",
+            Method::Stored => "`Workspace::simplify_stored` with `Config::new()`",
+            Method::StoredOptimal => "`Workspace::simplify_optimal` with `Config::new()`",
+            Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
         }
     }
 
     /// Whether this is one of ours.
     pub fn is_ours(self) -> bool {
-        self != Method::Meshopt
+        !matches!(self, Method::Meshopt | Method::MeshoptUpdate)
     }
 }
 
@@ -615,6 +646,43 @@ pub fn meshopt_simplify(mesh: &MeshData, target_triangles: usize) -> (MeshData, 
     (result, elapsed, peak)
 }
 
+/// `meshopt::simplify_with_update` (positions only, no attributes) on `mesh` down to
+/// `target_triangles`: result (with the moved positions), wall time and peak scratch bytes.
+pub fn meshopt_simplify_with_update(
+    mesh: &MeshData,
+    target_triangles: usize,
+) -> (MeshData, Duration, usize) {
+    let mut indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let mut positions = mesh.positions.clone();
+    let _lock = MESHOPT.lock().unwrap_or_else(|p| p.into_inner());
+    let ((n, elapsed), peak) = counted::peak_during(|| {
+        let start = Instant::now();
+        let n = meshopt::simplify_with_update(
+            &mut indices,
+            &mut positions,
+            &mut [],
+            &[],
+            0,
+            None,
+            3 * target_triangles,
+            1.0,
+            meshopt::SimplifyOptions::None,
+            None,
+        );
+        (n, start.elapsed())
+    });
+    indices.truncate(n);
+    let triangles = indices
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    let result = MeshData {
+        positions,
+        triangles,
+    };
+    (result, elapsed, peak)
+}
+
 // ---------------------------------------------------------------------------------------------
 // The benchmark
 
@@ -707,13 +775,27 @@ fn run_method(
     let mut times_ms = Vec::with_capacity(reps);
     let mut last = None;
     for _ in 0..reps {
-        let (out, elapsed, scratch, report) = match method.config() {
-            Some(config) => {
+        let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
+            (Some(config), Some(placement)) => {
+                let (out, report, elapsed) = crate::simplify::simplify_stored(
+                    mesh,
+                    &config.with_ratio(ratio),
+                    placement,
+                    false,
+                )?;
+                let bytes = workspace_bytes(v, t).0 + v * crate::simplify::QUADRIC_BYTES;
+                (out, elapsed, bytes, Some(report))
+            }
+            (Some(config), None) => {
                 let (out, report, elapsed) = simplify(mesh, &config.with_ratio(ratio))?;
                 (out, elapsed, workspace_bytes(v, t).0, Some(report))
             }
-            None => {
-                let (out, elapsed, peak) = meshopt_simplify(mesh, target);
+            (None, _) => {
+                let (out, elapsed, peak) = if method == Method::MeshoptUpdate {
+                    meshopt_simplify_with_update(mesh, target)
+                } else {
+                    meshopt_simplify(mesh, target)
+                };
                 (out, elapsed, peak, None)
             }
         };
@@ -766,7 +848,7 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                 bar.set_message(format!("{name} {ratio} {}", method.label()));
                 let run = run_method(mesh, method, ratio, target, opts.reps)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
-                let validity = compare(mesh, &run.out);
+                let validity = crate::check::compare_with(mesh, &run.out, method.moves());
                 let m = metro(mesh, &run.out, &metro_opts);
                 let triangles_out = run.out.triangles.len();
                 rows.push(Row {
@@ -1379,7 +1461,7 @@ mod tests {
         );
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 3);
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 5);
     }
 
     #[test]

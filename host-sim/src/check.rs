@@ -17,6 +17,11 @@ pub fn analyse(mesh: &MeshData) -> Topology {
 /// Whether `output` is a valid simplification of `input` (same vertex numbering; the output's
 /// positions of the vertices it uses must be the input's).
 pub fn compare(input: &MeshData, output: &MeshData) -> Validity {
+    compare_with(input, output, false)
+}
+
+/// [`compare`]; with `allow_moved`, kept vertices may have moved (optimal placement).
+pub fn compare_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> Validity {
     meshcheck::check_with(
         meshcheck::MeshRef {
             positions: &input.positions,
@@ -26,7 +31,10 @@ pub fn compare(input: &MeshData, output: &MeshData) -> Validity {
             positions: &output.positions,
             triangles: &output.triangles,
         },
-        &meshcheck::Options::default(),
+        &meshcheck::Options {
+            view: None,
+            allow_moved,
+        },
     )
 }
 

@@ -73,6 +73,7 @@ pub fn subset_that_fits(case: &Case, max_vertices: usize, max_triangles: usize) 
         triangles: m.triangles,
         index_type: case.index_type,
         config: case.config,
+        stored: case.stored,
     }
 }
 
@@ -128,6 +129,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         triangles: m.triangles,
         index_type,
         config,
+        stored: None,
     };
     let timeout = Duration::from_secs(a.timeout);
 
@@ -307,6 +309,7 @@ mod tests {
             triangles: m.triangles,
             index_type: IndexType::U16,
             config: Config::new(),
+            stored: None,
         };
         let s = subset_that_fits(&case, 30, 1000);
         assert!(s.positions.len() <= 30);

@@ -25,7 +25,7 @@ use std::process::{Command, ExitCode};
 
 use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::file::{decode_result, encode_case, encode_result};
-use meshfmt::{Board, ErrorKind, IndexType, ResultHeader, Status};
+use meshfmt::{Board, CostCode, ErrorKind, IndexType, ResultHeader, Status};
 use serde::Deserialize;
 use sha2::{Digest, Sha256};
 use tinydecimate::{Config, FeatureMode, Schedule, Workspace};
@@ -173,6 +173,16 @@ pub enum Features {
     Valence,
 }
 
+/// Stored quadrics as written in the manifest (`quadric = "stored-subset"`).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum QuadricName {
+    /// `Workspace::simplify_stored`.
+    StoredSubset,
+    /// `Workspace::simplify_optimal`.
+    StoredOptimal,
+}
+
 /// Index type as written in the manifest.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
@@ -220,6 +230,10 @@ pub struct CaseSpec {
     pub features: Features,
     /// `u16` or `u32`.
     pub index: IndexName,
+    /// Optional: `stored-subset` or `stored-optimal` (stored quadrics instead of the config's
+    /// cost; boundary planes weighted by the config's boundary weight).
+    #[serde(default)]
+    pub quadric: Option<QuadricName>,
 }
 
 impl CaseSpec {
@@ -303,6 +317,8 @@ pub struct Case {
     pub index_type: IndexType,
     /// Simplification settings.
     pub config: Config,
+    /// Stored quadrics with this placement instead of `config.cost` (`None`: `simplify`).
+    pub stored: Option<tinydecimate::cost::Placement>,
 }
 
 impl Case {
@@ -351,14 +367,29 @@ impl Case {
             triangles: mesh.triangles,
             index_type: spec.index_type(),
             config: spec.config(),
+            stored: spec.quadric.map(|q| match q {
+                QuadricName::StoredSubset => tinydecimate::cost::Placement::Subset,
+                QuadricName::StoredOptimal => tinydecimate::cost::Placement::Optimal,
+            }),
         })
     }
 
     /// The case file the firmware reads.
     pub fn encode(&self) -> Result<Vec<u8>> {
-        let h = meshfmt::lib::case_header(&self.config, self.index_type);
+        let h = self.header();
         encode_case(&h, &self.positions, &self.triangles)
             .map_err(|e| anyhow!("case {}: {e:?}", self.name))
+    }
+
+    /// The case file's header: the configuration, and the stored-quadric code if any.
+    pub fn header(&self) -> meshfmt::CaseHeader {
+        let mut h = meshfmt::lib::case_header(&self.config, self.index_type);
+        match self.stored {
+            Some(tinydecimate::cost::Placement::Subset) => h.cost = CostCode::StoredSubset,
+            Some(tinydecimate::cost::Placement::Optimal) => h.cost = CostCode::StoredOptimal,
+            None => {}
+        }
+        h
     }
 
     /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles).
@@ -455,7 +486,10 @@ pub fn reference(case: &Case) -> Result<Outcome> {
 }
 
 fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
-    let config = meshfmt::lib::config(&meshfmt::lib::case_header(&case.config, case.index_type));
+    let h = case.header();
+    let config = meshfmt::lib::config(&h);
+    let placement = meshfmt::lib::stored_placement(&h);
+    let mut positions = case.positions.clone();
     let (outcome, tris): (_, Vec<[u32; 3]>) = match case.index_type {
         IndexType::U16 => {
             let mut t: Vec<[u16; 3]> = case
@@ -466,23 +500,45 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
                 })
                 .map(|[a, b, c]| Ok([a?, b?, c?]))
                 .collect::<Result<_>>()?;
-            let r = ws.simplify(&case.positions, &mut t, &config);
+            let r = run_reference(ws, &mut positions, &mut t, &config, placement);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
         }
         IndexType::U32 => {
             let mut t = case.triangles.clone();
-            let r = ws.simplify(&case.positions, &mut t, &config);
+            let r = run_reference(ws, &mut positions, &mut t, &config, placement);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             t.truncate(n);
             (r, t)
         }
     };
-    let header = meshfmt::lib::result_header(case.index_type, &outcome, Board::Host);
+    let mut header = meshfmt::lib::result_header(case.index_type, &outcome, Board::Host);
+    if placement == Some(tinydecimate::cost::Placement::Optimal) {
+        header.positions_hash = meshfmt::positions_hash(&positions);
+    }
     Ok(Outcome {
         header,
         triangles: tris,
     })
+}
+
+/// The library call a case asks for, as the firmware makes it.
+fn run_reference<I: tinydecimate::Index>(
+    ws: &mut HostWorkspace,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+    placement: Option<tinydecimate::cost::Placement>,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    use tinydecimate::cost::Placement;
+    let mut quadrics = vec![[0.0f32; 10]; positions.len()];
+    match placement {
+        None => ws.simplify(positions, triangles, config),
+        Some(Placement::Subset) => ws.simplify_stored(positions, triangles, config, &mut quadrics),
+        Some(Placement::Optimal) => {
+            ws.simplify_optimal(positions, triangles, config, &mut quadrics)
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -576,6 +632,7 @@ fn error_text(h: &ResultHeader) -> String {
         ErrorKind::IndexOutOfRange => format!("index out of range: triangle {a}, index {b}"),
         ErrorKind::NonFinitePosition => format!("non-finite position: vertex {a}"),
         ErrorKind::InvalidConfig => format!("invalid config: field {a}"),
+        ErrorKind::CapacityQuadrics => format!("capacity: {a} quadrics needed, {b} available"),
     }
 }
 
@@ -603,6 +660,9 @@ impl Golden {
         writeln!(w, "mesh = {:?}", case.mesh)?;
         writeln!(w, "index = \"{it}\"")?;
         writeln!(w, "config = {:?}", config_line(&case.config))?;
+        if let Some(p) = case.stored {
+            writeln!(w, "quadric = \"stored, {p:?} placement\"")?;
+        }
         writeln!(w, "input_vertices = {}", case.positions.len())?;
         writeln!(w, "input_triangles = {}", case.triangles.len())?;
         writeln!(
@@ -661,6 +721,13 @@ impl Golden {
             case.index_type.bytes()
         )?;
         writeln!(w, "bin_sha256 = \"{}\"", sha256_hex(&bin))?;
+        if case.stored == Some(tinydecimate::cost::Placement::Optimal) {
+            writeln!(
+                w,
+                "positions_fnv1a = \"{:08x}\"  # every position after the run (optimal placement moves them)",
+                h.positions_hash
+            )?;
+        }
         Ok(Golden { txt: t, bin })
     }
 
@@ -744,12 +811,17 @@ pub fn judge(
     let h = &actual.header;
     if h.status == Status::TooBig {
         return Ok(Verdict::Skipped(format!(
-            "too big for this board: {} vertices, {} {} triangles; it holds {} vertices, {} triangles",
+            "too big for this board: {} vertices, {} {} triangles; it holds {} vertices, {} triangles{}",
             h.error_a,
             h.error_b,
             if case.index_type == IndexType::U16 { "u16" } else { "u32" },
             h.capacity_vertices,
-            h.capacity_triangles
+            h.capacity_triangles,
+            if case.stored.is_some() {
+                " (stored quadrics: the firmware's QUADRIC_VERTICES may be lower)"
+            } else {
+                ""
+            }
         )));
     }
     let got = Golden::of(case, backend, actual)?;

@@ -12,6 +12,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
+use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
 use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Workspace};
 
 use crate::io::{Format, MeshData};
@@ -83,6 +84,37 @@ impl From<CostArg> for CostKind {
         match c {
             CostArg::Quadric => CostKind::Quadric,
             CostArg::Normal => CostKind::NormalVariation,
+        }
+    }
+}
+
+/// Which quadric, on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum QuadricArg {
+    /// The cost of `--cost` (memoryless quadric by default): nothing stored per vertex.
+    #[default]
+    Memoryless,
+    /// `tinydecimate::cost::StoredQuadric`: a 4x4 quadric per vertex (40 B), summed on
+    /// collapse, boundary planes weighted by --boundary-weight (greedy schedule only).
+    Stored,
+}
+
+/// Where stored quadrics leave the kept vertex, on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlacementArg {
+    /// At an endpoint: positions are only read.
+    #[default]
+    Subset,
+    /// At the minimiser of the summed quadric (or the best of the endpoints and the
+    /// midpoint): the output file carries the moved positions.
+    Optimal,
+}
+
+impl From<PlacementArg> for Placement {
+    fn from(p: PlacementArg) -> Placement {
+        match p {
+            PlacementArg::Subset => Placement::Subset,
+            PlacementArg::Optimal => Placement::Optimal,
         }
     }
 }
@@ -212,6 +244,12 @@ pub struct Args {
     /// normal for passes as in `Config::paper()`).
     #[arg(long, value_enum)]
     pub cost: Option<CostArg>,
+    /// Quadric: `stored` keeps a quadric per vertex (issue 15), replacing --cost.
+    #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
+    pub quadric: QuadricArg,
+    /// Placement of the kept vertex with `--quadric stored`.
+    #[arg(long, value_enum, default_value_t = PlacementArg::Subset)]
+    pub placement: PlacementArg,
     /// Skip the validity check and the Metro measurement afterwards.
     #[arg(long)]
     pub no_measure: bool,
@@ -323,6 +361,62 @@ pub fn simplify(mesh: &MeshData, config: &Config) -> Result<(MeshData, Report, D
     };
     Ok((out, report, elapsed))
 }
+
+/// Runs the library with stored quadrics on `mesh` (`Workspace::start_with_cost`, or
+/// `start_moving` for optimal placement), stepping with a progress bar when `progress`. The
+/// result carries the positions as the library left them (moved by optimal placement). The
+/// wall time is that of the library alone (the quadric storage is allocated before).
+pub fn simplify_stored(
+    mesh: &MeshData,
+    config: &Config,
+    placement: Placement,
+    progress: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    let mut tris = mesh.triangles.clone();
+    let mut positions = mesh.positions.clone();
+    let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; positions.len()];
+    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let bar = progress.then(|| {
+        crate::progress::Progress::new(
+            "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
+            mesh.triangles.len() as u64,
+        )
+    });
+    let start = Instant::now();
+    let cost = StoredQuadric::new(&mut quadrics, config.boundary_weight, placement);
+    macro_rules! drive {
+        ($s:expr) => {{
+            let mut s = $s.map_err(|e| anyhow!("tinydecimate: {e}"))?;
+            let n0 = s.live_triangles();
+            while !s.step(1 << 14) {
+                if let Some(b) = &bar {
+                    b.set((n0 - s.live_triangles().min(n0)) as u64);
+                }
+            }
+            s.finish()
+        }};
+    }
+    let report = match placement {
+        Placement::Subset => drive!(ws.start_with_cost(&positions, &mut tris, config, cost)),
+        Placement::Optimal => drive!(ws.start_moving(&mut positions, &mut tris, config, cost)),
+    };
+    let elapsed = start.elapsed();
+    if let Some(b) = bar {
+        b.finish();
+    }
+    tris.truncate(report.triangles_out);
+    Ok((
+        MeshData {
+            positions,
+            triangles: tris,
+        },
+        report,
+        elapsed,
+    ))
+}
+
+/// Bytes of stored quadrics per vertex.
+pub const QUADRIC_BYTES: usize = core::mem::size_of::<VertexQuadric>();
 
 /// The report, every field, one per line.
 pub fn format_report(r: &Report) -> String {
@@ -457,7 +551,15 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     config
         .validate()
         .map_err(|e| anyhow!("configuration: {e}"))?;
-    let (out, report, elapsed) = simplify_with_progress(&mesh, &config)?;
+    let stored = args.quadric == QuadricArg::Stored;
+    if stored && config.schedule != Schedule::Greedy {
+        bail!("--quadric stored runs the greedy schedule only (drop --schedule passes)");
+    }
+    let (out, report, elapsed) = if stored {
+        simplify_stored(&mesh, &config, args.placement.into(), true)?
+    } else {
+        simplify_with_progress(&mesh, &config)?
+    };
     let written = if args.keep_numbering {
         out.clone()
     } else {
@@ -479,11 +581,19 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             ", unreferenced dropped"
         }
     );
-    let _ = writeln!(
-        text,
-        "  schedule, cost         {:?}, {:?}",
-        config.schedule, config.cost
-    );
+    if stored {
+        let _ = writeln!(
+            text,
+            "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
+            config.schedule, args.placement, config.boundary_weight
+        );
+    } else {
+        let _ = writeln!(
+            text,
+            "  schedule, cost         {:?}, {:?}",
+            config.schedule, config.cost
+        );
+    }
     if let Some(e) = args.max_error {
         let _ = writeln!(
             text,
@@ -523,6 +633,15 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         },
         per_tri(need)
     );
+    if stored {
+        let _ = writeln!(
+            text,
+            "  stored quadrics        {} bytes ({QUADRIC_BYTES} per vertex); with the workspace \
+             {:.2} bytes per input triangle",
+            v * QUADRIC_BYTES,
+            per_tri(need + v * QUADRIC_BYTES)
+        );
+    }
     let say = |text: &str| {
         if to_stdout {
             eprint!("{text}");
@@ -541,6 +660,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "keep_numbering": args.keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
+        "quadric": format!("{:?}", args.quadric),
+        "placement": format!("{:?}", args.placement),
         "max_error": args.max_error,
         "max_cost": if config.max_cost.is_finite() { Some(config.max_cost) } else { None },
         "report": report_json(&report),
@@ -551,7 +672,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if !args.no_measure {
         // The library drops degenerate and duplicate triangles before it starts; the check
         // compares the output with the input as the library saw it (`meshcheck::clean`).
-        let validity = crate::check::compare(&mesh, &out);
+        let moved = stored && args.placement == PlacementArg::Optimal;
+        let validity = crate::check::compare_with(&mesh, &out, moved);
         valid = validity.is_valid();
         let _ = writeln!(
             text,

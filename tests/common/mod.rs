@@ -259,6 +259,11 @@ pub fn analysis(m: &MeshData) -> meshcheck::Analysis {
 
 /// The shared checker's verdict on `output` as a simplification of `input` (same positions).
 pub fn verdict(input: &MeshData, output: &MeshData) -> Verdict {
+    verdict_with(input, output, false)
+}
+
+/// [`verdict`]; with `allow_moved`, kept vertices may have moved (optimal placement).
+pub fn verdict_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> Verdict {
     meshcheck::check_with(
         meshcheck::MeshRef {
             positions: &input.positions,
@@ -268,7 +273,10 @@ pub fn verdict(input: &MeshData, output: &MeshData) -> Verdict {
             positions: &output.positions,
             triangles: &output.triangles,
         },
-        &meshcheck::Options::default(),
+        &meshcheck::Options {
+            view: None,
+            allow_moved,
+        },
     )
 }
 

@@ -16,6 +16,8 @@ mod sel {
     /// stack, of which the firmware needs ~3.5 KB at its deepest (measured).
     pub const MAX_VERTICES: usize = 240;
     pub const MAX_TRIANGLES: usize = 440;
+    /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
+    pub const QUADRIC_VERTICES: usize = 0;
     pub type Link = u16;
     /// Progressive streams (`pm-*` cases): 44 vertex splits (704 B) and an 80 B chunk buffer
     /// (chunks of up to 71 B), taken from the stack's slack; triangles, their links, the list
@@ -31,6 +33,8 @@ mod sel {
     /// 64 KB of RAM: positions 15 000 B, triangles 14 400 B, workspace ≈ 28 100 B.
     pub const MAX_VERTICES: usize = 1_250;
     pub const MAX_TRIANGLES: usize = 2_400;
+    /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
+    pub const QUADRIC_VERTICES: usize = 0;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer.
     pub const PM_VERTICES: usize = 100;
@@ -60,6 +64,9 @@ mod sel {
     /// 636 000 B, triangles 1 272 000 B, workspace 2 173 000 B; ~110 KB left for the stack.
     pub const MAX_VERTICES: usize = 53_000;
     pub const MAX_TRIANGLES: usize = 106_000;
+    /// Stored quadrics (40 B per vertex) for meshes up to this many vertices: 40 960 B of
+    /// the stack's ~110 KB.
+    pub const QUADRIC_VERTICES: usize = 1_024;
     pub type Link = u32;
     /// Progressive streams: 4 000 vertex splits (64 000 B: the cow's 2 844 fit) and a 4 KB
     /// chunk buffer.

@@ -47,6 +47,10 @@ static RESULT: ConstStaticCell<ResultHeader> = ConstStaticCell::new(ResultHeader
     Status::Ok,
     board::BOARD,
 ));
+/// Stored quadrics of the current case (stored-quadric cases only).
+#[cfg(feature = "lib")]
+static QUADRICS: ConstStaticCell<[[f32; 10]; board::QUADRIC_VERTICES]> =
+    ConstStaticCell::new([[0.0; 10]; board::QUADRIC_VERTICES]);
 /// Triangles of the current case, in the file's index type.
 static TRIANGLES: ConstStaticCell<board::TriangleBytes> =
     ConstStaticCell::new(board::TriangleBytes([0; board::TRIANGLE_BYTES]));
@@ -118,7 +122,7 @@ fn run_case(
         simplify(
             syst,
             &h,
-            &positions[..h.vertices as usize],
+            &mut positions[..h.vertices as usize],
             &mut triangles[..h.triangles_len()],
             result,
         );
@@ -162,7 +166,14 @@ fn read_case(
         nt,
         h.index_type.bytes() * 8
     );
-    if nv > board::MAX_VERTICES || nt > board::triangle_capacity(h.index_type) {
+    let stored = matches!(
+        h.cost,
+        meshfmt::CostCode::StoredSubset | meshfmt::CostCode::StoredOptimal
+    );
+    if nv > board::MAX_VERTICES
+        || nt > board::triangle_capacity(h.index_type)
+        || (stored && nv > board::QUADRIC_VERTICES)
+    {
         defmt::warn!("the mesh does not fit this board");
         *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
         result.error_a = h.vertices;
@@ -335,7 +346,7 @@ fn calibrate(syst: &mut SYST, out_path: &str) -> Result<(), IoError> {
 fn simplify(
     syst: &mut SYST,
     h: &CaseHeader,
-    pos: &[[f32; 3]],
+    pos: &mut [[f32; 3]],
     tri: &mut [u8],
     r: &mut ResultHeader,
 ) {
@@ -345,20 +356,22 @@ fn simplify(
     static WORKSPACE: ConstStaticCell<board::Workspace> =
         ConstStaticCell::new(board::Workspace::new());
     let ws = WORKSPACE.take();
+    let quadrics = QUADRICS.take();
     let config = meshfmt::lib::config(h);
+    let placement = meshfmt::lib::stored_placement(h);
 
     let sp = measure::paint();
     measure::start(syst);
     let outcome = match h.index_type {
         IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config),
+            Ok(t) => run_library(ws, pos, t, &config, placement, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
             }
         },
         IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config),
+            Ok(t) => run_library(ws, pos, t, &config, placement, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
@@ -369,6 +382,9 @@ fn simplify(
     let low = measure::lowest_touched();
 
     *r = meshfmt::lib::result_header(h.index_type, &outcome, board::BOARD);
+    if placement == Some(tinydecimate::cost::Placement::Optimal) {
+        r.positions_hash = meshfmt::positions_hash(pos);
+    }
     r.ticks = ticks;
     r.stack_bytes = sp.saturating_sub(low) as u32;
     r.stack_high_water = measure::depth(low) as u32;
@@ -397,11 +413,18 @@ fn simplify(
 #[inline(never)]
 fn run_library<I: tinydecimate::Index>(
     ws: &mut board::Workspace,
-    positions: &[[f32; 3]],
+    positions: &mut [[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
+    placement: Option<tinydecimate::cost::Placement>,
+    quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    ws.simplify(positions, triangles, config)
+    use tinydecimate::cost::Placement;
+    match placement {
+        None => ws.simplify(positions, triangles, config),
+        Some(Placement::Subset) => ws.simplify_stored(positions, triangles, config, quadrics),
+        Some(Placement::Optimal) => ws.simplify_optimal(positions, triangles, config, quadrics),
+    }
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).
@@ -409,7 +432,7 @@ fn run_library<I: tinydecimate::Index>(
 fn simplify(
     syst: &mut SYST,
     h: &CaseHeader,
-    _pos: &[[f32; 3]],
+    _pos: &mut [[f32; 3]],
     _tri: &mut [u8],
     r: &mut ResultHeader,
 ) {
@@ -484,7 +507,7 @@ fn selftest(
         min_quality: 0.05,
         boundary_weight: 1.0,
     };
-    simplify(syst, &h, &positions[..nv], &mut triangles[..nt * 6], r);
+    simplify(syst, &h, &mut positions[..nv], &mut triangles[..nt * 6], r);
     if r.status == Status::Ok && r.triangles_out > 0 && r.triangles_out <= r.triangles_in {
         defmt::info!(
             "self-test passed: {=u32} -> {=u32} triangles",

@@ -20,7 +20,7 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u8      | cost: 0 = memoryless quadric, 1 = normal variation W (version 2) |
+//! |     30 | u8      | cost: 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement |
 //! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
@@ -43,11 +43,11 @@
 //! |      6 | u8       | index type of the triangles that follow                   |
 //! |      7 | u8       | [`Status`]                                                |
 //! |      8 | u8       | [`ErrorKind`] (status 1) or 0                             |
-//! |      9 | [u8; 3]  | reserved                                                  |
+//! |      9 | [u8; 3]  | bytes 0-2 of the positions hash (see offset 43)           |
 //! |     12 | u32      | error detail a (needed / triangle / vertex / field)       |
 //! |     16 | u32      | error detail b (available / index)                        |
 //! |     20 | u32 × 5  | triangles in, degenerate dropped, duplicates dropped, triangles out, target triangles |
-//! |     40 | u8 × 4   | target reached, stop code, pass log length, reserved      |
+//! |     40 | u8 × 4   | target reached, stop code, pass log length, byte 3 of the positions hash |
 //! |     44 | u32 × 5  | collapses, vertices removed, locked vertices, feature vertices, passes |
 //! |     64 | u32 × 8  | rejections: locked, feature, boundary, link, duplicate, normal turn, sliver, fold |
 //! |     96 | u32 × 32 | triangles after each pass (first `pass log length` used)  |
@@ -130,6 +130,10 @@ pub enum CostCode {
     Quadric = 0,
     /// `CostKind::NormalVariation`.
     NormalVariation = 1,
+    /// Stored quadrics, subset placement (`Workspace::simplify_stored`).
+    StoredSubset = 2,
+    /// Stored quadrics, optimal placement (`Workspace::simplify_optimal`): positions move.
+    StoredOptimal = 3,
 }
 
 /// Feature mode code.
@@ -200,9 +204,6 @@ impl W<'_> {
     }
     fn f32(&mut self, v: f32) {
         self.bytes(&v.to_bits().to_le_bytes());
-    }
-    fn skip(&mut self, n: usize) {
-        self.at += n;
     }
 }
 
@@ -297,6 +298,8 @@ impl CaseHeader {
         let cost = match r.u8() {
             0 => CostCode::Quadric,
             1 => CostCode::NormalVariation,
+            2 => CostCode::StoredSubset,
+            3 => CostCode::StoredOptimal,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -357,6 +360,7 @@ pub enum ErrorKind {
     IndexOutOfRange = 3,
     NonFinitePosition = 4,
     InvalidConfig = 5,
+    CapacityQuadrics = 6,
 }
 
 /// Which board produced a result (0 for the host).
@@ -395,6 +399,10 @@ pub struct ResultHeader {
     /// locked, feature, boundary, link, duplicate, normal turn, sliver, fold.
     pub rejected: [u32; 8],
     pub pass_triangles: [u32; PASS_LOG],
+    /// FNV-1a (32 bit) of all positions after the run, little-endian f32 bytes, for cases
+    /// whose positions move (stored quadrics, optimal placement); 0 otherwise. Stored in the
+    /// header's reserved bytes 9-11 and 43, so it is compared.
+    pub positions_hash: u32,
     // ---- measurement block, not compared ----
     pub ticks: u64,
     pub stack_bytes: u32,
@@ -429,6 +437,7 @@ impl ResultHeader {
             passes: 0,
             rejected: [0; 8],
             pass_triangles: [0; PASS_LOG],
+            positions_hash: 0,
             ticks: 0,
             stack_bytes: 0,
             workspace_bytes: 0,
@@ -448,7 +457,10 @@ impl ResultHeader {
         w.u8(self.index_type as u8);
         w.u8(self.status as u8);
         w.u8(self.error_kind as u8);
-        w.skip(3);
+        let hash = self.positions_hash.to_le_bytes();
+        w.u8(hash[0]);
+        w.u8(hash[1]);
+        w.u8(hash[2]);
         w.u32(self.error_a);
         w.u32(self.error_b);
         w.u32(self.triangles_in);
@@ -459,7 +471,7 @@ impl ResultHeader {
         w.u8(self.target_reached as u8);
         w.u8(self.stop);
         w.u8(self.pass_log_len);
-        w.skip(1);
+        w.u8(hash[3]);
         w.u32(self.collapses);
         w.u32(self.vertices_removed);
         w.u32(self.locked_vertices);
@@ -506,9 +518,10 @@ impl ResultHeader {
             3 => ErrorKind::IndexOutOfRange,
             4 => ErrorKind::NonFinitePosition,
             5 => ErrorKind::InvalidConfig,
+            6 => ErrorKind::CapacityQuadrics,
             _ => return Err(FormatError::Code),
         };
-        r.skip(3);
+        let hash = [r.u8(), r.u8(), r.u8()];
         let mut h = ResultHeader::empty(index_type, status, Board::Host);
         h.error_kind = error_kind;
         h.error_a = r.u32();
@@ -521,7 +534,7 @@ impl ResultHeader {
         h.target_reached = r.u8() != 0;
         h.stop = r.u8();
         h.pass_log_len = r.u8();
-        r.skip(1);
+        h.positions_hash = u32::from_le_bytes([hash[0], hash[1], hash[2], r.u8()]);
         h.collapses = r.u32();
         h.vertices_removed = r.u32();
         h.locked_vertices = r.u32();
@@ -596,7 +609,11 @@ pub mod lib {
             .with_max_passes(h.max_passes)
             .with_max_cost(h.max_cost)
             .with_cost(match h.cost {
-                CostCode::Quadric => CostKind::Quadric,
+                // Stored quadrics are not a `CostKind`: the runner picks the entry point
+                // (`stored_placement`).
+                CostCode::Quadric | CostCode::StoredSubset | CostCode::StoredOptimal => {
+                    CostKind::Quadric
+                }
                 CostCode::NormalVariation => CostKind::NormalVariation,
             });
         c.features = h.feature_mode != FeatureCode::Off;
@@ -610,6 +627,15 @@ pub mod lib {
         c.min_quality = h.min_quality;
         c.boundary_weight = h.boundary_weight;
         c
+    }
+
+    /// The stored-quadric placement a case asks for (`None`: `Workspace::simplify`).
+    pub fn stored_placement(h: &CaseHeader) -> Option<tinydecimate::cost::Placement> {
+        match h.cost {
+            CostCode::StoredSubset => Some(tinydecimate::cost::Placement::Subset),
+            CostCode::StoredOptimal => Some(tinydecimate::cost::Placement::Optimal),
+            _ => None,
+        }
     }
 
     /// A case header carrying `config` (vertex and triangle counts zero: `encode_case` sets them).
@@ -699,6 +725,7 @@ pub mod lib {
                         match what {
                             tinydecimate::Capacity::Vertices => ErrorKind::CapacityVertices,
                             tinydecimate::Capacity::Triangles => ErrorKind::CapacityTriangles,
+                            tinydecimate::Capacity::Quadrics => ErrorKind::CapacityQuadrics,
                         },
                         narrow(needed),
                         narrow(available),
@@ -928,4 +955,16 @@ mod tests {
         other.rejected[0] = 1;
         assert!(!h.same_outcome(&other));
     }
+}
+
+/// FNV-1a (32 bit) over the little-endian bytes of `positions`: [`ResultHeader::positions_hash`].
+pub fn positions_hash(positions: &[[f32; 3]]) -> u32 {
+    let mut h = 0x811c_9dc5u32;
+    for x in positions.iter().flatten() {
+        for b in x.to_le_bytes() {
+            h ^= u32::from(b);
+            h = h.wrapping_mul(0x0100_0193);
+        }
+    }
+    h
 }

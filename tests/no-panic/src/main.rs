@@ -18,7 +18,9 @@ use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
     Quadrics, SliceSource, Source, ThenCollapseError,
 };
-use tinydecimate::cost::{Builtin, Cost, Move, NormalVariation, Quadric};
+use tinydecimate::cost::{
+    error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
+};
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
@@ -197,6 +199,35 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
+    // Stored quadrics, both placements, one-shot and stepped.
+    let mut quadrics: [VertexQuadric; V] = black_box([[0.0; 10]; V]);
+    let mut moving: [[f32; 3]; V] = black_box([[0.0; 3]; V]);
+    let nq = input(11) as usize;
+    if let (Some(q), Some(mp)) = (quadrics.get_mut(..nq), moving.get_mut(..np)) {
+        match ws.simplify_stored(p, t, &config, q) {
+            Ok(r) => use_report(&r),
+            Err(e) => display(&e),
+        }
+        match ws.simplify_optimal(mp, t, &config, q) {
+            Ok(r) => use_report(&r),
+            Err(e) => display(&e),
+        }
+        let placement = if input(12) & 1 == 0 {
+            Placement::Subset
+        } else {
+            Placement::Optimal
+        };
+        let sq = StoredQuadric::new(q, opaque_f32(13), placement);
+        black_box((sq.boundary_weight(), sq.placement(), sq.quadric(input(14) as usize)));
+        match ws.start_moving(mp, t, &config, sq) {
+            Ok(s) => {
+                black_box(s.position(input(15) as usize));
+                drive(s)
+            }
+            Err(e) => display(&e),
+        }
+        black_box(&moving);
+    }
     black_box(&tris);
 
     // The cost trait's methods by themselves.
@@ -204,7 +235,13 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         d: [opaque_f32(1), opaque_f32(2), opaque_f32(3)],
         retreat2: opaque_f32(4),
         turn: opaque_f32(5),
+        from: input(16) as usize,
+        to: input(17) as usize,
+        p_from: [opaque_f32(1), opaque_f32(3), opaque_f32(5)],
+        p_to: [opaque_f32(2), opaque_f32(4), opaque_f32(6)],
+        keep: input(18) & 1 == 0,
     };
+    black_box(error(&[opaque_f32(7); 10], m.p_to));
     let n = [opaque_f32(6), opaque_f32(7), opaque_f32(10)];
     let mut pd = pd;
     pd.round(opaque_f32(11));
