@@ -585,6 +585,23 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         to: usize,
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
+        if !self.mesh.movable() {
+            return legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None));
+        }
+        self.legal_placed(from, w, to, c)
+    }
+
+    /// [`Self::legal`] on mutable positions. Never inlined, so that the read-only modes (every
+    /// device mode) do not carry its frame: the micro:bit has 4.5 KB of stack.
+    #[allow(clippy::type_complexity)]
+    #[inline(never)]
+    fn legal_placed(
+        &self,
+        from: usize,
+        w: &Walk<C::Fan>,
+        to: usize,
+        c: f32,
+    ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
         let at = self.placement(from, w, to);
         match legality::check(&self.mesh, &self.rules, from, to, at.map(|x| x.1)) {
             Ok(()) => Ok((c, at)),

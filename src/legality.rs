@@ -225,6 +225,9 @@ fn shape_moved<L: Index, I: Index>(
 
 /// Checks every rule for `a -> b`; with `at`, for `b` moved to `at` (optimal placement): then
 /// `b`'s own surviving triangles change too and pass the same shape, turn and fold rules.
+/// Never inlined: its frame then stacks beside the re-keying after a collapse, not on top of
+/// it (the micro:bit has 4.5 KB of stack).
+#[inline(never)]
 pub(crate) fn check<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
     rules: &Rules,
@@ -372,7 +375,9 @@ pub(crate) fn check<L: Index, I: Index>(
 
 /// The shape, turn and fold rules on `b`'s surviving triangles with `b` at `p` (`a` merged
 /// into it). A fold is looked for across each of their edges, against the triangle there
-/// after the collapse.
+/// after the collapse. Never inlined: only optimal placement needs it, and inlined its locals
+/// would deepen [`check`]'s frame for every mode (the micro:bit has 4.5 KB of stack).
+#[inline(never)]
 fn check_moved_b<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
     rules: &Rules,

@@ -1726,7 +1726,7 @@ mod tests {
     fn expected_skips_match_the_board_capacities() {
         // (board, MAX_VERTICES, MAX_TRIANGLES, bytes per link, QUADRIC_VERTICES)
         let caps = [
-            ("microbit", 240, 440, 2, 0),
+            ("microbit", 224, 432, 2, 0),
             ("lm3s6965evb", 1_250, 2_400, 2, 0),
             ("mps2-an386", 53_000, 106_000, 4, 1_024),
             ("mps2-an500", 53_000, 106_000, 4, 1_024),
@@ -1750,7 +1750,7 @@ mod tests {
             let (pv, pbuf) = match board {
                 "microbit" => (44, 80),
                 "lm3s6965evb" => (100, 272),
-                _ => (4_000, 4_096),
+                _ => (3_000, 4_096),
             };
             let too_big: Vec<&str> = too_big
                 .into_iter()
