@@ -521,6 +521,13 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         }
     }
 
+    /// Whether collapses may move the kept vertex: a placing cost on mutable positions
+    /// (compile-time `false` for every other cost).
+    #[inline]
+    fn movable(&self) -> bool {
+        C::PLACES && self.mesh.movable()
+    }
+
     /// The move `from -> to` as a cost sees it, if the flag and boundary rules allow it.
     fn make_move(&self, from: usize, w: &Walk<C::Fan>, to: usize, keep: bool) -> Option<Move> {
         let mesh = &self.mesh;
@@ -554,7 +561,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             to,
             p_from: w.p,
             p_to,
-            keep: keep || !mesh.movable() || mesh.has(to, flag::FEATURE),
+            keep: keep || !self.movable() || mesh.has(to, flag::FEATURE),
         })
     }
 
@@ -562,7 +569,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// mutable positions): its input-unit coordinates and the normalised position they read
     /// back as. `None`: it stays.
     fn placement(&self, from: usize, w: &Walk<C::Fan>, to: usize) -> Option<([f32; 3], V3)> {
-        if !self.mesh.movable() {
+        if !self.movable() {
             return None;
         }
         let m = self.make_move(from, w, to, false)?;
@@ -585,7 +592,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         to: usize,
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
-        if !self.mesh.movable() {
+        if !self.movable() {
             return legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None));
         }
         self.legal_placed(from, w, to, c)
@@ -603,7 +610,11 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
         let at = self.placement(from, w, to);
-        match legality::check(&self.mesh, &self.rules, from, to, at.map(|x| x.1)) {
+        let checked = match at {
+            Some((_, p)) => legality::check_placed(&self.mesh, &self.rules, from, to, p),
+            None => legality::check(&self.mesh, &self.rules, from, to, None),
+        };
+        match checked {
             Ok(()) => Ok((c, at)),
             Err(r) => {
                 if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok()
@@ -743,15 +754,22 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// other neighbours (marked before the collapse). Nothing else changes: the other
     /// neighbours of `b` keep their fans, so their prices stand.
     ///
-    /// A cost that stores per-vertex state changed `b`'s quadric (and a placement may have
-    /// moved `b`), so all of `b`'s neighbours are re-keyed.
+    /// A placing cost may have moved `b` and changes how its neighbours price onto it, so
+    /// then all of `b`'s neighbours are re-keyed (see below why stored quadrics with `b` in
+    /// place need not).
     fn collapse_greedy(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
         if !self.note(a, b) {
             return;
         }
         let mesh = &self.mesh;
         mesh.for_each_neighbour(a, |x| mesh.mark(x, true));
-        if self.cost.stores() || at.is_some() {
+        // A stored cost's quadric at `b` grew by `a`'s (positive semi-definite), so with `b`
+        // where it was, every other neighbour's price onto `b` (`Q_x(p_b) + Q_b(p_b)`) only
+        // rose: their keys stay lower bounds, checked exactly when they reach the top, and
+        // re-keying them now is wasted (16 % of the instructions on the cow). A placing cost
+        // (optimal placement) prices onto `b` through a minimiser that a larger `Q_b` can
+        // move inside the edge's reach, so there every neighbour is re-keyed.
+        if self.movable() {
             mesh.for_each_neighbour(b, |x| mesh.mark(x, true));
         }
         self.apply(a, b, at);
@@ -837,7 +855,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
         let mut n = 0;
         let wv = self.walk(v);
-        let movable = self.mesh.movable();
+        let movable = self.movable();
         for y in wv.neighbours() {
             if self.mesh.has(y, flag::DONE) {
                 continue;

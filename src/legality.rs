@@ -223,11 +223,8 @@ fn shape_moved<L: Index, I: Index>(
     )
 }
 
-/// Checks every rule for `a -> b`; with `at`, for `b` moved to `at` (optimal placement): then
-/// `b`'s own surviving triangles change too and pass the same shape, turn and fold rules.
-/// Never inlined: its frame then stacks beside the re-keying after a collapse, not on top of
-/// it (the micro:bit has 4.5 KB of stack).
-#[inline(never)]
+/// Checks every rule for `a -> b`; with `at`, the rules on `a`'s triangles for `b` moved to
+/// `at` (optimal placement; [`check_placed`] adds `b`'s own triangles, which change too).
 pub(crate) fn check<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
     rules: &Rules,
@@ -367,10 +364,21 @@ pub(crate) fn check<L: Index, I: Index>(
             return Err(Reject::Fold);
         }
     }
-    match at {
-        Some(p) => check_moved_b(mesh, rules, a, b, p),
-        None => Ok(()),
-    }
+    Ok(())
+}
+
+/// [`check`] for `b` moved to `at` (optimal placement), then the rules on `b`'s own
+/// triangles there ([`check_moved_b`]). Separate from `check` so that the read-only modes'
+/// images do not carry the moved-`b` rules.
+pub(crate) fn check_placed<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    a: usize,
+    b: usize,
+    at: V3,
+) -> Result<(), Reject> {
+    check(mesh, rules, a, b, Some(at))?;
+    check_moved_b(mesh, rules, a, b, at)
 }
 
 /// The shape, turn and fold rules on `b`'s surviving triangles with `b` at `p` (`a` merged
