@@ -133,6 +133,34 @@ fn real_meshes_keep_every_invariant() {
     }
 }
 
+/// A bit per vertex (`cluster_with_seen`) gives the same output and report as none, also
+/// with too few bits (the vertices beyond them are scored at every corner) and with cleanup.
+#[test]
+fn seen_bits_change_nothing_but_time() {
+    for name in ["cow.obj", "fandisk.obj", "stanford_bunny.obj"] {
+        let m = load_obj(name);
+        let words = m.positions.len() / 32 + 1;
+        for (frac, cleanup) in [(20usize, false), (5, false), (10, true)] {
+            let mut config = ClusterConfig::target(m.triangles.len() * frac / 100);
+            config.cleanup = cleanup;
+            let (want, wr) = cluster(&m, &config, true);
+            for n in [words, words / 2, 1] {
+                let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+                let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
+                let mut out = vec![[0u32; 3]; m.triangles.len()];
+                let mut bits = vec![u32::MAX; n];
+                let mut src = SliceSource::new(&m.positions, &m.triangles);
+                let r = table
+                    .cluster_with_seen(&mut src, Some(&mut *quads), &config, &mut out, &mut bits)
+                    .expect("cluster_with_seen");
+                out.truncate(r.triangles_out);
+                assert_eq!(r, wr, "{name} {frac}% {n} words: report");
+                assert_eq!(out, want, "{name} {frac}% {n} words: output");
+            }
+        }
+    }
+}
+
 #[test]
 fn cell_size_grid_and_given_bbox() {
     let m = load_obj("cow.obj");
