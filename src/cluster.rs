@@ -1300,12 +1300,15 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         for e in cache.iter_mut() {
             *e = NO_Q;
         }
+        for w in seen.iter_mut() {
+            *w = 0;
+        }
         let mut passes = 0u32;
         let (min, max) = match config.bbox {
             Some(b) => b,
             None => {
                 passes += 1;
-                bbox(source)?
+                bbox(source, seen, cache)?
             }
         };
         let mut target = 0;
@@ -1726,7 +1729,14 @@ impl<S: Source> Positions for SourcePositions<'_, S> {
 }
 
 /// Bounding box of the used vertices (one pass).
-fn bbox<S: Source>(source: &mut S) -> Result<([f32; 3], [f32; 3]), ClusterError> {
+/// With per-vertex memory (a cache entry still [`NO_Q`], then marked `NO_Q - 1`, which is
+/// still unfilled for [`quantised`]; or a clear bit, then set), only each vertex's first
+/// corner is read: the same box, and the same first error.
+fn bbox<S: Source>(
+    source: &mut S,
+    seen: &mut [u32],
+    cache: &mut [u64],
+) -> Result<([f32; 3], [f32; 3]), ClusterError> {
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
     }
@@ -1742,6 +1752,18 @@ fn bbox<S: Source>(source: &mut S) -> Result<([f32; 3], [f32; 3]), ClusterError>
         }
         for t in chunk {
             for &v in t {
+                if let Some(e) = cache.get_mut(v as usize) {
+                    if *e != NO_Q {
+                        continue;
+                    }
+                    *e = NO_Q - 1;
+                } else if let Some(w) = seen.get_mut((v >> 5) as usize) {
+                    let bit = 1u32 << (v & 31);
+                    if *w & bit != 0 {
+                        continue;
+                    }
+                    *w |= bit;
+                }
                 let p = source
                     .position(v as usize)
                     .ok_or(ClusterError::IndexOutOfRange {
