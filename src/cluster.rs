@@ -1744,6 +1744,7 @@ fn bbox<S: Source>(
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
     let mut index = 0usize;
+    let memory = !(cache.is_empty() && seen.is_empty());
     loop {
         let n = source.read(&mut buf);
         let Some(chunk) = buf.get(..n) else { break };
@@ -1752,7 +1753,9 @@ fn bbox<S: Source>(
         }
         for t in chunk {
             for &v in t {
-                if let Some(e) = cache.get_mut(v as usize) {
+                if !memory {
+                    // No per-vertex memory: every corner.
+                } else if let Some(e) = cache.get_mut(v as usize) {
                     if *e != NO_Q {
                         continue;
                     }
@@ -1770,15 +1773,18 @@ fn bbox<S: Source>(
                         triangle: index,
                         index: v as usize,
                     })?;
-                if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
-                    return Err(ClusterError::NonFinitePosition { vertex: v as usize });
-                }
-                for ((lo, hi), x) in min.iter_mut().zip(max.iter_mut()).zip(p) {
-                    if x < *lo {
-                        *lo = x;
+                for a in 0..3 {
+                    let x = get3(p, a);
+                    if !x.is_finite() {
+                        return Err(ClusterError::NonFinitePosition { vertex: v as usize });
                     }
-                    if x > *hi {
-                        *hi = x;
+                    if let (Some(lo), Some(hi)) = (min.get_mut(a), max.get_mut(a)) {
+                        if x < *lo {
+                            *lo = x;
+                        }
+                        if x > *hi {
+                            *hi = x;
+                        }
                     }
                 }
             }
