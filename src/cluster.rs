@@ -760,9 +760,9 @@ impl<I: Index> Pass<'_, I> {
             };
             // The quadric representative is chosen in the second pass only.
             if let (true, Some(p)) = (offers, &p) {
-                for (c, sc) in [s0, s1, s2].into_iter().enumerate() {
-                    if let Some(slot) = sc {
-                        self.offer(slot, k[c], t[c], p[c]);
+                for (((sc, &kc), &v), &pc) in [s0, s1, s2].iter().zip(&k).zip(t).zip(p) {
+                    if let Some(slot) = *sc {
+                        self.offer(slot, kc, v, pc);
                     }
                 }
             }
