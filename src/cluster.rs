@@ -1285,6 +1285,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         )
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn cluster_into<S: Source, I: Index>(
         &mut self,
         source: &mut S,
