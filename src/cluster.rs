@@ -1229,8 +1229,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
     /// representative's second pass then scores each vertex once instead of once per
     /// triangle corner (about 6 times), which is most of that pass's time: the same output,
     /// faster. Vertices beyond the bits are scored at every corner, as without them; with
-    /// the nearest representative the bits are unused. Costs `vertices / 8` bytes (4.3 KB for
-    /// the bunny's 34 817 vertices).
+    /// the nearest representative the bits are unused. Costs `vertices / 8` bytes (4.5 KB for
+    /// the bunny's 35 947 vertices).
     pub fn cluster_with_seen<S: Source, I: Index>(
         &mut self,
         source: &mut S,
@@ -1248,7 +1248,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
     /// quantised once for the grid search and the first pass instead of once per corner and
     /// pass, and the quadric representative's second pass scores each vertex once (as
     /// [`Clusterer::cluster_with_seen`]). The same output, faster; vertices beyond the cache
-    /// take the path without it. 279 KB for the bunny's 34 817 vertices: a host's or a large
+    /// take the path without it. 288 KB for the bunny's 35 947 vertices: a host's or a large
     /// device's option, not the micro:bit's.
     pub fn cluster_with_cache<S: Source, I: Index>(
         &mut self,
