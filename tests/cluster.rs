@@ -133,6 +133,56 @@ fn real_meshes_keep_every_invariant() {
     }
 }
 
+/// A bit per vertex (`cluster_with_seen`) or an 8-byte cache per vertex (`cluster_with_cache`)
+/// gives the same output and report as none, also when too short (the vertices beyond take
+/// the path without), with cleanup, with a given bounding box and with a cell size.
+#[test]
+fn vertex_memory_changes_nothing_but_time() {
+    for name in ["cow.obj", "fandisk.obj", "stanford_bunny.obj"] {
+        let m = load_obj(name);
+        let words = m.positions.len() / 32 + 1;
+        let nv = m.positions.len();
+        let (lo, hi) = bounds(&m);
+        let configs = [
+            ClusterConfig::target(m.triangles.len() / 5),
+            ClusterConfig::target(m.triangles.len() / 20),
+            ClusterConfig::target(m.triangles.len() / 10).with_cleanup(),
+            ClusterConfig::target(m.triangles.len() / 10).with_bbox(lo, hi),
+            ClusterConfig::cell_size((hi[0] - lo[0]) / 17.0),
+        ];
+        for (frac, config) in configs.iter().enumerate() {
+            let config = *config;
+            let (want, wr) = cluster(&m, &config, true);
+            for n in [nv, nv / 2, 1] {
+                let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+                let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
+                let mut out = vec![[0u32; 3]; m.triangles.len()];
+                let mut cache = vec![7u64; n];
+                let mut src = SliceSource::new(&m.positions, &m.triangles);
+                let r = table
+                    .cluster_with_cache(&mut src, Some(&mut *quads), &config, &mut out, &mut cache)
+                    .expect("cluster_with_cache");
+                out.truncate(r.triangles_out);
+                assert_eq!(r, wr, "{name} config {frac}, cache {n}: report");
+                assert_eq!(out, want, "{name} config {frac}, cache {n}: output");
+            }
+            for n in [words, words / 2, 1] {
+                let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+                let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
+                let mut out = vec![[0u32; 3]; m.triangles.len()];
+                let mut bits = vec![u32::MAX; n];
+                let mut src = SliceSource::new(&m.positions, &m.triangles);
+                let r = table
+                    .cluster_with_seen(&mut src, Some(&mut *quads), &config, &mut out, &mut bits)
+                    .expect("cluster_with_seen");
+                out.truncate(r.triangles_out);
+                assert_eq!(r, wr, "{name} {frac}% {n} words: report");
+                assert_eq!(out, want, "{name} {frac}% {n} words: output");
+            }
+        }
+    }
+}
+
 #[test]
 fn cell_size_grid_and_given_bbox() {
     let m = load_obj("cow.obj");
@@ -171,6 +221,20 @@ fn golden_bytes() {
 const GOLDEN_QUADRIC: (usize, u64) = (524, 0x4a3b_5adf_6844_d279);
 const GOLDEN_NEAREST: (usize, u64) = (524, 0x8b4b_9885_249a_0f1f);
 
+fn bounds(m: &MeshData) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for t in &m.triangles {
+        for &v in t {
+            for k in 0..3 {
+                lo[k] = lo[k].min(m.positions[v as usize][k]);
+                hi[k] = hi[k].max(m.positions[v as usize][k]);
+            }
+        }
+    }
+    (lo, hi)
+}
+
 #[test]
 fn nan_position_is_a_typed_error() {
     let mut m = icosphere(2);
@@ -180,6 +244,22 @@ fn nan_position_is_a_typed_error() {
     let mut src = SliceSource::new(&m.positions, &m.triangles);
     let e = table.cluster(&mut src, None, &ClusterConfig::target(100), &mut out);
     assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+    // The same first error with per-vertex memory, with and without a given box.
+    let (lo, hi) = ([-2.0; 3], [2.0; 3]);
+    for config in [
+        ClusterConfig::target(100),
+        ClusterConfig::target(100).with_bbox(lo, hi),
+    ] {
+        let mut cache = vec![0u64; m.positions.len()];
+        let mut bits = vec![0u32; m.positions.len() / 32 + 1];
+        let e = table.cluster_with_cache(&mut src, None, &config, &mut out, &mut cache);
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+        let mut quads = Quadrics::<512>::new();
+        let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+        let e = table.cluster_with_seen(&mut src, Some(&mut quads), &config, &mut out, &mut bits);
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+    }
 }
 
 #[test]
@@ -197,6 +277,18 @@ fn index_out_of_range_is_a_typed_error() {
             index: 9999
         })
     );
+    let mut cache = vec![0u64; m.positions.len()];
+    let mut quads = Quadrics::<512>::new();
+    for config in [ClusterConfig::cell_size(0.3), ClusterConfig::target(100)] {
+        let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
+        assert_eq!(
+            e,
+            Err(ClusterError::IndexOutOfRange {
+                triangle: 5,
+                index: 9999
+            })
+        );
+    }
 }
 
 #[test]

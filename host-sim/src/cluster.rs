@@ -49,6 +49,11 @@ pub struct Args {
     /// (`ClusterConfig::cleanup`).
     #[arg(long)]
     pub cleanup: bool,
+    /// Memory per input vertex besides the table and the output (the same output; time
+    /// only): none (`Clusterer::cluster`), a bit (`cluster_with_seen`) or 8 bytes
+    /// (`cluster_with_cache`).
+    #[arg(long, value_enum, default_value_t = VertexMemory::None)]
+    pub vertex_memory: VertexMemory,
     /// Skip the Metro measurement.
     #[arg(long)]
     pub no_measure: bool,
@@ -57,21 +62,47 @@ pub struct Args {
     pub samples_per_triangle: f64,
 }
 
-/// Clusters `mesh` with the library: output, report, wall time of the call.
+/// Memory per input vertex given to the library besides the table and the output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VertexMemory {
+    /// None: memory for the output only (`Clusterer::cluster`).
+    None,
+    /// A bit per vertex (`Clusterer::cluster_with_seen`).
+    Bit,
+    /// 8 bytes per vertex (`Clusterer::cluster_with_cache`).
+    Cache,
+}
+
+/// Clusters `mesh` with the library: output, report, wall time of the call. The per-vertex
+/// memory (`mem`) is allocated before the clock starts, like the output buffer.
 pub fn cluster(
     mesh: &MeshData,
     config: &ClusterConfig,
     quadric: bool,
+    mem: VertexMemory,
 ) -> Result<(MeshData, ClusterReport, Duration)> {
     let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
     let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
     let mut out = vec![[0u32; 3]; mesh.triangles.len().max(1)];
+    let n = mesh.positions.len();
+    let mut bits = vec![
+        0u32;
+        if mem == VertexMemory::Bit {
+            n / 32 + 1
+        } else {
+            0
+        }
+    ];
+    let mut cache = vec![0u64; if mem == VertexMemory::Cache { n } else { 0 }];
     let mut src = SliceSource::new(&mesh.positions, &mesh.triangles);
     let start = Instant::now();
     let q = if quadric { Some(&mut *quads) } else { None };
-    let r = table
-        .cluster(&mut src, q, config, &mut out)
-        .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
+    let r = match mem {
+        VertexMemory::None => table.cluster(&mut src, q, config, &mut out),
+        VertexMemory::Bit => table.cluster_with_seen(&mut src, q, config, &mut out, &mut bits),
+        VertexMemory::Cache => table.cluster_with_cache(&mut src, q, config, &mut out, &mut cache),
+    }
+    .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
     let dt = start.elapsed();
     out.truncate(r.triangles_out);
     Ok((
@@ -169,7 +200,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     let quadric = !args.nearest;
     let (out, r, dt, collapse) = match args.then_collapse {
         None => {
-            let (out, r, dt) = cluster(&mesh, &config, quadric)?;
+            let (out, r, dt) = cluster(&mesh, &config, quadric, args.vertex_memory)?;
             (out, r, dt, None)
         }
         Some(n) => {
@@ -271,8 +302,13 @@ pub struct Row {
     pub triangles: usize,
     /// Target ratio.
     pub ratio: f32,
-    /// Ours (quadric representative): count, median ms, Metro mean %, duplicates, degenerate.
+    /// Ours (quadric representative, 8 B cache per vertex): count, median ms, Metro mean %,
+    /// duplicates, degenerate.
     pub ours: (usize, f64, f64, usize, usize),
+    /// Ours with a bit per vertex: median ms.
+    pub ours_bit_ms: f64,
+    /// Ours with memory for the output only: median ms.
+    pub ours_stream_ms: f64,
     /// Sloppy at the same target: count, median ms, duplicates, degenerate.
     pub sloppy: (usize, f64, usize, usize),
     /// Sloppy run to our count: count, Metro mean %.
@@ -314,12 +350,26 @@ pub fn bench(
             let target = ((mesh.triangles.len() as f64) * f64::from(ratio)) as usize;
             let config = ClusterConfig::target(target);
             let mut ours_t = Vec::new();
+            let mut stream_t = Vec::new();
+            let mut bit_t = Vec::new();
             let mut sl_t = Vec::new();
             let mut ours = None;
             let mut sl = None;
             for _ in 0..reps.max(1) {
-                let (o, r, dt) = cluster(mesh, &config, true)?;
+                let (o, r, dt) = cluster(mesh, &config, true, VertexMemory::Cache)?;
                 ours_t.push(dt.as_secs_f64() * 1e3);
+                let (o2, r2, dt) = cluster(mesh, &config, true, VertexMemory::Bit)?;
+                bit_t.push(dt.as_secs_f64() * 1e3);
+                anyhow::ensure!(
+                    o2.triangles == o.triangles && r2 == r,
+                    "{name}: bits differ"
+                );
+                let (o2, r2, dt) = cluster(mesh, &config, true, VertexMemory::None)?;
+                stream_t.push(dt.as_secs_f64() * 1e3);
+                anyhow::ensure!(
+                    o2.triangles == o.triangles && r2 == r,
+                    "{name}: cache differs"
+                );
                 ours = Some((o, r));
                 let (s, dt) = sloppy(mesh, target);
                 sl_t.push(dt.as_secs_f64() * 1e3);
@@ -343,6 +393,8 @@ pub fn bench(
                     od,
                     odg,
                 ),
+                ours_bit_ms: median(bit_t),
+                ours_stream_ms: median(stream_t),
                 sloppy: (s.triangles.len(), median(sl_t), sd, sdg),
                 sloppy_same: (same.triangles.len(), sm.symmetric_mean_pct),
             };
@@ -355,7 +407,7 @@ pub fn bench(
 
 fn markdown_row(r: &Row) -> String {
     format!(
-        "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2}x | {} / {} | {} / {} | {:.4} | {} | {:.4} | {:.2}x |",
+        "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2}x | {:.3} | {:.2}x | {:.3} | {:.2}x | {} / {} | {} / {} | {:.4} | {} | {:.4} | {:.2}x |",
         r.mesh,
         r.triangles,
         r.ratio,
@@ -364,6 +416,10 @@ fn markdown_row(r: &Row) -> String {
         r.sloppy.0,
         r.sloppy.1,
         r.ours.1 / r.sloppy.1,
+        r.ours_bit_ms,
+        r.ours_bit_ms / r.sloppy.1,
+        r.ours_stream_ms,
+        r.ours_stream_ms / r.sloppy.1,
         r.ours.3,
         r.ours.4,
         r.sloppy.2,
@@ -381,11 +437,11 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let _ = writeln!(s, "Command: `{command}`\n");
     let _ = writeln!(
         s,
-        "| mesh | triangles | ratio | ours | ours ms | sloppy | sloppy ms | time ours/sloppy | ours dup / degen | sloppy dup / degen | ours mean % | sloppy at our count | its mean % | error ours/sloppy |"
+        "| mesh | triangles | ratio | ours | ours ms, 8 B/vertex | sloppy | sloppy ms | time ours/sloppy | ours ms, 1 bit/vertex | its time / sloppy | ours ms, output memory only | its time / sloppy | ours dup / degen | sloppy dup / degen | ours mean % | sloppy at our count | its mean % | error ours/sloppy |"
     );
     let _ = writeln!(
         s,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(s, "{}", markdown_row(r));
@@ -400,11 +456,27 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
         .fold(0.0, f64::max);
     let tot_t: f64 =
         rows.iter().map(|r| r.ours.1).sum::<f64>() / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
+    let geo = |f: &dyn Fn(&Row) -> f64| {
+        (rows.iter().map(|r| f(r).ln()).sum::<f64>() / rows.len().max(1) as f64).exp()
+    };
+    let geo_t = geo(&|r| r.ours.1 / r.sloppy.1);
+    let geo_s = geo(&|r| r.ours_stream_ms / r.sloppy.1);
+    let geo_b = geo(&|r| r.ours_bit_ms / r.sloppy.1);
+    let worst_b = rows
+        .iter()
+        .map(|r| r.ours_bit_ms / r.sloppy.1)
+        .fold(0.0, f64::max);
+    let worst_s = rows
+        .iter()
+        .map(|r| r.ours_stream_ms / r.sloppy.1)
+        .fold(0.0, f64::max);
+    let tot_s: f64 = rows.iter().map(|r| r.ours_stream_ms).sum::<f64>()
+        / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
     let dups: usize = rows.iter().map(|r| r.ours.3 + r.ours.4).sum();
     let sdups: usize = rows.iter().map(|r| r.sloppy.2 + r.sloppy.3).sum();
     let _ = writeln!(
         s,
-        "\nTime ours/sloppy: worst row {worst_t:.2}x, all rows together {tot_t:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
+        "\nTime ours/sloppy (8 B per input vertex, `Clusterer::cluster_with_cache`): worst row {worst_t:.2}x, all rows together {tot_t:.2}x, geometric mean {geo_t:.2}x. With a bit per vertex (`Clusterer::cluster_with_seen`): worst row {worst_b:.2}x, geometric mean {geo_b:.2}x. With memory for the output only (`Clusterer::cluster`, same output): worst row {worst_s:.2}x, all rows together {tot_s:.2}x, geometric mean {geo_s:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
     );
     s
 }

@@ -438,6 +438,34 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         }
         Err(e) => cluster_error(&e),
     }
+    // With per-vertex memory: a bit or an 8-byte cache per vertex (any length).
+    let mut bits: [u32; 4] = black_box([0; 4]);
+    let mut cache: [u64; 24] = black_box([0; 24]);
+    let (nb, nc) = (input(13) as usize, input(14) as usize);
+    if let (Some(b), Some(c)) = (bits.get_mut(..nb), cache.get_mut(..nc)) {
+        let q = if input(15) & 1 == 0 {
+            Some(&mut quads)
+        } else {
+            None
+        };
+        match table.cluster_with_seen(&mut src, q, &config, &mut out, b) {
+            Ok(r) => {
+                black_box(r);
+            }
+            Err(e) => cluster_error(&e),
+        }
+        let q = if input(16) & 1 == 0 {
+            Some(&mut quads)
+        } else {
+            None
+        };
+        match table.cluster_with_cache(&mut src, q, &config, &mut out, c) {
+            Ok(r) => {
+                black_box(r);
+            }
+            Err(e) => cluster_error(&e),
+        }
+    }
     // A slice source, and the single-pass stream with an accessor.
     let positions: [[f32; 3]; 16] = black_box([[0.0; 3]; 16]);
     let tris: [[I; 3]; 16] = black_box([[I::ZERO; 3]; 16]);
