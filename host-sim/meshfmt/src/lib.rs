@@ -205,6 +205,9 @@ impl W<'_> {
     fn f32(&mut self, v: f32) {
         self.bytes(&v.to_bits().to_le_bytes());
     }
+    fn skip(&mut self, n: usize) {
+        self.at += n;
+    }
 }
 
 /// Little-endian reader over a fixed array.
