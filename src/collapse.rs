@@ -23,6 +23,7 @@
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 
+use crate::bound::{Bound, NoBound};
 use crate::cost::{Cost, Move};
 use crate::feature::{Mean, Variation};
 use crate::heap::Heap;
@@ -88,7 +89,10 @@ enum Phase {
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
 /// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
-pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
+///
+/// `B` is the error bound: [`NoBound`] (none, the default) or the control points of
+/// [`Workspace::start_bounded`](crate::Workspace::start_bounded).
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
@@ -122,10 +126,18 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     logged: usize,
     /// The cost's per-vertex state has been filled (costs that store it only).
     initialised: bool,
+    /// The error bound (control points), if any.
+    bound: B,
 }
 
-impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
-    pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    pub(crate) fn new(
+        mesh: Mesh<'a, L, I>,
+        heap: Heap<'a, L>,
+        config: Config,
+        cost: C,
+        bound: B,
+    ) -> Self {
         // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
@@ -165,7 +177,30 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             logging: false,
             logged: 0,
             initialised: false,
+            bound,
         }
+    }
+
+    /// Enrols the control points of a bounded run (nothing without a bound).
+    pub(crate) fn enrol(&mut self) {
+        let d = self.config.max_error;
+        if let Some(c) = self.bound.controls_mut() {
+            c.enrol(&self.mesh, d);
+        }
+    }
+
+    /// The legality rules for `from -> to` (at `at` if the cost places the kept vertex), then
+    /// the error bound's veto.
+    fn check(&self, from: usize, to: usize, at: Option<V3>) -> Result<(), crate::Reject> {
+        legality::check(&self.mesh, &self.rules, from, to, at)?;
+        if B::ON && on::BOUND {
+            if let Some(c) = self.bound.controls() {
+                if !c.allows(&self.mesh, from, to) {
+                    return Err(crate::Reject::Bound);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Runs at most `budget` operations and returns `true` once the run is finished.
@@ -261,6 +296,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         for v in 0..self.mesh.vertex_count() {
             used += (self.mesh.first(v) != NIL) as usize;
         }
+        let errors = self.bound.controls().map(|c| c.errors(&self.mesh));
         Report {
             triangles_in: self.mesh.triangle_count(),
             degenerate_dropped: self.mesh.degenerate,
@@ -276,6 +312,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             passes: self.passes,
             pass_triangles: self.pass_triangles.clone(),
             rejected: self.rejected,
+            max_error: errors.map(|e| e.0),
+            mean_error: errors.map(|e| e.1),
         }
     }
 
@@ -586,11 +624,10 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
         let at = self.placement(from, w, to);
-        match legality::check(&self.mesh, &self.rules, from, to, at.map(|x| x.1)) {
+        match self.check(from, to, at.map(|x| x.1)) {
             Ok(()) => Ok((c, at)),
             Err(r) => {
-                if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok()
-                {
+                if at.is_some() && self.check(from, to, None).is_ok() {
                     if let Some(kept) = self.price_kept(from, w, to, true) {
                         return Ok((kept, None));
                     }
@@ -759,7 +796,16 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// Collapses `a -> b` in the mesh, moves `b` to its placement and merges the cost's state.
     fn apply(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
         let (pa, pb) = (self.mesh.p(a), self.mesh.p(b));
+        let chain = match self.bound.controls_mut() {
+            Some(c) if B::ON => c.detach(&self.mesh, a),
+            _ => NIL,
+        };
         self.mesh.collapse(a, b);
+        if B::ON {
+            if let Some(c) = self.bound.controls_mut() {
+                c.attach(&self.mesh, b, chain);
+            }
+        }
         let mut p_new = pb;
         if let Some((q, p)) = at {
             self.mesh.place(b, q);
@@ -854,7 +900,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                 let w = self.walk(from);
                 self.legal(from, &w, to, c)
             } else {
-                legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None))
+                self.check(from, to, None).map(|()| (c, None))
             };
             match checked {
                 Ok((c, at)) => {

@@ -59,6 +59,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod bound;
 pub mod cluster;
 mod collapse;
 mod config;
@@ -74,6 +75,7 @@ mod report;
 pub mod stream;
 mod workspace;
 
+pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Schedule};
 pub use index::Index;
@@ -96,6 +98,10 @@ pub enum Capacity {
     Triangles,
     /// Fewer stored quadrics than positions ([`Workspace::simplify_stored`]).
     Quadrics,
+    /// Fewer control links than [`bound::control_len`], more control points than the link
+    /// type numbers, or a finite [`Config::max_error`] on an entry point without control
+    /// points ([`Workspace::start_bounded`]).
+    Controls,
 }
 
 /// Which configuration field is out of range.
@@ -110,6 +116,8 @@ pub enum ConfigField {
     MaxNormalTurn,
     MinQuality,
     BoundaryWeight,
+    MaxError,
+    ControlAngle,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
@@ -143,6 +151,12 @@ pub enum Error {
         /// The field.
         field: ConfigField,
     },
+    /// The original triangles given for an error bound are not the triangles to simplify:
+    /// another length (`triangle` is then the shorter length) or a different triangle.
+    OriginalMismatch {
+        /// The first triangle that differs.
+        triangle: usize,
+    },
 }
 
 impl core::fmt::Display for Error {
@@ -164,6 +178,9 @@ impl core::fmt::Display for Error {
             }
             Error::InvalidConfig { field } => {
                 write!(f, "configuration field {field:?} is out of range")
+            }
+            Error::OriginalMismatch { triangle } => {
+                write!(f, "original triangle {triangle} is not the one to simplify")
             }
         }
     }
