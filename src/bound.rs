@@ -424,6 +424,28 @@ impl<'a, I: Index, K: Index> Controls<'a, I, K> {
         }
     }
 
+    /// `d_i,max` of seed 001 eq. 3: the largest distance of triangle `t`'s control points to
+    /// it, in normalised units (0 if it has none).
+    pub(crate) fn max_distance<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> f32 {
+        let q = mesh.tri(t).map(|v| mesh.p(v));
+        let mut max = 0.0f32;
+        let mut c = self.head(t);
+        let mut guard = self.guard();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let d2 = point_triangle_distance2(self.point(mesh, c), q);
+            if d2 > max {
+                max = d2;
+            }
+            c = self.next(c);
+        }
+        if max > math::TINY2 && max.is_finite() {
+            max * math::rsqrt(max)
+        } else {
+            0.0
+        }
+    }
+
     /// `(E_max, E_mean)` in the input's units (seed 001 §4, eq. 4-5): the largest distance of
     /// any control point (both kinds) to its controlled triangle, and the mean distance of the
     /// centroids weighted by their original triangles' areas.

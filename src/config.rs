@@ -26,6 +26,18 @@ pub enum CostKind {
     NormalVariation,
 }
 
+/// Which operator simplifies the mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Operator {
+    /// Half-edge collapse (the default): one vertex moves onto a neighbour.
+    Edge,
+    /// Triangle collapse (Zhu, Wang and Meng 2007, seed 001 §3): a triangle's three vertices
+    /// merge into one of them, smallest weight `W = A (α + rc + d_max)` (eq. 3) first; see
+    /// [`crate::triangle`]. Greedy schedule only.
+    Triangle,
+}
+
 /// How the feature test (seed 004 §3, eq. 3-5) weighs a vertex's normal variation D.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -86,6 +98,9 @@ pub struct Config {
     /// by more than this many degrees, in `(0, 180)`. Boundary and non-manifold edges always
     /// are.
     pub control_angle_deg: f32,
+    /// The simplification operator: edge collapse (default) or the seed 001 triangle
+    /// collapse ([`Schedule::Greedy`] only).
+    pub operator: Operator,
 }
 
 impl Config {
@@ -109,6 +124,7 @@ impl Config {
             boundary_weight: 1.0,
             max_error: f32::INFINITY,
             control_angle_deg: 30.0,
+            operator: Operator::Edge,
         }
     }
 
@@ -171,6 +187,12 @@ impl Config {
         self
     }
 
+    /// Sets the operator.
+    pub const fn with_operator(mut self, operator: Operator) -> Self {
+        self.operator = operator;
+        self
+    }
+
     /// Sets the guaranteed error bound `d_hold` in the input's units (see
     /// [`Config::max_error`]).
     pub const fn with_max_error(mut self, distance: f32) -> Self {
@@ -214,6 +236,9 @@ impl Config {
         }
         if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
             return bad(F::ControlAngle);
+        }
+        if self.operator == Operator::Triangle && self.schedule != Schedule::Greedy {
+            return bad(F::Operator);
         }
         Ok(())
     }

@@ -73,11 +73,12 @@ mod mesh;
 pub mod progressive;
 mod report;
 pub mod stream;
+pub mod triangle;
 mod workspace;
 
 pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
-pub use config::{Config, CostKind, FeatureMode, Schedule};
+pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
 pub use index::Index;
 pub use progressive::Progressive;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
@@ -118,6 +119,7 @@ pub enum ConfigField {
     BoundaryWeight,
     MaxError,
     ControlAngle,
+    Operator,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer

@@ -434,3 +434,41 @@ fn bad_input_is_refused() {
     common::assert_valid("zero bound", &m, &out, &r);
     assert_eq!(r.triangles_out, 80);
 }
+
+#[test]
+fn triangle_collapse_honours_the_bound() {
+    // The seed's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
+    let tri = unlimited().with_operator(tinydecimate::Operator::Triangle);
+    for (name, m) in [
+        ("icosphere4", icosphere(4)),
+        ("wavy grid", grid(40, 30, 0.3)),
+        ("fin and pinch", fin_and_pinch(16)),
+        ("cow", fixture("cow.obj")),
+        ("plate_holes", fixture("plate_holes.obj")),
+    ] {
+        let counts = check(&format!("triangle {name}"), &m, &[0.002, 0.01], tri);
+        assert!(counts[1] < counts[0], "{name}: {counts:?}");
+        assert!(counts[0] < m.triangles.len(), "{name}: {counts:?}");
+    }
+    // Without a bound, to a triangle target.
+    let m = fixture("cow.obj");
+    let (out, r) = common::simplify(
+        &m,
+        &Config::new().with_operator(tinydecimate::Operator::Triangle),
+    );
+    common::assert_valid("triangle cow 10 %", &m, &out, &r);
+    assert!(r.target_reached, "{r:?}");
+    // Passes and triangle collapse do not mix.
+    let mut tris = m.triangles.clone();
+    let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
+    assert_eq!(
+        ws.simplify(
+            &m.positions,
+            &mut tris,
+            &Config::paper().with_operator(tinydecimate::Operator::Triangle)
+        ),
+        Err(Error::InvalidConfig {
+            field: ConfigField::Operator
+        })
+    );
+}

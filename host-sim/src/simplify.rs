@@ -88,6 +88,16 @@ impl From<CostArg> for CostKind {
     }
 }
 
+/// Which operator, on the command line (`Config::with_operator`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum OperatorArg {
+    /// Half-edge collapse.
+    #[default]
+    Edge,
+    /// Triangle collapse (seed 001 §3): weight of eq. 3, penalty re-insertion; greedy only.
+    Triangle,
+}
+
 /// Which quadric, on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum QuadricArg {
@@ -287,6 +297,10 @@ pub struct Args {
     /// normal for passes as in `Config::paper()`).
     #[arg(long, value_enum)]
     pub cost: Option<CostArg>,
+    /// Simplification operator: half-edge collapse, or the triangle collapse of seed 001
+    /// (Zhu, Wang and Meng 2007; greedy schedule only).
+    #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
+    pub operator: OperatorArg,
     /// Quadric: `stored` keeps a quadric per vertex (issue 15), replacing --cost.
     #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
     pub quadric: QuadricArg,
@@ -341,6 +355,9 @@ impl Args {
         }
         if let Some(x) = self.boundary_weight {
             c.boundary_weight = x;
+        }
+        if self.operator == OperatorArg::Triangle {
+            c = c.with_operator(tinydecimate::Operator::Triangle);
         }
         c
     }
@@ -669,8 +686,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     } else {
         let _ = writeln!(
             text,
-            "  schedule, cost         {:?}, {:?}",
-            config.schedule, config.cost
+            "  schedule, cost, op     {:?}, {:?}, {:?} collapse",
+            config.schedule, config.cost, config.operator
         );
     }
     if let Some(e) = args.max_error {
@@ -751,6 +768,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "keep_numbering": args.keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
+        "operator": format!("{:?}", config.operator),
         "quadric": format!("{:?}", args.quadric),
         "placement": format!("{:?}", args.placement),
         "max_error": args.max_error.map(|e| e.to_string()),

@@ -25,8 +25,8 @@ use tinydecimate::cost::{
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, Error, FeatureMode, Index, Progressive, Report, Schedule, Simplifier,
-    Workspace,
+    Config, CostKind, Error, FeatureMode, Index, Operator, Progressive, Report, Schedule,
+    Simplifier, Workspace,
 };
 
 #[panic_handler]
@@ -81,6 +81,11 @@ fn opaque_config() -> Config {
         boundary_weight: opaque_f32(9),
         max_error: opaque_f32(19),
         control_angle_deg: opaque_f32(20),
+        operator: if input(6) & 8 == 0 {
+            Operator::Edge
+        } else {
+            Operator::Triangle
+        },
     };
     // The builders too.
     let b = black_box(Config::paper())
@@ -92,6 +97,7 @@ fn opaque_config() -> Config {
         .with_max_passes(input(13))
         .with_max_cost(opaque_f32(14))
         .with_max_error(opaque_f32(21))
+        .with_operator(c.operator)
         .with_cost(c.cost);
     black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
