@@ -472,3 +472,25 @@ fn triangle_collapse_honours_the_bound() {
         })
     );
 }
+
+#[test]
+#[ignore = "every shared mesh, both operators: about a minute in release"]
+fn all_shared_meshes_stay_within_the_bound() {
+    let mut names: Vec<String> = std::fs::read_dir(common::shared_meshes())
+        .expect("shared meshes")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".obj"))
+        .collect();
+    names.sort();
+    for name in &names {
+        let m = common::load_obj(name);
+        check(name, &m, &[0.005], unlimited());
+        check(
+            &format!("triangle {name}"),
+            &m,
+            &[0.005],
+            unlimited().with_operator(tinydecimate::Operator::Triangle),
+        );
+    }
+}
