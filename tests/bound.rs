@@ -494,3 +494,51 @@ fn all_shared_meshes_stay_within_the_bound() {
         );
     }
 }
+
+#[test]
+fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
+    // The pops between two collapses: a refused edge candidate re-queues a vertex at its true
+    // price or drops it; a triangle vertex whose triangles are all refused goes back at most
+    // MAX_PENALTIES (3) times before it is dropped until its fan changes, and a collapse
+    // re-keys the fans it touched (about 12 vertices). So pops ≤ 4·(V + 12·collapses) and
+    // sweeps ≤ 3·V per round plus V per halving.
+    let m = fixture("cow.obj");
+    let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
+    for op in [
+        tinydecimate::Operator::Edge,
+        tinydecimate::Operator::Triangle,
+    ] {
+        let config = unlimited()
+            .with_operator(op)
+            .with_relative_max_error(0.005, &m.positions);
+        let mut tris = m.triangles.clone();
+        let mut links = vec![0u32; control_len(tris.len(), m.positions.len())];
+        let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
+        let cost = tinydecimate::cost::Builtin::of(&config);
+        let mut s = ws
+            .start_bounded(
+                &m.positions,
+                &m.triangles,
+                &mut tris,
+                &mut links,
+                &config,
+                cost,
+            )
+            .expect("start");
+        let mut ops = 0u64;
+        while !s.step(1) {
+            ops += 1;
+        }
+        let r = s.finish();
+        let halvings = 64 - t.leading_zeros() as u64;
+        let sweeps = 3 * v * r.passes as u64 + v * halvings;
+        let c = r.collapses as u64;
+        eprintln!(
+            "{op:?}: {ops} operations, {c} collapses, {} rounds, {:.2} non-sweep operations per collapse",
+            r.passes,
+            (ops - sweeps.min(ops)) as f64 / c.max(1) as f64
+        );
+        assert!(c < v);
+        assert!(ops <= sweeps + 4 * (v + 12 * c), "{op:?}: {ops}");
+    }
+}
