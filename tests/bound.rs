@@ -542,3 +542,46 @@ fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
         assert!(ops <= sweeps + 4 * (v + 12 * c), "{op:?}: {ops}");
     }
 }
+
+mod property {
+    use super::*;
+    use proptest::prelude::*;
+    use tinydecimate::{Operator, Schedule};
+
+    fn mesh(kind: u8, n: u32, jitter_seed: u64) -> MeshData {
+        let m = match kind % 4 {
+            0 => icosphere(1 + n % 3),
+            1 => grid(2 + n % 14, 2 + (n / 3) % 14, 0.3),
+            2 => cube(1 + n % 6),
+            _ => fin_and_pinch(3 + n % 6),
+        };
+        jitter(m, jitter_seed, 1e-2)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+        /// Any generated mesh, bound, schedule, operator and target: valid output, every
+        /// control point within the bound (checked outside the library).
+        #[test]
+        fn the_bound_holds(
+            kind in any::<u8>(),
+            n in any::<u32>(),
+            seed in any::<u64>(),
+            fraction in 0.0f32..0.05,
+            ratio in prop_oneof![Just(0.0f32), 0.0f32..0.8],
+            passes in any::<bool>(),
+            triangle in any::<bool>(),
+        ) {
+            let m = mesh(kind, n, seed);
+            let base = if passes && !triangle { Config::paper() } else { Config::new() };
+            let base = base.with_ratio(ratio).with_operator(if triangle {
+                Operator::Triangle
+            } else {
+                Operator::Edge
+            });
+            prop_assume!(base.schedule == Schedule::Greedy || !triangle);
+            check("property", &m, &[fraction], base);
+        }
+    }
+}
