@@ -868,8 +868,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         let mut order = [(f32::INFINITY, 0usize); 3];
         for (k, slot) in order.iter_mut().enumerate() {
             let mut sum = 0.0f32;
-            for j in [next3(k), prev3(k)] {
-                let x = tri[j];
+            // Indexed with next3/prev3 directly: provably below 3 (no bounds check).
+            for x in [tri[next3(k)], tri[prev3(k)]] {
                 let w = self.walk(x);
                 sum += self
                     .price_kept(x, &w, tri[prev3(next3(k))], true)
