@@ -15,6 +15,11 @@
 //! link condition and boundary edges only between boundary vertices (§3.2(1)), a dihedral
 //! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
+//! A guaranteed error bound (Zhu, Wang and Meng 2007, seed 001 §2-§4) is a policy of the same
+//! engine: [`Config::with_max_error`] with [`Workspace::start_bounded`] checks control points
+//! (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
+//! seed's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
+//!
 //! Data flows one way:
 //!
 //! ```text
