@@ -681,7 +681,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// Greedy: re-classify `v` against the round's threshold and re-key it: the cheapest
     /// price among its candidates (a lower bound of its cheapest legal collapse).
     fn rekey(&mut self, v: usize) {
-        if self.config.operator == Operator::Triangle {
+        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
             return self.rekey_triangles(v);
         }
         let f = self.mesh.flags(v);
@@ -711,7 +711,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
 
     /// Greedy: one pop of the queue.
     fn pop(&mut self) {
-        if self.config.operator == Operator::Triangle {
+        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
             return self.pop_triangles();
         }
         if self.mesh.live <= self.target {

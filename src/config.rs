@@ -34,7 +34,8 @@ pub enum Operator {
     Edge,
     /// Triangle collapse (Zhu, Wang and Meng 2007, seed 001 §3): a triangle's three vertices
     /// merge into one of them, smallest weight `W = A (α + rc + d_max)` (eq. 3) first; see
-    /// [`crate::triangle`]. Greedy schedule only.
+    /// [`crate::triangle`]. Greedy schedule only, and only with the crate feature `triangle`
+    /// (else [`Config::validate`] refuses it).
     Triangle,
 }
 
@@ -99,7 +100,7 @@ pub struct Config {
     /// are.
     pub control_angle_deg: f32,
     /// The simplification operator: edge collapse (default) or the seed 001 triangle
-    /// collapse ([`Schedule::Greedy`] only).
+    /// collapse ([`Schedule::Greedy`] and the crate feature `triangle` only).
     pub operator: Operator,
 }
 
@@ -237,7 +238,9 @@ impl Config {
         if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
             return bad(F::ControlAngle);
         }
-        if self.operator == Operator::Triangle && self.schedule != Schedule::Greedy {
+        if self.operator == Operator::Triangle
+            && (self.schedule != Schedule::Greedy || !cfg!(feature = "triangle"))
+        {
             return bad(F::Operator);
         }
         Ok(())

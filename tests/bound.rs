@@ -435,6 +435,7 @@ fn bad_input_is_refused() {
     assert_eq!(r.triangles_out, 80);
 }
 
+#[cfg(feature = "triangle")]
 #[test]
 fn triangle_collapse_honours_the_bound() {
     // The seed's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
@@ -486,6 +487,9 @@ fn all_shared_meshes_stay_within_the_bound() {
     for name in &names {
         let m = common::load_obj(name);
         check(name, &m, &[0.005], unlimited());
+        if !cfg!(feature = "triangle") {
+            continue;
+        }
         check(
             &format!("triangle {name}"),
             &m,
@@ -504,10 +508,15 @@ fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
     // sweeps ≤ 3·V per round plus V per halving.
     let m = fixture("cow.obj");
     let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
-    for op in [
-        tinydecimate::Operator::Edge,
-        tinydecimate::Operator::Triangle,
-    ] {
+    let ops: &[tinydecimate::Operator] = if cfg!(feature = "triangle") {
+        &[
+            tinydecimate::Operator::Edge,
+            tinydecimate::Operator::Triangle,
+        ]
+    } else {
+        &[tinydecimate::Operator::Edge]
+    };
+    for &op in ops {
         let config = unlimited()
             .with_operator(op)
             .with_relative_max_error(0.005, &m.positions);
@@ -573,6 +582,7 @@ mod property {
             passes in any::<bool>(),
             triangle in any::<bool>(),
         ) {
+            let triangle = triangle && cfg!(feature = "triangle");
             let m = mesh(kind, n, seed);
             let base = if passes && !triangle { Config::paper() } else { Config::new() };
             let base = base.with_ratio(ratio).with_operator(if triangle {
@@ -584,4 +594,16 @@ mod property {
             check("property", &m, &[fraction], base);
         }
     }
+}
+
+#[cfg(not(feature = "triangle"))]
+#[test]
+fn triangle_collapse_needs_its_feature() {
+    let config = Config::new().with_operator(tinydecimate::Operator::Triangle);
+    assert_eq!(
+        config.validate(),
+        Err(Error::InvalidConfig {
+            field: ConfigField::Operator
+        })
+    );
 }
