@@ -12,13 +12,13 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-all_rules=(locked feature boundary link duplicate sliver normal_turn fold)
+all_rules=(locked feature boundary link duplicate sliver normal_turn fold bound)
 rules=("$@")
 [ ${#rules[@]} -eq 0 ] && rules=("${all_rules[@]}")
 # The subset: the rule tests (tests/rules.rs, one or more per rule, all asserting properties of
 # real output through the shared checker), bad input, the fuzz regressions and the property
-# tests.
-read -r -a tests <<<"${RULES_OFF_TESTS:---test rules --test errors --test fuzz_regressions --test properties}"
+# tests; and the error bound's independent check (tests/bound.rs, for the `bound` veto).
+read -r -a tests <<<"${RULES_OFF_TESTS:---test rules --test errors --test fuzz_regressions --test properties --test bound}"
 per_run_timeout=${RULES_OFF_TIMEOUT:-900}
 
 log_dir=$(mktemp -d)

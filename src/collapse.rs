@@ -23,6 +23,7 @@
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 
+use crate::bound::{Bound, NoBound};
 use crate::cost::{Cost, Move};
 use crate::feature::{Mean, Variation};
 use crate::heap::Heap;
@@ -31,7 +32,7 @@ use crate::legality::{self, on, Rules, Shape};
 use crate::math::{self, V3};
 use crate::mesh::{flag, next3, prev3, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
-use crate::{Config, Schedule};
+use crate::{Config, Operator, Schedule};
 
 /// Candidates priced per vertex: its first `MAX_CANDIDATES` neighbours in fan order (a vertex
 /// of higher valence never moves onto the others).
@@ -88,7 +89,10 @@ enum Phase {
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
 /// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
-pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
+///
+/// `B` is the error bound: [`NoBound`] (none, the default) or the control points of
+/// [`Workspace::start_bounded`](crate::Workspace::start_bounded).
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
@@ -122,10 +126,18 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost> {
     logged: usize,
     /// The cost's per-vertex state has been filled (costs that store it only).
     initialised: bool,
+    /// The error bound (control points), if any.
+    bound: B,
 }
 
-impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
-    pub(crate) fn new(mesh: Mesh<'a, L, I>, heap: Heap<'a, L>, config: Config, cost: C) -> Self {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    pub(crate) fn new(
+        mesh: Mesh<'a, L, I>,
+        heap: Heap<'a, L>,
+        config: Config,
+        cost: C,
+        bound: B,
+    ) -> Self {
         // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
@@ -165,7 +177,35 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             logging: false,
             logged: 0,
             initialised: false,
+            bound,
         }
+    }
+
+    /// Enrols the control points of a bounded run (nothing without a bound).
+    pub(crate) fn enrol(&mut self) {
+        let d = self.config.max_error;
+        if let Some(c) = self.bound.controls_mut() {
+            c.enrol(&self.mesh, d);
+        }
+    }
+
+    /// The legality rules for `from -> to` (at `at` if the cost places the kept vertex), then
+    /// the error bound's veto.
+    #[inline(always)]
+    fn check(&self, from: usize, to: usize, at: Option<V3>) -> Result<(), crate::Reject> {
+        // Inlined, so that the read-only modes (always `None`) drop the moved-`b` rules.
+        match at {
+            Some(p) => legality::check_placed(&self.mesh, &self.rules, from, to, p)?,
+            None => legality::check(&self.mesh, &self.rules, from, to, None)?,
+        }
+        if B::ON && on::BOUND {
+            if let Some(c) = self.bound.controls() {
+                if !c.allows(&self.mesh, from, to) {
+                    return Err(crate::Reject::Bound);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Runs at most `budget` operations and returns `true` once the run is finished.
@@ -261,6 +301,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         for v in 0..self.mesh.vertex_count() {
             used += (self.mesh.first(v) != NIL) as usize;
         }
+        let errors = self.bound.controls().map(|c| c.errors(&self.mesh));
         Report {
             triangles_in: self.mesh.triangle_count(),
             degenerate_dropped: self.mesh.degenerate,
@@ -276,6 +317,8 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             passes: self.passes,
             pass_triangles: self.pass_triangles.clone(),
             rejected: self.rejected,
+            max_error: errors.map(|e| e.0),
+            mean_error: errors.map(|e| e.1),
         }
     }
 
@@ -593,7 +636,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
         if !self.movable() {
-            return legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None));
+            return self.check(from, to, None).map(|()| (c, None));
         }
         self.legal_placed(from, w, to, c)
     }
@@ -610,15 +653,10 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
         c: f32,
     ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
         let at = self.placement(from, w, to);
-        let checked = match at {
-            Some((_, p)) => legality::check_placed(&self.mesh, &self.rules, from, to, p),
-            None => legality::check(&self.mesh, &self.rules, from, to, None),
-        };
-        match checked {
+        match self.check(from, to, at.map(|x| x.1)) {
             Ok(()) => Ok((c, at)),
             Err(r) => {
-                if at.is_some() && legality::check(&self.mesh, &self.rules, from, to, None).is_ok()
-                {
+                if at.is_some() && self.check(from, to, None).is_ok() {
                     if let Some(kept) = self.price_kept(from, w, to, true) {
                         return Ok((kept, None));
                     }
@@ -672,6 +710,9 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// Greedy: re-classify `v` against the round's threshold and re-key it: the cheapest
     /// price among its candidates (a lower bound of its cheapest legal collapse).
     fn rekey(&mut self, v: usize) {
+        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
+            return self.rekey_triangles(v);
+        }
         let f = self.mesh.flags(v);
         if f & flag::USED == 0 || (on::LOCKED && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
@@ -699,6 +740,9 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
 
     /// Greedy: one pop of the queue.
     fn pop(&mut self) {
+        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
+            return self.pop_triangles();
+        }
         if self.mesh.live <= self.target {
             return self.done(Stop::Target);
         }
@@ -742,6 +786,171 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
             }
         }
         self.heap.remove(v);
+    }
+
+    /// Triangle collapse (seed 001 eq. 3): the weight of live triangle `t`, `A (α + rc +
+    /// d_max)`; `None` if not finite.
+    fn triangle_weight(&self, t: usize) -> Option<f32> {
+        let tri = self.mesh.tri(t);
+        let (w, area) = crate::triangle::weight(&self.mesh, tri)?;
+        let d = match self.bound.controls() {
+            Some(c) if B::ON => c.max_distance(&self.mesh, t),
+            _ => 0.0,
+        };
+        let w = w + area * d;
+        w.is_finite().then_some(w)
+    }
+
+    /// Triangle collapse: `v`'s key is the smallest weight of its triangles (feature and
+    /// locked vertices are not queued: their triangles are reached from their other vertices).
+    fn rekey_triangles(&mut self, v: usize) {
+        let f = self.mesh.flags(v);
+        if f & flag::USED == 0 || (on::LOCKED && f & flag::LOCKED != 0) {
+            return self.heap.remove(v);
+        }
+        let w = self.walk(v);
+        let is = self.config.features && self.is_feature_now(&w);
+        self.mesh.set_flag(v, flag::FEATURE, is);
+        if is && on::FEATURE {
+            return self.heap.remove(v);
+        }
+        let mut key = f32::INFINITY;
+        for (t, _) in self.mesh.corners(v) {
+            if let Some(x) = self.triangle_weight(t) {
+                if x < key {
+                    key = x;
+                }
+            }
+        }
+        if key.is_finite() {
+            self.heap.set(v, key)
+        } else {
+            self.heap.remove(v)
+        }
+    }
+
+    /// Triangle collapse: one pop. `v`'s triangles in weight order; the first that collapses
+    /// ends the pop. All refused: the key times the penalty `p` (seed 001 §3), at most
+    /// `MAX_PENALTIES` times in a row.
+    fn pop_triangles(&mut self) {
+        use crate::triangle::{MAX_PENALTIES, PENALTY};
+        if self.mesh.live <= self.target {
+            return self.done(Stop::Target);
+        }
+        let Some((v, key)) = self.heap.peek() else {
+            if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
+                return self.done(Stop::NoLegalCollapse);
+            }
+            return self.new_round();
+        };
+        if self.mesh.live <= self.refresh_at {
+            self.refresh_only = true;
+            self.phase = Phase::Mean;
+            self.v = 0;
+            return;
+        }
+        if key > self.config.max_cost {
+            return self.done(Stop::MaxCost);
+        }
+        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
+        let mut n = 0;
+        for (t, _) in self.mesh.corners(v) {
+            if let (Some(w), Some(slot)) = (self.triangle_weight(t), cand.get_mut(n)) {
+                *slot = (w, t);
+                n += 1;
+            }
+        }
+        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        let mut least = f32::INFINITY;
+        for c in cand.iter() {
+            if c.0 < least {
+                least = c.0;
+            }
+        }
+        while let Some((_, t)) = take_cheapest(cand) {
+            if self.collapse_triangle(t) {
+                return;
+            }
+        }
+        // Every triangle refused: back in at p times the key, unless it was already
+        // penalised MAX_PENALTIES times since its weights last changed.
+        let mut cap = least;
+        for _ in 0..MAX_PENALTIES {
+            cap *= PENALTY;
+        }
+        let next = key * PENALTY;
+        if least.is_finite() && next > key && key < cap && next.is_finite() {
+            self.heap.set(v, next);
+        } else {
+            self.heap.remove(v);
+        }
+    }
+
+    /// Collapses live triangle `t` into one of its vertices, as two half-edge moves `x -> k`,
+    /// `y -> k` (see `crate::triangle`); `false` if the first move is refused for every `k`.
+    fn collapse_triangle(&mut self, t: usize) -> bool {
+        let tri = self.mesh.tri(t);
+        if crate::mesh::is_dead(tri) {
+            return false;
+        }
+        // The kept vertex: the one whose two moves the cost prices lowest (ties: lower slot).
+        let mut order = [(f32::INFINITY, 0usize); 3];
+        for (k, slot) in order.iter_mut().enumerate() {
+            let mut sum = 0.0f32;
+            // Indexed with next3/prev3 directly: provably below 3 (no bounds check).
+            for x in [tri[next3(k)], tri[prev3(k)]] {
+                let w = self.walk(x);
+                sum += self
+                    .price_kept(x, &w, tri[prev3(next3(k))], true)
+                    .unwrap_or(f32::INFINITY);
+            }
+            *slot = (sum, k);
+        }
+        for _ in 0..3 {
+            // The cheapest choice left (a selection, not a sort: no comparator to misuse).
+            let mut best: Option<usize> = None;
+            for (i, c) in order.iter().enumerate() {
+                if c.0.is_finite() && best.is_none_or(|b| order.get(b).is_some_and(|o| c.0 < o.0)) {
+                    best = Some(i);
+                }
+            }
+            let Some((price, k)) = best.and_then(|b| order.get_mut(b)).map(|o| {
+                let v = *o;
+                o.0 = f32::INFINITY;
+                v
+            }) else {
+                break;
+            };
+            if !price.is_finite() {
+                continue;
+            }
+            let keep = tri[prev3(next3(k))];
+            let (x, y) = (tri[next3(k)], tri[prev3(k)]);
+            match self.check(x, keep, None) {
+                Ok(()) => {
+                    self.heap.remove(x);
+                    self.collapse_greedy(x, keep, None);
+                    if matches!(self.phase, Phase::Done(_)) {
+                        return true;
+                    }
+                    // The second move, on the mesh after the first.
+                    let w = self.walk(y);
+                    if self.mesh.live > self.target && self.price_kept(y, &w, keep, true).is_some()
+                    {
+                        match self.check(y, keep, None) {
+                            Ok(()) => {
+                                self.heap.remove(y);
+                                self.collapse_greedy(y, keep, None);
+                            }
+                            Err(r) => self.rejected.count(r),
+                        }
+                    }
+                    return true;
+                }
+                Err(r) => self.rejected.count(r),
+            }
+        }
+        false
     }
 
     fn new_round(&mut self) {
@@ -794,7 +1003,16 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
     /// Collapses `a -> b` in the mesh, moves `b` to its placement and merges the cost's state.
     fn apply(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
         let (pa, pb) = (self.mesh.p(a), self.mesh.p(b));
+        let chain = match self.bound.controls_mut() {
+            Some(c) if B::ON => c.detach(&self.mesh, a),
+            _ => NIL,
+        };
         self.mesh.collapse(a, b);
+        if B::ON {
+            if let Some(c) = self.bound.controls_mut() {
+                c.attach(&self.mesh, b, chain);
+            }
+        }
         let mut p_new = pb;
         if let Some((q, p)) = at {
             self.mesh.place(b, q);
@@ -889,7 +1107,7 @@ impl<'a, L: Index, I: Index, C: Cost> Simplifier<'a, L, I, C> {
                 let w = self.walk(from);
                 self.legal(from, &w, to, c)
             } else {
-                legality::check(&self.mesh, &self.rules, from, to, None).map(|()| (c, None))
+                self.check(from, to, None).map(|()| (c, None))
             };
             match checked {
                 Ok((c, at)) => {

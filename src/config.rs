@@ -26,6 +26,19 @@ pub enum CostKind {
     NormalVariation,
 }
 
+/// Which operator simplifies the mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Operator {
+    /// Half-edge collapse (the default): one vertex moves onto a neighbour.
+    Edge,
+    /// Triangle collapse (Zhu, Wang and Meng 2007, seed 001 §3): a triangle's three vertices
+    /// merge into one of them, smallest weight `W = A (α + rc + d_max)` (eq. 3) first; see
+    /// [`crate::triangle`]. Greedy schedule only, and only with the crate feature `triangle`
+    /// (else [`Config::validate`] refuses it).
+    Triangle,
+}
+
 /// How the feature test (seed 004 §3, eq. 3-5) weighs a vertex's normal variation D.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -75,6 +88,20 @@ pub struct Config {
     /// Weight of the boundary retreat (squared distance of a removed boundary vertex to the new
     /// boundary edge) against the normal variation. Non-negative.
     pub boundary_weight: f32,
+    /// The guaranteed error bound `d_hold` (seed 001 §2-§3), in the input's units: no control
+    /// point (original triangle centroid or feature-edge vertex) ends farther than this from
+    /// the result. Infinite (the default): no bound. A finite value needs the control points
+    /// of [`Workspace::start_bounded`](crate::Workspace::start_bounded); the other entry
+    /// points refuse it with [`Capacity::Controls`](crate::Capacity::Controls). Non-negative.
+    pub max_error: f32,
+    /// With an error bound: an original edge is a feature edge (its vertices are control
+    /// points of the second kind, seed 001 §2 fig. 2) when its two triangles' normals differ
+    /// by more than this many degrees, in `(0, 180)`. Boundary and non-manifold edges always
+    /// are.
+    pub control_angle_deg: f32,
+    /// The simplification operator: edge collapse (default) or the seed 001 triangle
+    /// collapse ([`Schedule::Greedy`] and the crate feature `triangle` only).
+    pub operator: Operator,
 }
 
 impl Config {
@@ -96,6 +123,9 @@ impl Config {
             max_normal_turn_deg: 60.0,
             min_quality: 0.05,
             boundary_weight: 1.0,
+            max_error: f32::INFINITY,
+            control_angle_deg: 30.0,
+            operator: Operator::Edge,
         }
     }
 
@@ -158,6 +188,25 @@ impl Config {
         self
     }
 
+    /// Sets the operator.
+    pub const fn with_operator(mut self, operator: Operator) -> Self {
+        self.operator = operator;
+        self
+    }
+
+    /// Sets the guaranteed error bound `d_hold` in the input's units (see
+    /// [`Config::max_error`]).
+    pub const fn with_max_error(mut self, distance: f32) -> Self {
+        self.max_error = distance;
+        self
+    }
+
+    /// Sets the guaranteed error bound to `fraction` of the bounding-box diagonal of
+    /// `positions` (0.005: 0.5 % of the diagonal).
+    pub fn with_relative_max_error(self, fraction: f32, positions: &[[f32; 3]]) -> Self {
+        self.with_max_error(fraction * crate::bound::bounding_diagonal(positions))
+    }
+
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), crate::Error> {
         use crate::{ConfigField as F, Error};
@@ -182,6 +231,17 @@ impl Config {
         }
         if !(self.boundary_weight.is_finite() && self.boundary_weight >= 0.0) {
             return bad(F::BoundaryWeight);
+        }
+        if self.max_error.is_nan() || self.max_error < 0.0 {
+            return bad(F::MaxError);
+        }
+        if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
+            return bad(F::ControlAngle);
+        }
+        if self.operator == Operator::Triangle
+            && (self.schedule != Schedule::Greedy || !cfg!(feature = "triangle"))
+        {
+            return bad(F::Operator);
         }
         Ok(())
     }

@@ -61,6 +61,8 @@ pub(crate) mod on {
     pub(crate) const SLIVER: bool = !off("sliver");
     pub(crate) const NORMAL_TURN: bool = !off("normal_turn");
     pub(crate) const FOLD: bool = !off("fold");
+    /// The error bound's veto (control points, `crate::bound`).
+    pub(crate) const BOUND: bool = !off("bound");
 }
 
 /// Two adjacent triangles whose unit normals have a dot product below −0.9 are folded onto

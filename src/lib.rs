@@ -15,6 +15,11 @@
 //! link condition and boundary edges only between boundary vertices (§3.2(1)), a dihedral
 //! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
+//! A guaranteed error bound (Zhu, Wang and Meng 2007, seed 001 §2-§4) is a policy of the same
+//! engine: [`Config::with_max_error`] with [`Workspace::start_bounded`] checks control points
+//! (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
+//! seed's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
+//!
 //! Data flows one way:
 //!
 //! ```text
@@ -59,6 +64,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod bound;
 pub mod cluster;
 mod collapse;
 mod config;
@@ -72,10 +78,12 @@ mod mesh;
 pub mod progressive;
 mod report;
 pub mod stream;
+pub mod triangle;
 mod workspace;
 
+pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
-pub use config::{Config, CostKind, FeatureMode, Schedule};
+pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
 pub use index::Index;
 pub use progressive::Progressive;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
@@ -96,6 +104,10 @@ pub enum Capacity {
     Triangles,
     /// Fewer stored quadrics than positions ([`Workspace::simplify_stored`]).
     Quadrics,
+    /// Fewer control links than [`bound::control_len`], more control points than the link
+    /// type numbers, or a finite [`Config::max_error`] on an entry point without control
+    /// points ([`Workspace::start_bounded`]).
+    Controls,
 }
 
 /// Which configuration field is out of range.
@@ -110,6 +122,9 @@ pub enum ConfigField {
     MaxNormalTurn,
     MinQuality,
     BoundaryWeight,
+    MaxError,
+    ControlAngle,
+    Operator,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
@@ -143,6 +158,12 @@ pub enum Error {
         /// The field.
         field: ConfigField,
     },
+    /// The original triangles given for an error bound are not the triangles to simplify:
+    /// another length (`triangle` is then the shorter length) or a different triangle.
+    OriginalMismatch {
+        /// The first triangle that differs.
+        triangle: usize,
+    },
 }
 
 impl core::fmt::Display for Error {
@@ -164,6 +185,9 @@ impl core::fmt::Display for Error {
             }
             Error::InvalidConfig { field } => {
                 write!(f, "configuration field {field:?} is out of range")
+            }
+            Error::OriginalMismatch { triangle } => {
+                write!(f, "original triangle {triangle} is not the one to simplify")
             }
         }
     }

@@ -371,6 +371,16 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
+    /// A length in the input's units, in the normalised units of [`Mesh::p`].
+    pub(crate) fn normalised_length(&self, d: f32) -> f32 {
+        d * 0.5 * self.inv_half
+    }
+
+    /// A length in the normalised units of [`Mesh::p`], in the input's units.
+    pub(crate) fn input_length(&self, d: f32) -> f32 {
+        d * 2.0 / self.inv_half
+    }
+
     /// `v`'s position as stored (input units).
     pub(crate) fn raw(&self, v: usize) -> Option<[f32; 3]> {
         self.pos.get(v).copied()

@@ -26,6 +26,9 @@ pub enum Reject {
     Sliver,
     /// Two adjacent triangles would fold onto each other (normals nearly opposite).
     Fold,
+    /// A control point would end farther than [`Config::max_error`](crate::Config::max_error)
+    /// from every triangle of the new fan (seed 001 §3).
+    Bound,
 }
 
 /// Collapses refused, by reason. A candidate is counted once per evaluation, so the figures
@@ -42,6 +45,7 @@ pub struct Rejections {
     pub normal_turn: u32,
     pub sliver: u32,
     pub fold: u32,
+    pub bound: u32,
 }
 
 impl Rejections {
@@ -55,6 +59,7 @@ impl Rejections {
             Reject::NormalTurn => &mut self.normal_turn,
             Reject::Sliver => &mut self.sliver,
             Reject::Fold => &mut self.fold,
+            Reject::Bound => &mut self.bound,
         };
         *c = c.saturating_add(1);
     }
@@ -70,6 +75,7 @@ impl Rejections {
             self.normal_turn,
             self.sliver,
             self.fold,
+            self.bound,
         ]
         .iter()
         .fold(0u32, |a, b| a.saturating_add(*b))
@@ -129,4 +135,12 @@ pub struct Report {
     pub pass_triangles: heapless::Vec<u32, PASS_LOG>,
     /// Refused candidate collapses by reason.
     pub rejected: Rejections,
+    /// With an error bound ([`Workspace::start_bounded`](crate::Workspace::start_bounded)):
+    /// E_max of seed 001 eq. 4, the largest distance of a control point (original centroid
+    /// or feature-edge vertex) to its controlled triangle, in the input's units. Never more
+    /// than [`Config::max_error`](crate::Config::max_error). `None` without a bound.
+    pub max_error: Option<f32>,
+    /// With an error bound: E_mean of seed 001 eq. 5, `Σ dc_i·A_i / Σ A_i` over the original
+    /// triangles' centroids (`A_i`: the original triangle's area), in the input's units.
+    pub mean_error: Option<f32>,
 }

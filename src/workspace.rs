@@ -1,5 +1,6 @@
 //! The fixed-capacity working memory, sized at compile time.
 
+use crate::bound::{control_len, Bound, Controls, NoBound};
 use crate::collapse::Simplifier;
 use crate::cost::{Builtin, Cost, Placement, StoredQuadric, VertexQuadric};
 use crate::index::Index;
@@ -98,7 +99,7 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         config: &Config,
         cost: C,
     ) -> Result<Simplifier<'a, L, I, C>, Error> {
-        self.start_on(Positions::Read(positions), triangles, config, cost)
+        self.start_on(Positions::Read(positions), triangles, config, cost, NoBound)
     }
 
     /// Like [`Workspace::start_with_cost`], on positions that a placing cost may move
@@ -112,7 +113,93 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         config: &Config,
         cost: C,
     ) -> Result<Simplifier<'a, L, I, C>, Error> {
-        self.start_on(Positions::Write(positions), triangles, config, cost)
+        self.start_on(
+            Positions::Write(positions),
+            triangles,
+            config,
+            cost,
+            NoBound,
+        )
+    }
+
+    /// Like [`Workspace::start_with_cost`], with the guaranteed error bound
+    /// [`Config::max_error`] (Zhu, Wang and Meng 2007, seed 001 §2-§4; see [`crate::bound`]):
+    /// no collapse is made that would leave a control point (a centroid of an `original`
+    /// triangle, or a vertex of an original feature edge) farther than the bound from the
+    /// result, whatever the cost. The report gives E_max and E_mean (eq. 4-5).
+    ///
+    /// * `original`: the triangles as handed in, read only (they may stay in flash): a copy of
+    ///   `triangles` before the call, else [`Error::OriginalMismatch`].
+    /// * `controls`: at least [`control_len`]`(triangles.len(), positions.len())` links of
+    ///   any [`Index`] type (`2·T + V`: 5 bytes per triangle with `u16` and `V ≈ T/2`), all
+    ///   numbered below its `NIL`; else [`Error::Capacity`] with
+    ///   [`Capacity::Controls`](crate::Capacity::Controls). Meaningless after
+    ///   [`Simplifier::finish`] (the triangles are compacted).
+    ///
+    /// Positions are only read (subset placement). An infinite `max_error` runs unbounded but
+    /// still reports E_max and E_mean.
+    #[allow(clippy::too_many_arguments)]
+    pub fn start_bounded<'a, I: Index, C: Cost, K: Index>(
+        &'a mut self,
+        positions: &'a [[f32; 3]],
+        original: &'a [[I; 3]],
+        triangles: &'a mut [[I; 3]],
+        controls: &'a mut [K],
+        config: &Config,
+        cost: C,
+    ) -> Result<Simplifier<'a, L, I, C, Controls<'a, I, K>>, Error> {
+        if original.len() != triangles.len() {
+            return Err(Error::OriginalMismatch {
+                triangle: original.len().min(triangles.len()),
+            });
+        }
+        if let Some(t) = original
+            .iter()
+            .zip(triangles.iter())
+            .position(|(a, b)| a != b)
+        {
+            return Err(Error::OriginalMismatch { triangle: t });
+        }
+        let need = control_len(triangles.len(), positions.len());
+        if need > K::COUNT {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Controls,
+                needed: need,
+                available: K::COUNT,
+            });
+        }
+        let available = controls.len();
+        let Some(links) = controls.get_mut(..need) else {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Controls,
+                needed: need,
+                available,
+            });
+        };
+        config.validate()?;
+        let bound = Controls::new(
+            original,
+            links,
+            crate::math::cos_deg(config.control_angle_deg),
+        );
+        let mut s = self.start_on(Positions::Read(positions), triangles, config, cost, bound)?;
+        s.enrol();
+        Ok(s)
+    }
+
+    /// [`Workspace::start_bounded`] with the configuration's built-in cost, in one call.
+    pub fn simplify_bounded<I: Index, K: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        original: &[[I; 3]],
+        triangles: &mut [[I; 3]],
+        controls: &mut [K],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        let cost = Builtin::of(config);
+        let mut s = self.start_bounded(positions, original, triangles, controls, config, cost)?;
+        while !s.step(u32::MAX) {}
+        Ok(s.finish())
     }
 
     /// Simplifies with stored quadrics ([`StoredQuadric`], seed 000 §2.3-2.5 and §3.3) and
@@ -151,14 +238,22 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         Ok(s.finish())
     }
 
-    fn start_on<'a, I: Index, C: Cost>(
+    fn start_on<'a, I: Index, C: Cost, B: Bound<'a, I>>(
         &'a mut self,
         positions: Positions<'a>,
         triangles: &'a mut [[I; 3]],
         config: &Config,
         cost: C,
-    ) -> Result<Simplifier<'a, L, I, C>, Error> {
+        bound: B,
+    ) -> Result<Simplifier<'a, L, I, C, B>, Error> {
         config.validate()?;
+        if !B::ON && config.max_error < f32::INFINITY {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Controls,
+                needed: control_len(triangles.len(), positions.len()),
+                available: 0,
+            });
+        }
         if positions.len() > MAX_VERTICES || positions.len() > L::COUNT {
             return Err(Error::Capacity {
                 what: crate::Capacity::Vertices,
@@ -214,6 +309,7 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
             crate::heap::Heap::new(heap, heap_pos, key),
             *config,
             cost,
+            bound,
         ))
     }
 }

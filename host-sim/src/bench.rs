@@ -283,6 +283,8 @@ pub struct Rejected {
     pub sliver: u32,
     /// Fold test.
     pub fold: u32,
+    /// Error bound (control points).
+    pub bound: u32,
 }
 
 impl Rejected {
@@ -298,6 +300,7 @@ impl Rejected {
             normal_turn: j.normal_turn,
             sliver: j.sliver,
             fold: j.fold,
+            bound: j.bound,
         }
     }
 
@@ -312,6 +315,7 @@ impl Rejected {
             ("normal turn", self.normal_turn),
             ("sliver", self.sliver),
             ("fold", self.fold),
+            ("bound", self.bound),
         ];
         v.sort_by_key(|x| std::cmp::Reverse(x.1));
         let parts: Vec<String> = v

@@ -633,6 +633,8 @@ fn error_text(h: &ResultHeader) -> String {
         ErrorKind::NonFinitePosition => format!("non-finite position: vertex {a}"),
         ErrorKind::InvalidConfig => format!("invalid config: field {a}"),
         ErrorKind::CapacityQuadrics => format!("capacity: {a} quadrics needed, {b} available"),
+        ErrorKind::CapacityControls => format!("capacity: {a} control links needed, {b} available"),
+        ErrorKind::OriginalMismatch => format!("original triangle {a} differs"),
     }
 }
 

@@ -49,6 +49,7 @@ pub fn exit_code_for_io(e: &std::io::Error) -> i32 {
 }
 
 pub mod bench;
+pub mod boundtable;
 pub mod check;
 pub mod cluster;
 pub mod demo;

@@ -7,7 +7,9 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::{bench, check, cluster, demo, golden, metro, pm, qemu, render, simplify};
+use host_sim::{
+    bench, boundtable, check, cluster, demo, golden, metro, pm, qemu, render, simplify,
+};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
@@ -43,6 +45,9 @@ enum Command {
     /// Progressive meshes: encode a mesh as a base mesh plus vertex splits, decode a stream to
     /// a level, measure and draw a ladder of levels.
     Pm(pm::Args),
+    /// The error-bound figures: triangles under a guaranteed bound (control points, seed 001)
+    /// next to meshoptimizer at the same target_error, with E_max, E_mean and Metro.
+    BoundTable(boundtable::Args),
     /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
     /// examples/firmware (`cargo run --example … --target thumbv7em-none-eabihf`).
     RunElf(qemu::RunElfArgs),
@@ -62,6 +67,7 @@ fn main() -> ExitCode {
         Command::Demo(a) => demo::run(a),
         Command::Pm(a) => pm::run(a),
         Command::RunElf(a) => qemu::run_elf(a),
+        Command::BoundTable(a) => boundtable::run(a),
     };
     result.unwrap_or_else(|e| {
         // A reader that closed the pipe early wants no more: end quietly, as `out!` does.

@@ -88,6 +88,16 @@ impl From<CostArg> for CostKind {
     }
 }
 
+/// Which operator, on the command line (`Config::with_operator`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum OperatorArg {
+    /// Half-edge collapse.
+    #[default]
+    Edge,
+    /// Triangle collapse (seed 001 §3): weight of eq. 3, penalty re-insertion; greedy only.
+    Triangle,
+}
+
 /// Which quadric, on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum QuadricArg {
@@ -148,13 +158,55 @@ fn parse_ratio(v: &str) -> std::result::Result<f32, String> {
     )
 }
 
-fn parse_max_error(v: &str) -> std::result::Result<f32, String> {
-    ranged(
-        v,
-        |x| x > 0.0 && x <= 1.0,
-        "above 0, at most 1",
-        "a fraction of the bounding-box diagonal, 0.01 is 1 %",
-    )
+/// A guaranteed error bound on the command line: a percentage of the bounding-box diagonal
+/// (`0.5%`) or an absolute distance in the input's units (`0.02`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaxError {
+    /// This fraction of the diagonal (`0.5%` is 0.005).
+    Fraction(f32),
+    /// This distance.
+    Absolute(f32),
+}
+
+impl MaxError {
+    /// The distance on `mesh`.
+    pub fn distance(self, positions: &[[f32; 3]]) -> f32 {
+        match self {
+            MaxError::Fraction(f) => f * tinydecimate::bound::bounding_diagonal(positions),
+            MaxError::Absolute(d) => d,
+        }
+    }
+}
+
+impl std::fmt::Display for MaxError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MaxError::Fraction(x) => write!(f, "{}%", 100.0 * x),
+            MaxError::Absolute(d) => write!(f, "{d}"),
+        }
+    }
+}
+
+/// `P%` or a distance.
+pub fn parse_max_error(v: &str) -> std::result::Result<MaxError, String> {
+    let v = v.trim();
+    if let Some(p) = v.strip_suffix('%') {
+        ranged(
+            p,
+            |x| x > 0.0 && x <= 100.0,
+            "above 0 %, at most 100 %",
+            "a percentage of the bounding-box diagonal, 0.5% is half a percent",
+        )
+        .map(|x| MaxError::Fraction(x / 100.0))
+    } else {
+        ranged(
+            v,
+            |x| x >= 0.0,
+            "0 or more, or a percentage such as 0.5%",
+            "a distance in the input's units",
+        )
+        .map(MaxError::Absolute)
+    }
 }
 
 fn parse_lambda(v: &str) -> std::result::Result<f32, String> {
@@ -208,14 +260,15 @@ pub struct Args {
     /// Target triangle count (with --ratio, the higher target wins).
     #[arg(long, group = "target")]
     pub target_triangles: Option<usize>,
-    /// Stop before a collapse would cost more than this error, given as a fraction of the
-    /// bounding-box diagonal (0.01 = 1 %). With --ratio or --target-triangles, whichever stops
-    /// first. Quadric cost only. Approximate, until the library bounds the error itself: the
-    /// distance is mapped onto the quadric's cost units as the cost of moving a vertex this far
-    /// off the planes of a fan of 6 triangles of the input's mean area (see `max_cost_for`).
-    /// The measured Metro error is printed afterwards.
+    /// Guaranteed error bound (Zhu, Wang and Meng 2007, seed 001): no original triangle's
+    /// centroid and no vertex of an original feature edge ends farther than this from the
+    /// result. `P%` of the bounding-box diagonal (`0.5%`) or an absolute distance in the
+    /// input's units. Alone, simplifies as far as the bound allows; with --ratio or
+    /// --target-triangles, whichever stops first. Any schedule and cost; `--quadric stored`
+    /// with subset placement only. Prints E_max and E_mean (eq. 4-5) next to the Metro
+    /// one-sided maximum from the input to the result.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_max_error)]
-    pub max_error: Option<f32>,
+    pub max_error: Option<MaxError>,
     /// Collapse schedule.
     #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
     pub schedule: ScheduleArg,
@@ -244,6 +297,10 @@ pub struct Args {
     /// normal for passes as in `Config::paper()`).
     #[arg(long, value_enum)]
     pub cost: Option<CostArg>,
+    /// Simplification operator: half-edge collapse, or the triangle collapse of seed 001
+    /// (Zhu, Wang and Meng 2007; greedy schedule only).
+    #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
+    pub operator: OperatorArg,
     /// Quadric: `stored` keeps a quadric per vertex (issue 15), replacing --cost.
     #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
     pub quadric: QuadricArg,
@@ -259,46 +316,6 @@ pub struct Args {
     /// Print the report, the check and the Metro error as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
-}
-
-/// The `max_cost` (quadric cost units) that `--max-error e` stands for on `mesh`.
-///
-/// The library works in normalised units: coordinates divided by the largest side `L` of the
-/// bounding box. The quadric prices a move of the removed vertex by `d` as
-/// `Σ A_t (n_t·d)² · (1 + Ā / A_fan)` (A: twice a triangle's area, Ā: their mean). A move of
-/// distance `δ = e · diagonal / L` straight off the planes of a fan of 6 triangles of the
-/// input's mean area costs `δ² · (6 Ā + Ā) = 7 Ā δ²`, which is the bound returned. Fans of
-/// larger or more curved triangles reach it at a smaller distance, so the measured error is
-/// usually below `e`; it is an approximation, not a guarantee.
-pub fn max_cost_for(mesh: &MeshData, e: f32) -> f32 {
-    let Some((lo, hi)) = mesh.bbox() else {
-        return 0.0;
-    };
-    let side = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
-    if side <= 0.0 {
-        return 0.0;
-    }
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize].map(|x| f64::from(x) / side));
-        let (u, v) = (
-            [0, 1, 2].map(|k| b[k] - a[k]),
-            [0, 1, 2].map(|k| c[k] - a[k]),
-        );
-        let cr = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        let area2 = (cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]).sqrt();
-        if area2 > 0.0 {
-            sum += area2;
-            n += 1;
-        }
-    }
-    let mean = if n > 0 { sum / n as f64 } else { 0.0 };
-    let delta = f64::from(e) * mesh.bbox_diagonal() / side;
-    (7.0 * mean * delta * delta) as f32
 }
 
 impl Args {
@@ -338,6 +355,9 @@ impl Args {
         }
         if let Some(x) = self.boundary_weight {
             c.boundary_weight = x;
+        }
+        if self.operator == OperatorArg::Triangle {
+            c = c.with_operator(tinydecimate::Operator::Triangle);
         }
         c
     }
@@ -415,6 +435,72 @@ pub fn simplify_stored(
     ))
 }
 
+/// Runs the library with the error bound (`Workspace::start_bounded`, control points in a
+/// `u32` link slice), with the configuration's cost or stored quadrics with subset placement,
+/// stepping with a progress bar when `progress`. The wall time is that of the library alone.
+pub fn simplify_bounded(
+    mesh: &MeshData,
+    config: &Config,
+    stored: bool,
+    progress: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    let mut tris = mesh.triangles.clone();
+    let mut links = vec![0u32; tinydecimate::bound::control_len(tris.len(), mesh.positions.len())];
+    let mut quadrics: Vec<VertexQuadric> = if stored {
+        vec![[0.0; 10]; mesh.positions.len()]
+    } else {
+        Vec::new()
+    };
+    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let bar = progress.then(|| {
+        crate::progress::Progress::new(
+            "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
+            mesh.triangles.len() as u64,
+        )
+    });
+    let start = Instant::now();
+    macro_rules! drive {
+        ($s:expr) => {{
+            let mut s = $s.map_err(|e| anyhow!("tinydecimate: {e}"))?;
+            let n0 = s.live_triangles();
+            while !s.step(1 << 12) {
+                if let Some(b) = &bar {
+                    b.set((n0 - s.live_triangles().min(n0)) as u64);
+                }
+            }
+            s.finish()
+        }};
+    }
+    let (p, o) = (&mesh.positions, &mesh.triangles);
+    let report = if stored {
+        let cost = StoredQuadric::new(&mut quadrics, config.boundary_weight, Placement::Subset);
+        drive!(ws.start_bounded(p, o, &mut tris, &mut links, config, cost))
+    } else {
+        let cost = tinydecimate::cost::Builtin::of(config);
+        drive!(ws.start_bounded(p, o, &mut tris, &mut links, config, cost))
+    };
+    let elapsed = start.elapsed();
+    if let Some(b) = bar {
+        b.finish();
+    }
+    tris.truncate(report.triangles_out);
+    Ok((
+        MeshData {
+            positions: mesh.positions.clone(),
+            triangles: tris,
+        },
+        report,
+        elapsed,
+    ))
+}
+
+/// Bytes of control links per input triangle for a bounded run with `u16`/`u32` links:
+/// `control_len(T, V)` links.
+pub fn control_bytes(v: usize, t: usize) -> (usize, usize) {
+    let n = tinydecimate::bound::control_len(t, v);
+    (2 * n, 4 * n)
+}
+
 /// Bytes of stored quadrics per vertex.
 pub const QUADRIC_BYTES: usize = core::mem::size_of::<VertexQuadric>();
 
@@ -436,7 +522,7 @@ pub fn format_report(r: &Report) -> String {
          \x20 passes                 {}\n\
          \x20 triangles after pass   [{}]\n\
          \x20 rejected (total {}): locked {}, feature {}, boundary {}, link {}, duplicate {}, \
-         normal turn {}, sliver {}, fold {}",
+         normal turn {}, sliver {}, fold {}, bound {}{}",
         r.triangles_in,
         r.degenerate_dropped,
         r.duplicates_dropped,
@@ -460,6 +546,11 @@ pub fn format_report(r: &Report) -> String {
         j.normal_turn,
         j.sliver,
         j.fold,
+        j.bound,
+        match (r.max_error, r.mean_error) {
+            (Some(a), Some(b)) => format!("\n  E_max, E_mean          {a:.6e}, {b:.6e}"),
+            _ => String::new(),
+        },
     )
 }
 
@@ -524,7 +615,10 @@ pub fn report_json(r: &Report) -> serde_json::Value {
             "normal_turn": j.normal_turn,
             "sliver": j.sliver,
             "fold": j.fold,
+            "bound": j.bound,
         },
+        "max_error": r.max_error,
+        "mean_error": r.mean_error,
     })
 }
 
@@ -540,13 +634,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     let mesh = crate::io::load_noting(&args.input)?;
     let mut config = args.config();
     if let Some(e) = args.max_error {
-        if config.cost != CostKind::Quadric {
-            bail!(
-                "--max-error is mapped onto the quadric cost's units only; drop --cost normal / \
-                 --schedule passes, or use --ratio / --target-triangles"
-            );
-        }
-        config = config.with_max_cost(max_cost_for(&mesh, e));
+        config = config.with_max_error(e.distance(&mesh.positions));
     }
     config
         .validate()
@@ -555,7 +643,15 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if stored && config.schedule != Schedule::Greedy {
         bail!("--quadric stored runs the greedy schedule only (drop --schedule passes)");
     }
-    let (out, report, elapsed) = if stored {
+    let bounded = args.max_error.is_some();
+    if bounded && stored && args.placement == PlacementArg::Optimal {
+        bail!(
+            "--max-error keeps positions read only: use --placement subset with --quadric stored"
+        );
+    }
+    let (out, report, elapsed) = if bounded {
+        simplify_bounded(&mesh, &config, stored, true)?
+    } else if stored {
         simplify_stored(&mesh, &config, args.placement.into(), true)?
     } else {
         simplify_with_progress(&mesh, &config)?
@@ -590,15 +686,16 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     } else {
         let _ = writeln!(
             text,
-            "  schedule, cost         {:?}, {:?}",
-            config.schedule, config.cost
+            "  schedule, cost, op     {:?}, {:?}, {:?} collapse",
+            config.schedule, config.cost, config.operator
         );
     }
     if let Some(e) = args.max_error {
         let _ = writeln!(
             text,
-            "  max error              {e} of the diagonal = max_cost {:e} (quadric units, approximate)",
-            config.max_cost
+            "  error bound            d_hold {e} = {:.6e} (guaranteed at the control points; \
+             feature edges past {}°)",
+            config.max_error, config.control_angle_deg
         );
     }
     let _ = writeln!(text, "{}", format_report(&report));
@@ -633,6 +730,17 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         },
         per_tri(need)
     );
+    if args.max_error.is_some() {
+        let (b16, b32) = control_bytes(v, t);
+        let _ = writeln!(
+            text,
+            "  control links          2T + V = {} links: {b16} bytes with u16 links ({:.2} per \
+             input triangle), {b32} with u32 ({:.2})",
+            tinydecimate::bound::control_len(t, v),
+            per_tri(b16),
+            per_tri(b32)
+        );
+    }
     if stored {
         let _ = writeln!(
             text,
@@ -660,10 +768,11 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "keep_numbering": args.keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
+        "operator": format!("{:?}", config.operator),
         "quadric": format!("{:?}", args.quadric),
         "placement": format!("{:?}", args.placement),
-        "max_error": args.max_error,
-        "max_cost": if config.max_cost.is_finite() { Some(config.max_cost) } else { None },
+        "max_error": args.max_error.map(|e| e.to_string()),
+        "d_hold": if config.max_error.is_finite() { Some(config.max_error) } else { None },
         "report": report_json(&report),
         "library_ms": elapsed.as_secs_f64() * 1e3,
         "workspace_bytes": need,
@@ -690,6 +799,25 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         let m = crate::metro::metro(&mesh, &out, &opts);
         let _ = writeln!(text, "metro (input vs output):");
         let _ = writeln!(text, "{m}");
+        if let (Some(emax), Some(emean)) = (report.max_error, report.mean_error) {
+            let pct = |x: f64| 100.0 * x / m.diagonal.max(f64::MIN_POSITIVE);
+            let _ = writeln!(
+                text,
+                "error bound (input units; % of the diagonal):\n\
+                 \x20 d_hold                   {:.6e} = {:.5} %\n\
+                 \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
+                 \x20 E_mean (eq. 5)           {:.6e} = {:.5} %\n\
+                 \x20 Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
+                config.max_error,
+                pct(f64::from(config.max_error)),
+                emax,
+                pct(f64::from(emax)),
+                emean,
+                pct(f64::from(emean)),
+                m.a_to_b.max,
+                m.a_to_b.max_pct,
+            );
+        }
         say(&text);
         json["check"] = serde_json::json!({
             "against": "cleaned input",

@@ -210,7 +210,12 @@ fn numbers_out_of_range_say_the_range() {
         ("--ratio", "-1", "accepted: 0 to 1"),
         ("--ratio", "2", "accepted: 0 to 1"),
         ("--ratio", "abc", "accepted: 0 to 1"),
-        ("--max-error", "-0.5", "accepted: above 0, at most 1"),
+        (
+            "--max-error",
+            "-0.5",
+            "accepted: 0 or more, or a percentage",
+        ),
+        ("--max-error", "200%", "accepted: above 0 %, at most 100 %"),
         ("--max-turn", "200", "accepted: above 0, below 180"),
         ("--min-quality", "1", "accepted: 0 or more, below 1"),
         ("--lambda", "-2", "accepted: 0 or more"),
@@ -270,14 +275,28 @@ fn json_max_error_and_stdio() {
     assert!(j["metro"].is_object(), "{j}");
     assert_eq!(j["valid"], true);
 
-    // --max-error alone: a tighter bound keeps more triangles and stops on the cost.
+    // --max-error alone (a percentage of the diagonal or a distance): a guaranteed bound; a
+    // tighter one keeps more triangles, E_max stays within it, any cost.
     let mut kept = Vec::new();
-    for e in ["0.002", "0.02"] {
-        let o = run(&["simplify", s(&input), s(&out), "--max-error", e, "--json"]);
+    for (e, cost) in [("0.2%", "quadric"), ("2%", "quadric"), ("0.01", "normal")] {
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--max-error",
+            e,
+            "--cost",
+            cost,
+            "--json",
+        ]);
         assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
         let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-        assert_eq!(j["report"]["stop"], "MaxCost", "{e}");
-        assert!(j["max_cost"].as_f64().unwrap() > 0.0);
+        let d = j["d_hold"].as_f64().unwrap();
+        assert!(d > 0.0);
+        let emax = j["report"]["max_error"].as_f64().unwrap();
+        assert!(emax <= d, "{e}: {emax} > {d}");
+        assert!(j["report"]["mean_error"].as_f64().unwrap() <= emax);
+        assert_eq!(j["valid"], true);
         kept.push(j["report"]["triangles_out"].as_u64().unwrap());
     }
     assert!(kept[0] > kept[1], "{kept:?}");
@@ -287,11 +306,13 @@ fn json_max_error_and_stdio() {
         s(&out),
         "--max-error",
         "0.01",
-        "--cost",
-        "normal",
+        "--quadric",
+        "stored",
+        "--placement",
+        "optimal",
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("quadric"));
+    assert!(text(&o.stderr).contains("subset"));
 
     // Standard input to standard output: the mesh on stdout, the report on stderr.
     let mut child = bin()

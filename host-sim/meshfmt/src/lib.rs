@@ -364,6 +364,8 @@ pub enum ErrorKind {
     NonFinitePosition = 4,
     InvalidConfig = 5,
     CapacityQuadrics = 6,
+    CapacityControls = 7,
+    OriginalMismatch = 8,
 }
 
 /// Which board produced a result (0 for the host).
@@ -522,6 +524,8 @@ impl ResultHeader {
             4 => ErrorKind::NonFinitePosition,
             5 => ErrorKind::InvalidConfig,
             6 => ErrorKind::CapacityQuadrics,
+            7 => ErrorKind::CapacityControls,
+            8 => ErrorKind::OriginalMismatch,
             _ => return Err(FormatError::Code),
         };
         let hash = [r.u8(), r.u8(), r.u8()];
@@ -729,6 +733,7 @@ pub mod lib {
                             tinydecimate::Capacity::Vertices => ErrorKind::CapacityVertices,
                             tinydecimate::Capacity::Triangles => ErrorKind::CapacityTriangles,
                             tinydecimate::Capacity::Quadrics => ErrorKind::CapacityQuadrics,
+                            tinydecimate::Capacity::Controls => ErrorKind::CapacityControls,
                         },
                         narrow(needed),
                         narrow(available),
@@ -740,6 +745,9 @@ pub mod lib {
                         (ErrorKind::NonFinitePosition, narrow(vertex), 0)
                     }
                     Error::InvalidConfig { field } => (ErrorKind::InvalidConfig, field as u32, 0),
+                    Error::OriginalMismatch { triangle } => {
+                        (ErrorKind::OriginalMismatch, narrow(triangle), 0)
+                    }
                 };
                 h.error_kind = kind;
                 h.error_a = a;

@@ -18,14 +18,15 @@ use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
     Quadrics, SliceSource, Source, ThenCollapseError,
 };
+use tinydecimate::bound::{control_len, Bound};
 use tinydecimate::cost::{
     error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, Error, FeatureMode, Index, Progressive, Report, Schedule, Simplifier,
-    Workspace,
+    Config, CostKind, Error, FeatureMode, Index, Operator, Progressive, Report, Schedule,
+    Simplifier, Workspace,
 };
 
 #[panic_handler]
@@ -78,6 +79,13 @@ fn opaque_config() -> Config {
         max_normal_turn_deg: opaque_f32(7),
         min_quality: opaque_f32(8),
         boundary_weight: opaque_f32(9),
+        max_error: opaque_f32(19),
+        control_angle_deg: opaque_f32(20),
+        operator: if input(6) & 8 == 0 {
+            Operator::Edge
+        } else {
+            Operator::Triangle
+        },
     };
     // The builders too.
     let b = black_box(Config::paper())
@@ -88,7 +96,10 @@ fn opaque_config() -> Config {
         .with_feature_mode(c.feature_mode)
         .with_max_passes(input(13))
         .with_max_cost(opaque_f32(14))
+        .with_max_error(opaque_f32(21))
+        .with_operator(c.operator)
         .with_cost(c.cost);
+    black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
     black_box(Config::new());
     if input(15) & 1 == 0 {
@@ -135,7 +146,7 @@ fn use_report(r: &Report) {
     black_box(r);
 }
 
-fn drive<L: Index, I: Index, C: Cost>(mut s: Simplifier<'_, L, I, C>) {
+fn drive<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>>(mut s: Simplifier<'a, L, I, C, B>) {
     let budget = input(0);
     loop {
         let done = s.step(budget);
@@ -227,6 +238,26 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
             Err(e) => display(&e),
         }
         black_box(&moving);
+    }
+    // The error bound: control points over the original triangles, u16 and u32 links.
+    let original: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let mut links16: [u16; 1024] = black_box([0; 1024]);
+    let mut links32: [u32; 1024] = black_box([0; 1024]);
+    let nl = input(12) as usize;
+    if let (Some(o), Some(l16), Some(l32)) = (
+        original.get(..input(13) as usize),
+        links16.get_mut(..nl),
+        links32.get_mut(..nl),
+    ) {
+        black_box(control_len(input(14) as usize, input(15) as usize));
+        match ws.simplify_bounded(p, o, t, l16, &config) {
+            Ok(r) => use_report(&r),
+            Err(e) => display(&e),
+        }
+        match ws.start_bounded(p, o, t, l32, &config, Builtin::of(&config)) {
+            Ok(s) => drive(s),
+            Err(e) => display(&e),
+        }
     }
     black_box(&tris);
 
