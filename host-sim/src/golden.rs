@@ -234,6 +234,11 @@ pub struct CaseSpec {
     /// cost; boundary planes weighted by the config's boundary weight).
     #[serde(default)]
     pub quadric: Option<QuadricName>,
+    /// Optional: the guaranteed error bound (seed 001's control points,
+    /// `Workspace::simplify_bounded`) as a fraction of the bounding-box diagonal; the case file
+    /// carries it in input units.
+    #[serde(default)]
+    pub max_error: Option<f32>,
 }
 
 impl CaseSpec {
@@ -360,13 +365,17 @@ impl Case {
                 spec.append_triangles.len()
             );
         }
+        let config = match spec.max_error {
+            Some(f) => spec.config().with_relative_max_error(f, &mesh.positions),
+            None => spec.config(),
+        };
         Ok(Case {
             name: name.clone(),
             mesh: desc,
             positions: mesh.positions,
             triangles: mesh.triangles,
             index_type: spec.index_type(),
-            config: spec.config(),
+            config,
             stored: spec.quadric.map(|q| match q {
                 QuadricName::StoredSubset => tinydecimate::cost::Placement::Subset,
                 QuadricName::StoredOptimal => tinydecimate::cost::Placement::Optimal,
@@ -489,6 +498,7 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
     let h = case.header();
     let config = meshfmt::lib::config(&h);
     let placement = meshfmt::lib::stored_placement(&h);
+    let bounded = meshfmt::lib::bounded(&h);
     let mut positions = case.positions.clone();
     let (outcome, tris): (_, Vec<[u32; 3]>) = match case.index_type {
         IndexType::U16 => {
@@ -500,13 +510,13 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
                 })
                 .map(|[a, b, c]| Ok([a?, b?, c?]))
                 .collect::<Result<_>>()?;
-            let r = run_reference(ws, &mut positions, &mut t, &config, placement);
+            let r = run_reference(ws, &mut positions, &mut t, &config, placement, bounded);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
         }
         IndexType::U32 => {
             let mut t = case.triangles.clone();
-            let r = run_reference(ws, &mut positions, &mut t, &config, placement);
+            let r = run_reference(ws, &mut positions, &mut t, &config, placement, bounded);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             t.truncate(n);
             (r, t)
@@ -529,8 +539,16 @@ fn run_reference<I: tinydecimate::Index>(
     triangles: &mut [[I; 3]],
     config: &Config,
     placement: Option<tinydecimate::cost::Placement>,
+    bounded: bool,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use tinydecimate::cost::Placement;
+    if bounded {
+        // The firmware lends its quadric storage to these two (`board::BOUND_BYTES`).
+        let original = triangles.to_vec();
+        let mut controls =
+            vec![0u32; tinydecimate::bound::control_len(triangles.len(), positions.len())];
+        return ws.simplify_bounded(positions, &original, triangles, &mut controls, config);
+    }
     let mut quadrics = vec![[0.0f32; 10]; positions.len()];
     match placement {
         None => ws.simplify(positions, triangles, config),
@@ -664,6 +682,13 @@ impl Golden {
         writeln!(w, "config = {:?}", config_line(&case.config))?;
         if let Some(p) = case.stored {
             writeln!(w, "quadric = \"stored, {p:?} placement\"")?;
+        }
+        if case.config.max_error.is_finite() {
+            writeln!(
+                w,
+                "max_error = {:e}  # the guaranteed bound, input units",
+                case.config.max_error
+            )?;
         }
         writeln!(w, "input_vertices = {}", case.positions.len())?;
         writeln!(w, "input_triangles = {}", case.triangles.len())?;
@@ -821,6 +846,8 @@ pub fn judge(
             h.capacity_triangles,
             if case.stored.is_some() {
                 " (stored quadrics: the firmware's QUADRIC_VERTICES may be lower)"
+            } else if case.config.max_error.is_finite() {
+                " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {
                 ""
             }

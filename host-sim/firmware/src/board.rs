@@ -78,6 +78,16 @@ mod sel {
 
 pub use sel::*;
 
+/// Bytes a bounded case (`Workspace::simplify_bounded`) borrows from the quadric storage, which
+/// it does not use: a read-only copy of the input triangles and the control-point links
+/// (`bound::control_len(T, V)` of `Link`).
+pub const BOUND_BYTES: usize = QUADRIC_VERTICES * 40;
+
+/// Bytes a bounded case of `v` vertices and `t` triangles of `index_bytes` needs.
+pub const fn bound_bytes(v: usize, t: usize, index_bytes: usize) -> usize {
+    t * 3 * index_bytes + tinydecimate::bound::control_len(t, v) * core::mem::size_of::<Link>()
+}
+
 /// Bytes of the triangle buffer: `MAX_TRIANGLES` triangles of the widest index type this board
 /// takes (`u16` boards read `u32` files too, with half as many triangles).
 pub const TRIANGLE_BYTES: usize = MAX_TRIANGLES * 3 * core::mem::size_of::<Link>();

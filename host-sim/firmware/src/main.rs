@@ -173,6 +173,8 @@ fn read_case(
     if nv > board::MAX_VERTICES
         || nt > board::triangle_capacity(h.index_type)
         || (stored && nv > board::QUADRIC_VERTICES)
+        || (meshfmt::lib::bounded(&h)
+            && board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES)
     {
         defmt::warn!("the mesh does not fit this board");
         *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
@@ -359,19 +361,20 @@ fn simplify(
     let quadrics = QUADRICS.take();
     let config = meshfmt::lib::config(h);
     let placement = meshfmt::lib::stored_placement(h);
+    let bounded = meshfmt::lib::bounded(h);
 
     let sp = measure::paint();
     measure::start(syst);
     let outcome = match h.index_type {
         IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, placement, quadrics),
+            Ok(t) => run_library(ws, pos, t, &config, placement, bounded, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
             }
         },
         IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, placement, quadrics),
+            Ok(t) => run_library(ws, pos, t, &config, placement, bounded, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
@@ -411,20 +414,55 @@ fn simplify(
 /// [`measure::paint`] stopped, so the painted stack measures all of it.
 #[cfg(feature = "lib")]
 #[inline(never)]
-fn run_library<I: tinydecimate::Index>(
+fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     ws: &mut board::Workspace,
     positions: &mut [[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
     placement: Option<tinydecimate::cost::Placement>,
+    bounded: bool,
     quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use tinydecimate::cost::Placement;
+    if bounded {
+        return run_bounded(ws, positions, triangles, config, quadrics);
+    }
     match placement {
         None => ws.simplify(positions, triangles, config),
         Some(Placement::Subset) => ws.simplify_stored(positions, triangles, config, quadrics),
         Some(Placement::Optimal) => ws.simplify_optimal(positions, triangles, config, quadrics),
     }
+}
+
+/// A bounded case (`Workspace::simplify_bounded`). Never inlined: its locals would deepen
+/// [`run_library`]'s frame for every case, and the micro:bit has no stack to spare.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
+    ws: &mut board::Workspace,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+    quadrics: &mut [[f32; 10]],
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    // The quadric storage lends its bytes: the input triangles' read-only copy, then the
+    // control-point links (`read_case` checked that they fit).
+    let bytes: &mut [u8] = bytemuck::cast_slice_mut(quadrics);
+    let (orig, rest) =
+        bytes.split_at_mut((triangles.len() * 3 * core::mem::size_of::<I>()).min(bytes.len()));
+    let nc = tinydecimate::bound::control_len(triangles.len(), positions.len());
+    let links = rest.get_mut(..nc * core::mem::size_of::<board::Link>());
+    let (Ok(orig), Some(Ok(controls))) = (
+        bytemuck::try_cast_slice_mut::<u8, [I; 3]>(orig),
+        links.map(bytemuck::try_cast_slice_mut::<u8, board::Link>),
+    ) else {
+        return Err(tinydecimate::Error::OriginalMismatch { triangle: 0 });
+    };
+    if orig.len() != triangles.len() {
+        return Err(tinydecimate::Error::OriginalMismatch { triangle: 0 });
+    }
+    orig.copy_from_slice(triangles);
+    ws.simplify_bounded(positions, orig, triangles, controls, config)
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).
@@ -506,6 +544,7 @@ fn selftest(
         max_normal_turn_deg: 60.0,
         min_quality: 0.05,
         boundary_weight: 1.0,
+        max_error: 0.0,
     };
     simplify(syst, &h, &mut positions[..nv], &mut triangles[..nt * 6], r);
     if r.status == Status::Ok && r.triangles_out > 0 && r.triangles_out <= r.triangles_in {

@@ -27,7 +27,8 @@
 //! |     40 | f32     | max normal turn, degrees                                     |
 //! |     44 | f32     | min quality                                                  |
 //! |     48 | f32     | boundary weight                                              |
-//! |     52 | [u8;12] | reserved, 0                                                  |
+//! |     52 | f32     | max error: the guaranteed bound (`Config::max_error`, input units); 0 = none |
+//! |     56 | [u8; 8] | reserved, 0                                                  |
 //! |     64 | f32     | positions: V × 3                                             |
 //! |        | u16/u32 | triangles: T × 3                                             |
 //!
@@ -178,6 +179,9 @@ pub struct CaseHeader {
     pub max_normal_turn_deg: f32,
     pub min_quality: f32,
     pub boundary_weight: f32,
+    /// The error bound in input units (`Workspace::simplify_bounded`); 0 (or anything not
+    /// positive and finite): no bound, `Workspace::simplify`.
+    pub max_error: f32,
 }
 
 /// Little-endian writer over a fixed array.
@@ -268,6 +272,7 @@ impl CaseHeader {
         w.f32(self.max_normal_turn_deg);
         w.f32(self.min_quality);
         w.f32(self.boundary_weight);
+        w.f32(self.max_error);
         b
     }
 
@@ -322,6 +327,7 @@ impl CaseHeader {
             max_normal_turn_deg: r.f32(),
             min_quality: r.f32(),
             boundary_weight: r.f32(),
+            max_error: r.f32(),
         })
     }
 
@@ -633,7 +639,15 @@ pub mod lib {
         c.max_normal_turn_deg = h.max_normal_turn_deg;
         c.min_quality = h.min_quality;
         c.boundary_weight = h.boundary_weight;
+        if bounded(h) {
+            c = c.with_max_error(h.max_error);
+        }
         c
+    }
+
+    /// Whether a case asks for the guaranteed error bound (`Workspace::simplify_bounded`).
+    pub fn bounded(h: &CaseHeader) -> bool {
+        h.max_error > 0.0 && h.max_error.is_finite()
     }
 
     /// The stored-quadric placement a case asks for (`None`: `Workspace::simplify`).
@@ -673,6 +687,11 @@ pub mod lib {
             max_normal_turn_deg: config.max_normal_turn_deg,
             min_quality: config.min_quality,
             boundary_weight: config.boundary_weight,
+            max_error: if config.max_error.is_finite() {
+                config.max_error
+            } else {
+                0.0
+            },
         }
     }
 
@@ -891,6 +910,7 @@ mod tests {
             max_normal_turn_deg: 60.0,
             min_quality: 0.05,
             boundary_weight: 1.0,
+            max_error: 0.25,
         }
     }
 
