@@ -83,9 +83,11 @@ pub use sel::*;
 /// (`bound::control_len(T, V)` of `Link`).
 pub const BOUND_BYTES: usize = QUADRIC_VERTICES * 40;
 
-/// Bytes a bounded case of `v` vertices and `t` triangles of `index_bytes` needs.
+/// Bytes a bounded case of `v` vertices and `t` triangles of `index_bytes` needs: the
+/// triangles' copy and `tinydecimate::bound::control_len(t, v)` = `2t + v` links (written out:
+/// the image without the library must build too).
 pub const fn bound_bytes(v: usize, t: usize, index_bytes: usize) -> usize {
-    t * 3 * index_bytes + tinydecimate::bound::control_len(t, v) * core::mem::size_of::<Link>()
+    t * 3 * index_bytes + (2 * t + v) * core::mem::size_of::<Link>()
 }
 
 /// Bytes of the triangle buffer: `MAX_TRIANGLES` triangles of the widest index type this board

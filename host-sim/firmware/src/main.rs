@@ -173,7 +173,7 @@ fn read_case(
     if nv > board::MAX_VERTICES
         || nt > board::triangle_capacity(h.index_type)
         || (stored && nv > board::QUADRIC_VERTICES)
-        || (meshfmt::lib::bounded(&h)
+        || (h.bounded()
             && board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES)
     {
         defmt::warn!("the mesh does not fit this board");

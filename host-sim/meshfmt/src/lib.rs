@@ -331,6 +331,12 @@ impl CaseHeader {
         })
     }
 
+    /// Whether the case asks for the guaranteed error bound (`Workspace::simplify_bounded`):
+    /// a positive, finite `max_error`.
+    pub fn bounded(&self) -> bool {
+        self.max_error > 0.0 && self.max_error.is_finite()
+    }
+
     /// Bytes of the position array.
     pub fn positions_len(&self) -> usize {
         self.vertices as usize * 12
@@ -647,7 +653,7 @@ pub mod lib {
 
     /// Whether a case asks for the guaranteed error bound (`Workspace::simplify_bounded`).
     pub fn bounded(h: &CaseHeader) -> bool {
-        h.max_error > 0.0 && h.max_error.is_finite()
+        h.bounded()
     }
 
     /// The stored-quadric placement a case asks for (`None`: `Workspace::simplify`).
