@@ -738,22 +738,23 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         }
     }
 
-    /// Greedy: one pop of the queue.
-    fn pop(&mut self) {
-        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
-            return self.pop_triangles();
-        }
+    /// Greedy, both operators: the vertex on top of the queue and its key; `None` when this
+    /// pop instead ended the run, started a new round or a refresh of the feature threshold.
+    fn top(&mut self) -> Option<(usize, f32)> {
         if self.mesh.live <= self.target {
-            return self.done(Stop::Target);
+            self.done(Stop::Target);
+            return None;
         }
         let Some((v, key)) = self.heap.peek() else {
             // Rules that look past a vertex's own fan may have changed far from recent
             // collapses: a new round re-keys everything, and only a round without a collapse
             // ends the run.
             if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
-                return self.done(Stop::NoLegalCollapse);
+                self.done(Stop::NoLegalCollapse);
+            } else {
+                self.new_round();
             }
-            return self.new_round();
+            return None;
         };
         if self.mesh.live <= self.refresh_at {
             // The mesh has halved since the threshold was taken: take it afresh (one sweep;
@@ -761,11 +762,23 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             self.refresh_only = true;
             self.phase = Phase::Mean;
             self.v = 0;
-            return;
+            return None;
         }
         if key > self.config.max_cost {
-            return self.done(Stop::MaxCost);
+            self.done(Stop::MaxCost);
+            return None;
         }
+        Some((v, key))
+    }
+
+    /// Greedy: one pop of the queue.
+    fn pop(&mut self) {
+        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
+            return self.pop_triangles();
+        }
+        let Some((v, key)) = self.top() else {
+            return;
+        };
         let w = self.walk(v);
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
         let n = self.candidates(v, &w, &mut cand);
@@ -834,24 +847,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// `MAX_PENALTIES` times in a row.
     fn pop_triangles(&mut self) {
         use crate::triangle::{MAX_PENALTIES, PENALTY};
-        if self.mesh.live <= self.target {
-            return self.done(Stop::Target);
-        }
-        let Some((v, key)) = self.heap.peek() else {
-            if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
-                return self.done(Stop::NoLegalCollapse);
-            }
-            return self.new_round();
-        };
-        if self.mesh.live <= self.refresh_at {
-            self.refresh_only = true;
-            self.phase = Phase::Mean;
-            self.v = 0;
+        let Some((v, key)) = self.top() else {
             return;
-        }
-        if key > self.config.max_cost {
-            return self.done(Stop::MaxCost);
-        }
+        };
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
         let mut n = 0;
         for (t, _) in self.mesh.corners(v) {
