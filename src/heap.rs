@@ -141,6 +141,11 @@ impl<'a, L: Index> Heap<'a, L> {
         self.up(moved);
     }
 
+    /// `v`'s key if it is queued.
+    pub(crate) fn queued(&self, v: usize) -> Option<f32> {
+        self.slot_of(v).map(|_| self.key_of(v))
+    }
+
     /// The cheapest vertex and its key, without removing it.
     pub(crate) fn peek(&self) -> Option<(usize, f32)> {
         if self.len == 0 {

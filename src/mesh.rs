@@ -44,6 +44,10 @@ pub(crate) mod flag {
     pub const MARK: u8 = 32;
     /// Build only: the vertex is some corner's `a` in the fan being ordered.
     pub const SEEN_A: u8 = 64;
+    /// Greedy queue, after the build (`SEEN_A`'s bit, free by then): the vertex went back in
+    /// at its cheapest *legal* price, above a cheaper refused candidate, so its key is no
+    /// lower bound of its prices (see `Simplifier::keys_only_fall`).
+    pub const RAISED: u8 = 64;
     /// Build only: the vertex is some corner's `b` in the fan being ordered.
     pub const SEEN_B: u8 = 128;
 }
@@ -166,6 +170,11 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
         let inv = 1.0 / half;
         let inv_half = if inv.is_finite() { inv } else { 1.0 };
+        // A workspace is reused: nothing of an earlier run's flags may reach the fan
+        // ordering below (its SEEN bits are the queue's RAISED bit).
+        for f in flags.iter_mut() {
+            *f = 0;
+        }
 
         let mut mesh = Mesh {
             pos,

@@ -132,11 +132,20 @@ fn meshes() -> Vec<(&'static str, MeshData)> {
 #[test]
 fn both_placements_give_valid_simplifications() {
     for (name, m) in meshes() {
-        for ratio in [0.5, 0.25, 0.05] {
-            let config = Config::new().with_ratio(ratio);
+        // With the feature rule and without (`Config::stored()`, where subset placement
+        // re-keys a collapse's neighbours with one price each).
+        for (ratio, base) in [
+            (0.5, Config::new()),
+            (0.25, Config::new()),
+            (0.05, Config::new()),
+            (0.5, Config::stored()),
+            (0.25, Config::stored()),
+            (0.05, Config::stored()),
+        ] {
+            let config = base.with_ratio(ratio);
             for placement in [Placement::Subset, Placement::Optimal] {
                 let (out, r) = stored(&m, &config, placement);
-                let label = format!("{name} {ratio} {placement:?}");
+                let label = format!("{name} {ratio} {placement:?} features {}", config.features);
                 assert_eq!(r.triangles_out, out.triangles.len(), "{label}");
                 assert!(
                     r.triangles_out < m.triangles.len(),
@@ -198,8 +207,13 @@ fn optimal_placement_is_not_worse_than_the_memoryless_default() {
 #[test]
 fn runs_are_exactly_repeatable_and_stepping_gives_the_same_bytes() {
     let m = fixture("cow.obj");
-    let config = Config::new().with_ratio(0.1);
-    for placement in [Placement::Subset, Placement::Optimal] {
+    for (config, placement) in [
+        (Config::new(), Placement::Subset),
+        (Config::new(), Placement::Optimal),
+        (Config::stored(), Placement::Subset),
+        (Config::stored(), Placement::Optimal),
+    ] {
+        let config = config.with_ratio(0.1);
         let (a, ra) = stored(&m, &config, placement);
         let (b, rb) = stored(&m, &config, placement);
         assert_eq!(a.triangles, b.triangles, "{placement:?}");

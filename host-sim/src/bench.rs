@@ -238,7 +238,7 @@ impl Method {
             Method::Default => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
-            Method::Stored | Method::StoredOptimal => Some(Config::new()),
+            Method::Stored | Method::StoredOptimal => Some(Config::stored()),
             Method::Meshopt | Method::MeshoptUpdate => None,
         }
     }
@@ -250,8 +250,8 @@ impl Method {
             Method::GreedyW => "`Config::new().with_cost(CostKind::NormalVariation)`",
             Method::Paper => "`Config::paper()`",
             Method::Meshopt => "`meshopt::simplify`",
-            Method::Stored => "`Workspace::simplify_stored` with `Config::new()`",
-            Method::StoredOptimal => "`Workspace::simplify_optimal` with `Config::new()`",
+            Method::Stored => "`Workspace::simplify_stored` with `Config::stored()`",
+            Method::StoredOptimal => "`Workspace::simplify_optimal` with `Config::stored()`",
             Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
         }
     }

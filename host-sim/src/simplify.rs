@@ -278,9 +278,14 @@ pub struct Args {
     /// Normalise the feature measure D by valence² (FeatureMode::ValenceNormalized).
     #[arg(long)]
     pub valence_normalized: bool,
-    /// Turn feature detection off (every vertex may be collapsed).
-    #[arg(long)]
+    /// Turn feature detection off (every vertex may be collapsed). The default with
+    /// `--quadric stored` (`Config::stored()`).
+    #[arg(long, conflicts_with = "features")]
     pub no_features: bool,
+    /// Turn feature detection on with `--quadric stored` (seed 004's rule on top of the
+    /// quadrics; on by default in every other mode).
+    #[arg(long)]
+    pub features: bool,
     /// Greedy: feature vertices may not even be the kept end of a collapse (the paper's rule).
     #[arg(long)]
     pub no_feature_targets: bool,
@@ -343,7 +348,12 @@ impl Args {
         if let Some(l) = self.lambda {
             c = c.with_lambda(l);
         }
-        c.features = !self.no_features;
+        // Stored quadrics default to `Config::stored()`: no feature rule.
+        c.features = if self.quadric == QuadricArg::Stored {
+            self.features
+        } else {
+            !self.no_features
+        };
         if self.no_feature_targets {
             c.feature_targets = false;
         }
