@@ -18,8 +18,11 @@
 //! at that price, so collapses still come out in exact cost order.
 //!
 //! Termination: every collapse removes a vertex, so there are fewer collapses than vertices.
-//! Between two collapses the queue only re-keys a popped vertex to its exact current cost (so
-//! its next pop collapses it) or drops it, so at most `2·V` pops separate two collapses; a
+//! Between two collapses the queue only re-keys a popped vertex to a strictly higher price of
+//! one of its at most `MAX_CANDIDATES` candidates (its exact current cost, or for a stored
+//! cost without the feature rule possibly a refused candidate's price first) or drops it, and
+//! prices do not change without a collapse, so at most `(MAX_CANDIDATES + 1)·V` pops separate
+//! two collapses; a
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 

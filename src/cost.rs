@@ -64,8 +64,9 @@ pub trait Cost {
     fn round(&mut self, _mean_area2: f32) {}
     /// Whether the cost keeps state per vertex (stored quadrics). If so the engine, once before
     /// the first keys, hands it every used vertex's planes ([`Cost::plane`]); after each
-    /// collapse it calls [`Cost::merge`] and re-keys the kept vertex's whole ring (every
-    /// neighbour's price onto it changed), not only the removed vertex's former neighbours.
+    /// collapse it calls [`Cost::merge`]. Such a cost's price of `x -> y` must depend only on
+    /// the two vertices' states and positions: without the feature rule the engine then
+    /// re-keys a collapse's neighbours by their one changed price, onto the kept vertex.
     fn stores(&self) -> bool {
         false
     }
