@@ -17,8 +17,10 @@ rules=("$@")
 [ ${#rules[@]} -eq 0 ] && rules=("${all_rules[@]}")
 # The subset: the rule tests (tests/rules.rs, one or more per rule, all asserting properties of
 # real output through the shared checker), bad input, the fuzz regressions and the property
-# tests; and the error bound's independent check (tests/bound.rs, for the `bound` veto).
-read -r -a tests <<<"${RULES_OFF_TESTS:---test rules --test errors --test fuzz_regressions --test properties --test bound}"
+# tests; the error bound's independent check (tests/bound.rs, for the `bound` veto); and the
+# stored quadrics' validity over both placements, with and without the feature rule
+# (tests/stored.rs: the engine's one-price re-keying runs there).
+read -r -a tests <<<"${RULES_OFF_TESTS:---test rules --test errors --test fuzz_regressions --test properties --test bound --test stored}"
 per_run_timeout=${RULES_OFF_TIMEOUT:-900}
 
 log_dir=$(mktemp -d)
