@@ -938,6 +938,18 @@ mod tests {
         assert_eq!(cfg.lambda, 1.5);
         assert_eq!(cfg.feature_mode, FeatureMode::ValenceNormalized);
         assert!(Cli::try_parse_from(["x", "a.obj", "b.obj"]).is_err());
+        // Stored quadrics: `Config::stored()` (no feature rule) unless --features.
+        let stored = |extra: &[&str]| {
+            let mut a = vec!["x", "a", "b", "--ratio", "0.1", "--quadric", "stored"];
+            a.extend_from_slice(extra);
+            Cli::try_parse_from(a).map(|c| c.args.config())
+        };
+        assert_eq!(stored(&[]).unwrap(), Config::stored().with_ratio(0.1));
+        assert_eq!(
+            stored(&["--features"]).unwrap(),
+            Config::new().with_ratio(0.1)
+        );
+        assert!(stored(&["--features", "--no-features"]).is_err());
     }
 
     #[test]
