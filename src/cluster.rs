@@ -589,6 +589,9 @@ struct Pass<'a, I: Index> {
     /// The caller's per-vertex cache of quantised coordinates ([`Clusterer::cluster_with_cache`]);
     /// empty without.
     cache: &'a mut [u64],
+    /// The caller's key entries ([`Clusterer::cluster_with_keys`]): lane 6 holds the vertex's
+    /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`]; empty without.
+    keys: &'a mut [[u32; KEY_LANES]],
 }
 
 /// A cache entry not yet filled (valid entries have bit 63 clear).
@@ -741,9 +744,18 @@ impl<I: Index> Pass<'_, I> {
             } else {
                 let mut k = [0u32; 3];
                 for (kc, &v) in k.iter_mut().zip(t) {
-                    *kc = self
-                        .grid
-                        .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                    let e = self.keys.get_mut(v as usize);
+                    match e {
+                        Some(&mut [.., key, FINAL]) => *kc = key,
+                        e => {
+                            *kc = self
+                                .grid
+                                .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                            if let Some(e) = e {
+                                *e = [0, 0, 0, 0, 0, 0, *kc, FINAL];
+                            }
+                        }
+                    }
                 }
                 (k, None)
             };
@@ -1194,6 +1206,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             slivers: 0,
             flipped: 0,
             cache: &mut [],
+            keys: &mut [],
         })
     }
 
@@ -1387,6 +1400,10 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             let o = out.get_mut(..ao_now).unwrap_or(&mut []);
             let mut pass = self.pass(grid, quad.as_deref_mut(), o, ac_now)?;
             pass.cache = &mut *cache;
+            if !keys.is_empty() {
+                final_keys(&grid, pass.cache, keys);
+                pass.keys = &mut *keys;
+            }
             let total = run(&mut pass, source)?;
             passes += 1;
             let small_table = pass.cells_missed > 0 && ac_now < cells;
@@ -1514,6 +1531,20 @@ pub const PROBES: usize = 6;
 pub const KEY_LANES: usize = 8;
 /// The lane of a key entry that holds the number of the counting pass it was computed for.
 const STAMP: usize = KEY_LANES - 1;
+/// The stamp of an entry computed for the final grid (counting passes are 1, 2, ...).
+const FINAL: u32 = u32::MAX;
+
+/// Before the accumulating pass: each vertex with quantised coordinates in the cache gets
+/// its cell on the final `grid` in its key entry (the others are computed at their first
+/// corner). Clears the stamps of the rest.
+fn final_keys(grid: &Grid, cache: &[u64], keys: &mut [[u32; KEY_LANES]]) {
+    for (v, k) in keys.iter_mut().enumerate() {
+        *k = match cache.get(v) {
+            Some(&e) if e >> 63 == 0 => [0, 0, 0, 0, 0, 0, grid.key_q(unpack_q(e)), FINAL],
+            _ => [0; KEY_LANES],
+        };
+    }
+}
 
 /// The cells of quantised coordinates `q` at the resolutions `ns` (lane `i`: `ns[i]` cells
 /// along the longest side; 0 gives cell 0).
