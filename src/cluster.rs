@@ -592,6 +592,8 @@ struct Pass<'a, I: Index> {
     /// The caller's key entries ([`Clusterer::cluster_with_keys`]): lane 6 holds the vertex's
     /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`]; empty without.
     keys: &'a mut [[u32; KEY_LANES]],
+    /// A corner's vertex was beyond the cache (in a pass that reads the cache).
+    beyond: bool,
 }
 
 /// A cache entry not yet filled (valid entries have bit 63 clear).
@@ -717,6 +719,8 @@ impl<I: Index> Pass<'_, I> {
             let d = math::sub(p, self.grid.centre(k));
             math::dot(d, d)
         };
+        // NaN as infinity: the choice is the least (score, vertex) in any order of offers.
+        let score = if score.is_nan() { f32::INFINITY } else { score };
         if let Some(x) = self.slots.get_mut(s) {
             if score < x.best || (score == x.best && v < x.rep) || x.rep == EMPTY {
                 x.best = score;
@@ -743,16 +747,26 @@ impl<I: Index> Pass<'_, I> {
                 (k, Some(p))
             } else {
                 let mut k = [0u32; 3];
-                for (kc, &v) in k.iter_mut().zip(t) {
-                    let e = self.keys.get_mut(v as usize);
-                    match e {
-                        Some(&mut [.., key, FINAL]) => *kc = key,
-                        e => {
-                            *kc = self
-                                .grid
-                                .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
-                            if let Some(e) = e {
-                                *e = [0, 0, 0, 0, 0, 0, *kc, FINAL];
+                let top = t[0].max(t[1]).max(t[2]);
+                self.beyond |= top as usize >= self.cache.len();
+                if self.keys.is_empty() {
+                    for (kc, &v) in k.iter_mut().zip(t) {
+                        *kc = self
+                            .grid
+                            .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                    }
+                } else {
+                    for (kc, &v) in k.iter_mut().zip(t) {
+                        let e = self.keys.get_mut(v as usize);
+                        match e {
+                            Some(&mut [.., key, FINAL]) => *kc = key,
+                            e => {
+                                *kc = self
+                                    .grid
+                                    .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                                if let Some(e) = e {
+                                    *e = [0, 0, 0, 0, 0, 0, *kc, FINAL];
+                                }
                             }
                         }
                     }
@@ -1207,6 +1221,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             flipped: 0,
             cache: &mut [],
             keys: &mut [],
+            beyond: false,
         })
     }
 
@@ -1418,12 +1433,16 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                     return Err(ClusterError::NotRereadable);
                 }
                 pass.choose = true;
-                pass.read = 0;
-                if seen.is_empty() && pass.cache.is_empty() {
+                if !pass.cache.is_empty() && !pass.beyond {
+                    // Every vertex used is in the cache: no stream needed.
+                    choose_by_vertex(&mut pass, source)?;
+                } else if seen.is_empty() && pass.cache.is_empty() {
+                    pass.read = 0;
                     run(&mut pass, source)?;
                     // `collapsed` was counted twice.
                     pass.collapsed /= 2;
                 } else {
+                    pass.read = 0;
                     choose_once(&mut pass, source, seen)?;
                 }
                 passes += 1;
@@ -1579,6 +1598,9 @@ fn count<S: Source>(
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
     }
+    if keys.is_empty() {
+        return count_corners(source, grids, cache);
+    }
     let mut counts = [0usize; PROBES];
     // Every probe shares the origin and scale (the same box): quantise once per corner with
     // the first grid, then each probe's cells are `(q · n) >> 20` in integers. A probe that
@@ -1665,6 +1687,56 @@ fn count<S: Source>(
         }
         for (cnt, l) in counts.iter_mut().zip(lane) {
             *cnt += l as usize;
+        }
+    }
+    Ok(counts)
+}
+
+/// [`count`] without key entries: each corner quantised (or read from the cache) and its
+/// cells at every probed resolution computed at the corner.
+fn count_corners<S: Source>(
+    source: &mut S,
+    grids: &[Option<Grid>; PROBES],
+    cache: &mut [u64],
+) -> Result<[usize; PROBES], ClusterError> {
+    let mut counts = [0usize; PROBES];
+    // Every probe shares the origin and scale (the same box): quantise once per corner with
+    // the first grid, then each probe's cells are `(q · n) >> 20` in integers. A probe that
+    // is not run has n = 0 (all its corners in cell 0: counts nothing; not reported anyway).
+    let g0 = grids.iter().flatten().next().copied();
+    let mut ns = [0u32; PROBES];
+    for (m, g) in ns.iter_mut().zip(grids) {
+        *m = g.map_or(0, |g| g.n);
+    }
+    let mut buf = [[0u32; 3]; CHUNK];
+    let mut index = 0usize;
+    loop {
+        let n = source.read(&mut buf);
+        let Some(chunk) = buf.get(..n) else { break };
+        if chunk.is_empty() {
+            break;
+        }
+        for t in chunk {
+            let Some(g0) = &g0 else {
+                corners(&mut SourcePositions(&mut *source), t, index)?;
+                index += 1;
+                continue;
+            };
+            let mut pos = SourcePositions(&mut *source);
+            let a = quantised(cache, &mut pos, g0, t[0], index)?;
+            let b = quantised(cache, &mut pos, g0, t[1], index)?;
+            let c = quantised(cache, &mut pos, g0, t[2], index)?;
+            index += 1;
+            for (cnt, &m) in counts.iter_mut().zip(&ns) {
+                // Cells are below 1024 (q <= QMAX, n <= 1024): the packed keys are exact.
+                let key = |q: [u32; 3]| {
+                    (q[0].wrapping_mul(m) >> QBITS)
+                        | ((q[1].wrapping_mul(m) >> QBITS) << 10)
+                        | ((q[2].wrapping_mul(m) >> QBITS) << 20)
+                };
+                let (ka, kb, kc) = (key(a), key(b), key(c));
+                *cnt += usize::from((ka != kb) & (kb != kc) & (ka != kc));
+            }
         }
     }
     Ok(counts)
@@ -1860,6 +1932,33 @@ fn choose_once<S: Source, I: Index>(
                     pass.offer(slot, k, v, p);
                 }
             }
+        }
+    }
+    Ok(())
+}
+
+/// The quadric representative's second pass when the cache holds every vertex used (the
+/// first pass met none beyond it): each vertex with quantised coordinates is offered once,
+/// in vertex order, without reading the stream. The choice (least score, then least vertex
+/// number) does not depend on the order of the offers.
+fn choose_by_vertex<S: Source, I: Index>(
+    pass: &mut Pass<'_, I>,
+    source: &mut S,
+) -> Result<(), ClusterError> {
+    let grid = pass.grid;
+    for v in 0..pass.cache.len() {
+        let Some(&e) = pass.cache.get(v) else { break };
+        if e >> 63 != 0 {
+            continue;
+        }
+        let k = match pass.keys.get(v) {
+            Some(&[.., key, FINAL]) => key,
+            _ => grid.key_q(unpack_q(e)),
+        };
+        // Checked in an earlier pass already (the vertex was quantised).
+        let p = checked_position(&mut SourcePositions(&mut *source), to_u32(v), 0)?;
+        if let Some(slot) = pass.cell(k) {
+            pass.offer(slot, k, to_u32(v), p);
         }
     }
     Ok(())
