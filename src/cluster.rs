@@ -714,13 +714,19 @@ impl<I: Index> Pass<'_, I> {
             if !self.choose {
                 return;
             }
-            quadric_error(q, math::sub(p, self.grid.corner(k)))
+            // NaN as infinity: the choice is the least (score, vertex) in any order of
+            // offers (`choose_by_vertex` offers in vertex order).
+            let e = quadric_error(q, math::sub(p, self.grid.corner(k)));
+            if e.is_nan() {
+                f32::INFINITY
+            } else {
+                e
+            }
         } else {
+            // Never NaN (finite positions: a square of a difference is finite or infinite).
             let d = math::sub(p, self.grid.centre(k));
             math::dot(d, d)
         };
-        // NaN as infinity: the choice is the least (score, vertex) in any order of offers.
-        let score = if score.is_nan() { f32::INFINITY } else { score };
         if let Some(x) = self.slots.get_mut(s) {
             if score < x.best || (score == x.best && v < x.rep) || x.rep == EMPTY {
                 x.best = score;
