@@ -1374,11 +1374,12 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             *w = 0;
         }
         let mut passes = 0u32;
-        let (min, max) = match config.bbox {
-            Some(b) => b,
+        let (min, max, top) = match config.bbox {
+            Some(b) => (b.0, b.1, None),
             None => {
                 passes += 1;
-                bbox(source, seen, cache)?
+                let (lo, hi, top) = bbox(source, seen, cache)?;
+                (lo, hi, Some(top))
             }
         };
         let mut target = 0;
@@ -1387,7 +1388,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             GridChoice::Resolution(n) => Grid::with_resolution(min, max, n)?,
             GridChoice::TargetTriangles(t) => {
                 target = t;
-                let (g, p) = Self::search(source, min, max, t, config.refine_passes, cache, keys)?;
+                let (g, p) =
+                    Self::search(source, min, max, t, config.refine_passes, cache, keys, top)?;
                 passes += p;
                 g
             }
@@ -1485,6 +1487,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         passes: u32,
         cache: &mut [u64],
         keys: &mut [[u32; KEY_LANES]],
+        top: Option<u32>,
     ) -> Result<(Grid, u32), ClusterError> {
         // Estimate: about target/2 occupied cells, and a surface filling its box occupies
         // about 3 n² cells at n cells along the longest side (integer square root: no float
@@ -1529,7 +1532,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                     *g = Some(Grid::with_resolution(min, max, r)?);
                 }
             }
-            let counts = count(source, &grids, cache, keys, pass + 1)?;
+            let counts = count(source, &grids, cache, keys, pass + 1, top)?;
             done += 1;
             for ((g, &r), &c) in grids.iter().zip(&n).zip(&counts) {
                 if g.is_none() {
@@ -1600,6 +1603,7 @@ fn count<S: Source>(
     cache: &mut [u64],
     keys: &mut [[u32; KEY_LANES]],
     stamp: u32,
+    top: Option<u32>,
 ) -> Result<[usize; PROBES], ClusterError> {
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
@@ -1623,6 +1627,11 @@ fn count<S: Source>(
         }
         k
     };
+    // Every vertex used has a current entry once the loop below has run: the bounding-box
+    // pass saw every corner (`top`: the largest vertex number) and marked every vertex in
+    // the cache. Then a triangle needs no stamp check (for a source that reads back the same
+    // triangles, as every pass assumes).
+    let mut complete = top.is_some_and(|t| (t as usize) < cache.len().min(keys.len()));
     if let Some(g0) = &g0 {
         for (v, (e, k)) in cache.iter_mut().zip(keys.iter_mut()).enumerate() {
             if *e == NO_Q - 1 {
@@ -1633,7 +1642,10 @@ fn count<S: Source>(
                     Some(p) if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() => {
                         *e = pack_q(g0.quantise(p));
                     }
-                    _ => continue,
+                    _ => {
+                        complete = false;
+                        continue;
+                    }
                 }
             }
             if *e >> 63 == 0 {
@@ -1656,6 +1668,19 @@ fn count<S: Source>(
                 index += 1;
                 continue;
             };
+            if complete {
+                if let (Some(a), Some(b), Some(c)) = (
+                    keys.get(t[0] as usize),
+                    keys.get(t[1] as usize),
+                    keys.get(t[2] as usize),
+                ) {
+                    for (((l, x), y), z) in lane.iter_mut().zip(a).zip(b).zip(c) {
+                        *l += u32::from((x != y) & (y != z) & (x != z));
+                    }
+                    index += 1;
+                    continue;
+                }
+            }
             let current = |keys: &[[u32; KEY_LANES]], v: u32| {
                 keys.get(v as usize)
                     .filter(|k| k.get(STAMP) == Some(&stamp))
@@ -1979,7 +2004,7 @@ impl<S: Source> Positions for SourcePositions<'_, S> {
     }
 }
 
-/// Bounding box of the used vertices (one pass).
+/// Bounding box of the used vertices and the largest vertex number (one pass).
 /// With per-vertex memory (a cache entry still [`NO_Q`], then marked `NO_Q - 1`, which is
 /// still unfilled for [`quantised`]; or a clear bit, then set), only each vertex's first
 /// corner is read: the same box, and the same first error.
@@ -1987,7 +2012,7 @@ fn bbox<S: Source>(
     source: &mut S,
     seen: &mut [u32],
     cache: &mut [u64],
-) -> Result<([f32; 3], [f32; 3]), ClusterError> {
+) -> Result<([f32; 3], [f32; 3], u32), ClusterError> {
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
     }
@@ -1995,6 +2020,7 @@ fn bbox<S: Source>(
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
     let mut index = 0usize;
+    let mut top = 0u32;
     let memory = !(cache.is_empty() && seen.is_empty());
     loop {
         let n = source.read(&mut buf);
@@ -2004,6 +2030,7 @@ fn bbox<S: Source>(
         }
         for t in chunk {
             for &v in t {
+                top = top.max(v);
                 if !memory {
                     // No per-vertex memory: every corner.
                 } else if let Some(e) = cache.get_mut(v as usize) {
@@ -2045,7 +2072,7 @@ fn bbox<S: Source>(
     if index == 0 {
         return Err(ClusterError::EmptyInput);
     }
-    Ok((min, max))
+    Ok((min, max, top))
 }
 
 /// Integer square root (floor), by Newton's method on integers.
