@@ -1479,6 +1479,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
     /// probe counts the triangles whose corners fall into three distinct cells, which needs no
     /// memory and bounds the deduplicated output from above, so the result never exceeds the
     /// target.
+    #[allow(clippy::too_many_arguments)]
     fn search<S: Source>(
         source: &mut S,
         min: [f32; 3],
