@@ -2005,7 +2005,8 @@ impl<S: Source> Positions for SourcePositions<'_, S> {
     }
 }
 
-/// Bounding box of the used vertices and the largest vertex number (one pass).
+/// Bounding box of the used vertices and, with per-vertex memory, the largest vertex number
+/// (0 without: then there is no memory for `count` to rely on).
 /// With per-vertex memory (a cache entry still [`NO_Q`], then marked `NO_Q - 1`, which is
 /// still unfilled for [`quantised`]; or a clear bit, then set), only each vertex's first
 /// corner is read: the same box, and the same first error.
@@ -2031,20 +2032,24 @@ fn bbox<S: Source>(
         }
         for t in chunk {
             for &v in t {
-                top = top.max(v);
                 if !memory {
-                    // No per-vertex memory: every corner.
+                    // No per-vertex memory: every corner (and `top` is not needed).
                 } else if let Some(e) = cache.get_mut(v as usize) {
+                    top = top.max(v);
                     if *e != NO_Q {
                         continue;
                     }
                     *e = NO_Q - 1;
-                } else if let Some(w) = seen.get_mut((v >> 5) as usize) {
-                    let bit = 1u32 << (v & 31);
-                    if *w & bit != 0 {
-                        continue;
+                } else {
+                    // Beyond the cache: `top` says so.
+                    top = top.max(v);
+                    if let Some(w) = seen.get_mut((v >> 5) as usize) {
+                        let bit = 1u32 << (v & 31);
+                        if *w & bit != 0 {
+                            continue;
+                        }
+                        *w |= bit;
                     }
-                    *w |= bit;
                 }
                 let p = source
                     .position(v as usize)
