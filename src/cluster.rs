@@ -589,6 +589,11 @@ struct Pass<'a, I: Index> {
     /// The caller's per-vertex cache of quantised coordinates ([`Clusterer::cluster_with_cache`]);
     /// empty without.
     cache: &'a mut [u64],
+    /// The caller's key entries ([`Clusterer::cluster_with_keys`]): lane 6 holds the vertex's
+    /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`]; empty without.
+    keys: &'a mut [[u32; KEY_LANES]],
+    /// A corner's vertex was beyond the cache (in a pass that reads the cache).
+    beyond: bool,
 }
 
 /// A cache entry not yet filled (valid entries have bit 63 clear).
@@ -709,8 +714,16 @@ impl<I: Index> Pass<'_, I> {
             if !self.choose {
                 return;
             }
-            quadric_error(q, math::sub(p, self.grid.corner(k)))
+            // NaN as infinity: the choice is the least (score, vertex) in any order of
+            // offers (`choose_by_vertex` offers in vertex order).
+            let e = quadric_error(q, math::sub(p, self.grid.corner(k)));
+            if e.is_nan() {
+                f32::INFINITY
+            } else {
+                e
+            }
         } else {
+            // Never NaN (finite positions: a square of a difference is finite or infinite).
             let d = math::sub(p, self.grid.centre(k));
             math::dot(d, d)
         };
@@ -740,10 +753,29 @@ impl<I: Index> Pass<'_, I> {
                 (k, Some(p))
             } else {
                 let mut k = [0u32; 3];
-                for (kc, &v) in k.iter_mut().zip(t) {
-                    *kc = self
-                        .grid
-                        .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                let top = t[0].max(t[1]).max(t[2]);
+                self.beyond |= top as usize >= self.cache.len();
+                if self.keys.is_empty() {
+                    for (kc, &v) in k.iter_mut().zip(t) {
+                        *kc = self
+                            .grid
+                            .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                    }
+                } else {
+                    for (kc, &v) in k.iter_mut().zip(t) {
+                        let e = self.keys.get_mut(v as usize);
+                        match e {
+                            Some(&mut [.., key, FINAL]) => *kc = key,
+                            e => {
+                                *kc = self
+                                    .grid
+                                    .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
+                                if let Some(e) = e {
+                                    *e = [0, 0, 0, 0, 0, 0, *kc, FINAL];
+                                }
+                            }
+                        }
+                    }
                 }
                 (k, None)
             };
@@ -1194,6 +1226,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             slivers: 0,
             flipped: 0,
             cache: &mut [],
+            keys: &mut [],
+            beyond: false,
         })
     }
 
@@ -1220,8 +1254,17 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         config: &ClusterConfig,
         out: &mut [[I; 3]],
     ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, &mut [], &mut [])
-            .map(|(r, _)| r)
+        self.cluster_into(
+            source,
+            quadrics,
+            config,
+            out,
+            None,
+            &mut [],
+            &mut [],
+            &mut [],
+        )
+        .map(|(r, _)| r)
     }
 
     /// Like [`Clusterer::cluster`], with a caller's bit per input vertex (`seen`: vertex `v` is
@@ -1239,7 +1282,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &mut [[I; 3]],
         seen: &mut [u32],
     ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, seen, &mut [])
+        self.cluster_into(source, quadrics, config, out, None, seen, &mut [], &mut [])
             .map(|(r, _)| r)
     }
 
@@ -1258,7 +1301,27 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &mut [[I; 3]],
         cache: &mut [u64],
     ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, &mut [], cache)
+        self.cluster_into(source, quadrics, config, out, None, &mut [], cache, &mut [])
+            .map(|(r, _)| r)
+    }
+
+    /// Like [`Clusterer::cluster_with_cache`], with a further 32 bytes per input vertex
+    /// (`keys[v]` for vertex `v`; contents on entry do not matter): each counting pass of the
+    /// target search computes a vertex's cells at all its probed resolutions once, per
+    /// vertex, instead of at every corner, and counts a triangle with one comparison of its
+    /// corners' keys. The same output, faster (the counting passes are half the time with the
+    /// cache alone); vertices beyond either memory take the per-corner path. 40 bytes per
+    /// vertex in all: 1.4 MB for the bunny's 35 947 vertices, a host's option.
+    pub fn cluster_with_keys<S: Source, I: Index>(
+        &mut self,
+        source: &mut S,
+        quadrics: Option<&mut Quadrics<CELLS>>,
+        config: &ClusterConfig,
+        out: &mut [[I; 3]],
+        cache: &mut [u64],
+        keys: &mut [[u32; KEY_LANES]],
+    ) -> Result<ClusterReport, ClusterError> {
+        self.cluster_into(source, quadrics, config, out, None, &mut [], cache, keys)
             .map(|(r, _)| r)
     }
 
@@ -1282,6 +1345,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             Some(vertices),
             &mut [],
             &mut [],
+            &mut [],
         )
     }
 
@@ -1295,21 +1359,27 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         vertices: Option<&mut [u32]>,
         seen: &mut [u32],
         cache: &mut [u64],
+        keys: &mut [[u32; KEY_LANES]],
     ) -> Result<(ClusterReport, usize), ClusterError> {
         // Quantised coordinates depend only on the bounding box, the same for every grid of
         // this run: the cache is filled once (from the first counting or clustering pass).
         for e in cache.iter_mut() {
             *e = NO_Q;
         }
+        // No key entry is valid for any counting pass (stamps start at 1).
+        for k in keys.iter_mut() {
+            *k = [0; KEY_LANES];
+        }
         for w in seen.iter_mut() {
             *w = 0;
         }
         let mut passes = 0u32;
-        let (min, max) = match config.bbox {
-            Some(b) => b,
+        let (min, max, top) = match config.bbox {
+            Some(b) => (b.0, b.1, None),
             None => {
                 passes += 1;
-                bbox(source, seen, cache)?
+                let (lo, hi, top) = bbox(source, seen, cache)?;
+                (lo, hi, Some(top))
             }
         };
         let mut target = 0;
@@ -1318,7 +1388,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             GridChoice::Resolution(n) => Grid::with_resolution(min, max, n)?,
             GridChoice::TargetTriangles(t) => {
                 target = t;
-                let (g, p) = Self::search(source, min, max, t, config.refine_passes, cache)?;
+                let (g, p) =
+                    Self::search(source, min, max, t, config.refine_passes, cache, keys, top)?;
                 passes += p;
                 g
             }
@@ -1352,6 +1423,10 @@ impl<const CELLS: usize> Clusterer<CELLS> {
             let o = out.get_mut(..ao_now).unwrap_or(&mut []);
             let mut pass = self.pass(grid, quad.as_deref_mut(), o, ac_now)?;
             pass.cache = &mut *cache;
+            if !keys.is_empty() {
+                final_keys(&grid, pass.cache, keys);
+                pass.keys = &mut *keys;
+            }
             let total = run(&mut pass, source)?;
             passes += 1;
             let small_table = pass.cells_missed > 0 && ac_now < cells;
@@ -1366,12 +1441,16 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                     return Err(ClusterError::NotRereadable);
                 }
                 pass.choose = true;
-                pass.read = 0;
-                if seen.is_empty() && pass.cache.is_empty() {
+                if !pass.cache.is_empty() && !pass.beyond {
+                    // Every vertex used is in the cache: no stream needed.
+                    choose_by_vertex(&mut pass, source)?;
+                } else if seen.is_empty() && pass.cache.is_empty() {
+                    pass.read = 0;
                     run(&mut pass, source)?;
                     // `collapsed` was counted twice.
                     pass.collapsed /= 2;
                 } else {
+                    pass.read = 0;
                     choose_once(&mut pass, source, seen)?;
                 }
                 passes += 1;
@@ -1400,6 +1479,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
     /// probe counts the triangles whose corners fall into three distinct cells, which needs no
     /// memory and bounds the deduplicated output from above, so the result never exceeds the
     /// target.
+    #[allow(clippy::too_many_arguments)]
     fn search<S: Source>(
         source: &mut S,
         min: [f32; 3],
@@ -1407,6 +1487,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         target: usize,
         passes: u32,
         cache: &mut [u64],
+        keys: &mut [[u32; KEY_LANES]],
+        top: Option<u32>,
     ) -> Result<(Grid, u32), ClusterError> {
         // Estimate: about target/2 occupied cells, and a surface filling its box occupies
         // about 3 n² cells at n cells along the longest side (integer square root: no float
@@ -1451,7 +1533,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                     *g = Some(Grid::with_resolution(min, max, r)?);
                 }
             }
-            let counts = count(source, &grids, cache)?;
+            let counts = count(source, &grids, cache, keys, pass + 1, top)?;
             done += 1;
             for ((g, &r), &c) in grids.iter().zip(&n).zip(&counts) {
                 if g.is_none() {
@@ -1473,15 +1555,182 @@ impl<const CELLS: usize> Clusterer<CELLS> {
 /// Resolutions probed per counting pass of the target search.
 pub const PROBES: usize = 6;
 
+/// Lanes of a per-vertex key entry of [`Clusterer::cluster_with_keys`]: the cells of the
+/// [`PROBES`] resolutions of a counting pass, padded to 8 (32 bytes, two SIMD registers).
+pub const KEY_LANES: usize = 8;
+/// The lane of a key entry that holds the number of the counting pass it was computed for.
+const STAMP: usize = KEY_LANES - 1;
+/// The stamp of an entry computed for the final grid (counting passes are 1, 2, ...).
+const FINAL: u32 = u32::MAX;
+
+/// Before the accumulating pass: each vertex with quantised coordinates in the cache gets
+/// its cell on the final `grid` in its key entry (the others are computed at their first
+/// corner). Clears the stamps of the rest.
+fn final_keys(grid: &Grid, cache: &[u64], keys: &mut [[u32; KEY_LANES]]) {
+    for (v, k) in keys.iter_mut().enumerate() {
+        *k = match cache.get(v) {
+            Some(&e) if e >> 63 == 0 => [0, 0, 0, 0, 0, 0, grid.key_q(unpack_q(e)), FINAL],
+            _ => [0; KEY_LANES],
+        };
+    }
+}
+
+/// The cells of quantised coordinates `q` at the resolutions `ns` (lane `i`: `ns[i]` cells
+/// along the longest side; 0 gives cell 0).
+#[inline]
+fn probe_keys(q: [u32; 3], ns: &[u32; KEY_LANES]) -> [u32; KEY_LANES] {
+    let mut k = [0u32; KEY_LANES];
+    for (kc, &m) in k.iter_mut().zip(ns) {
+        // Cells are below 1024 (q <= QMAX, n <= 1024): the packed keys are exact.
+        *kc = (q[0].wrapping_mul(m) >> QBITS)
+            | ((q[1].wrapping_mul(m) >> QBITS) << 10)
+            | ((q[2].wrapping_mul(m) >> QBITS) << 20);
+    }
+    k
+}
+
 /// One counting pass: for each grid, the triangles whose corners fall into distinct cells.
+///
+/// With `keys`, each vertex's cells at all probed resolutions are computed once per pass and
+/// vertex, before the stream is read, from the quantised coordinates in the cache (filled
+/// from the position for a vertex the bounding-box pass marked), so a triangle costs three
+/// 32-byte loads and one branch-free comparison of 8 lanes. Lane [`STAMP`] says for which
+/// pass an entry was computed (`stamp`, from 1; entries are cleared to 0 first). A vertex
+/// without a current entry (beyond the memory, or not yet quantised) takes the per-corner
+/// path, which stores its entry for the rest of the pass: the same counts either way.
 fn count<S: Source>(
     source: &mut S,
     grids: &[Option<Grid>; PROBES],
     cache: &mut [u64],
+    keys: &mut [[u32; KEY_LANES]],
+    stamp: u32,
+    top: Option<u32>,
 ) -> Result<[usize; PROBES], ClusterError> {
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
     }
+    if keys.is_empty() {
+        return count_corners(source, grids, cache);
+    }
+    let mut counts = [0usize; PROBES];
+    // Every probe shares the origin and scale (the same box): quantise once per corner with
+    // the first grid, then each probe's cells are `(q · n) >> 20` in integers. A probe that
+    // is not run has n = 0 (all its corners in cell 0: counts nothing; not reported anyway).
+    let g0 = grids.iter().flatten().next().copied();
+    let mut ns = [0u32; KEY_LANES];
+    for (m, g) in ns.iter_mut().zip(grids) {
+        *m = g.map_or(0, |g| g.n);
+    }
+    let entry = |q: [u32; 3]| {
+        let mut k = probe_keys(q, &ns);
+        if let Some(s) = k.get_mut(STAMP) {
+            *s = stamp;
+        }
+        k
+    };
+    // Every vertex used has a current entry once the loop below has run: the bounding-box
+    // pass saw every corner (`top`: the largest vertex number) and marked every vertex in
+    // the cache. Then a triangle needs no stamp check (for a source that reads back the same
+    // triangles, as every pass assumes).
+    let mut complete = top.is_some_and(|t| (t as usize) < cache.len().min(keys.len()));
+    if let Some(g0) = &g0 {
+        for (v, (e, k)) in cache.iter_mut().zip(keys.iter_mut()).enumerate() {
+            if *e == NO_Q - 1 {
+                // Marked by the bounding-box pass, which checked its position. A source
+                // that now answers otherwise is left to the per-corner path (the same
+                // error, in stream order).
+                match source.position(v) {
+                    Some(p) if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() => {
+                        *e = pack_q(g0.quantise(p));
+                    }
+                    _ => {
+                        complete = false;
+                        continue;
+                    }
+                }
+            }
+            if *e >> 63 == 0 {
+                *k = entry(unpack_q(*e));
+            }
+        }
+    }
+    let mut buf = [[0u32; 3]; CHUNK];
+    let mut index = 0usize;
+    loop {
+        let n = source.read(&mut buf);
+        let Some(chunk) = buf.get(..n) else { break };
+        if chunk.is_empty() {
+            break;
+        }
+        let mut lane = [0u32; KEY_LANES];
+        for t in chunk {
+            let Some(g0) = &g0 else {
+                corners(&mut SourcePositions(&mut *source), t, index)?;
+                index += 1;
+                continue;
+            };
+            if complete {
+                if let (Some(a), Some(b), Some(c)) = (
+                    keys.get(t[0] as usize),
+                    keys.get(t[1] as usize),
+                    keys.get(t[2] as usize),
+                ) {
+                    for (((l, x), y), z) in lane.iter_mut().zip(a).zip(b).zip(c) {
+                        *l += u32::from((x != y) & (y != z) & (x != z));
+                    }
+                    index += 1;
+                    continue;
+                }
+            }
+            let current = |keys: &[[u32; KEY_LANES]], v: u32| {
+                keys.get(v as usize)
+                    .filter(|k| k.get(STAMP) == Some(&stamp))
+                    .copied()
+            };
+            let k = match (
+                current(keys, t[0]),
+                current(keys, t[1]),
+                current(keys, t[2]),
+            ) {
+                (Some(a), Some(b), Some(c)) => [a, b, c],
+                _ => {
+                    let mut k = [[0u32; KEY_LANES]; 3];
+                    for (kc, &v) in k.iter_mut().zip(t) {
+                        if let Some(e) = current(keys, v) {
+                            *kc = e;
+                            continue;
+                        }
+                        let mut pos = SourcePositions(&mut *source);
+                        let q = quantised(cache, &mut pos, g0, v, index)?;
+                        *kc = entry(q);
+                        if let Some(e) = keys.get_mut(v as usize) {
+                            *e = *kc;
+                        }
+                    }
+                    k
+                }
+            };
+            index += 1;
+            let [a, b, c] = k;
+            for i in 0..KEY_LANES {
+                let (x, y, z) = (a[i], b[i], c[i]);
+                lane[i] += u32::from((x != y) & (y != z) & (x != z));
+            }
+        }
+        for (cnt, l) in counts.iter_mut().zip(lane) {
+            *cnt += l as usize;
+        }
+    }
+    Ok(counts)
+}
+
+/// [`count`] without key entries: each corner quantised (or read from the cache) and its
+/// cells at every probed resolution computed at the corner.
+fn count_corners<S: Source>(
+    source: &mut S,
+    grids: &[Option<Grid>; PROBES],
+    cache: &mut [u64],
+) -> Result<[usize; PROBES], ClusterError> {
     let mut counts = [0usize; PROBES];
     // Every probe shares the origin and scale (the same box): quantise once per corner with
     // the first grid, then each probe's cells are `(q · n) >> 20` in integers. A probe that
@@ -1720,6 +1969,33 @@ fn choose_once<S: Source, I: Index>(
     Ok(())
 }
 
+/// The quadric representative's second pass when the cache holds every vertex used (the
+/// first pass met none beyond it): each vertex with quantised coordinates is offered once,
+/// in vertex order, without reading the stream. The choice (least score, then least vertex
+/// number) does not depend on the order of the offers.
+fn choose_by_vertex<S: Source, I: Index>(
+    pass: &mut Pass<'_, I>,
+    source: &mut S,
+) -> Result<(), ClusterError> {
+    let grid = pass.grid;
+    for v in 0..pass.cache.len() {
+        let Some(&e) = pass.cache.get(v) else { break };
+        if e >> 63 != 0 {
+            continue;
+        }
+        let k = match pass.keys.get(v) {
+            Some(&[.., key, FINAL]) => key,
+            _ => grid.key_q(unpack_q(e)),
+        };
+        // Checked in an earlier pass already (the vertex was quantised).
+        let p = checked_position(&mut SourcePositions(&mut *source), to_u32(v), 0)?;
+        if let Some(slot) = pass.cell(k) {
+            pass.offer(slot, k, to_u32(v), p);
+        }
+    }
+    Ok(())
+}
+
 struct SourcePositions<'s, S>(&'s mut S);
 
 impl<S: Source> Positions for SourcePositions<'_, S> {
@@ -1729,7 +2005,8 @@ impl<S: Source> Positions for SourcePositions<'_, S> {
     }
 }
 
-/// Bounding box of the used vertices (one pass).
+/// Bounding box of the used vertices and, with per-vertex memory, the largest vertex number
+/// (0 without: then there is no memory for `count` to rely on).
 /// With per-vertex memory (a cache entry still [`NO_Q`], then marked `NO_Q - 1`, which is
 /// still unfilled for [`quantised`]; or a clear bit, then set), only each vertex's first
 /// corner is read: the same box, and the same first error.
@@ -1737,7 +2014,7 @@ fn bbox<S: Source>(
     source: &mut S,
     seen: &mut [u32],
     cache: &mut [u64],
-) -> Result<([f32; 3], [f32; 3]), ClusterError> {
+) -> Result<([f32; 3], [f32; 3], u32), ClusterError> {
     if !source.rewind() {
         return Err(ClusterError::NotRereadable);
     }
@@ -1745,6 +2022,7 @@ fn bbox<S: Source>(
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
     let mut index = 0usize;
+    let mut top = 0u32;
     let memory = !(cache.is_empty() && seen.is_empty());
     loop {
         let n = source.read(&mut buf);
@@ -1755,18 +2033,23 @@ fn bbox<S: Source>(
         for t in chunk {
             for &v in t {
                 if !memory {
-                    // No per-vertex memory: every corner.
+                    // No per-vertex memory: every corner (and `top` is not needed).
                 } else if let Some(e) = cache.get_mut(v as usize) {
+                    top = top.max(v);
                     if *e != NO_Q {
                         continue;
                     }
                     *e = NO_Q - 1;
-                } else if let Some(w) = seen.get_mut((v >> 5) as usize) {
-                    let bit = 1u32 << (v & 31);
-                    if *w & bit != 0 {
-                        continue;
+                } else {
+                    // Beyond the cache: `top` says so.
+                    top = top.max(v);
+                    if let Some(w) = seen.get_mut((v >> 5) as usize) {
+                        let bit = 1u32 << (v & 31);
+                        if *w & bit != 0 {
+                            continue;
+                        }
+                        *w |= bit;
                     }
-                    *w |= bit;
                 }
                 let p = source
                     .position(v as usize)
@@ -1795,7 +2078,7 @@ fn bbox<S: Source>(
     if index == 0 {
         return Err(ClusterError::EmptyInput);
     }
-    Ok((min, max))
+    Ok((min, max, top))
 }
 
 /// Integer square root (floor), by Newton's method on integers.

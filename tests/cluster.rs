@@ -12,7 +12,7 @@ use std::sync::Mutex;
 use proptest::prelude::*;
 use tinydecimate::cluster::{
     ClusterConfig, ClusterError, ClusterReport, Clusterer, Grid, GridChoice, PositionFn, Quadrics,
-    SliceSource,
+    SliceSource, KEY_LANES,
 };
 
 const CELLS: usize = 65_535;
@@ -166,6 +166,31 @@ fn vertex_memory_changes_nothing_but_time() {
                 assert_eq!(r, wr, "{name} config {frac}, cache {n}: report");
                 assert_eq!(out, want, "{name} config {frac}, cache {n}: output");
             }
+            for (n, nk) in [(nv, nv), (nv, nv / 2), (nv / 2, nv), (1, nv), (nv, 1)] {
+                let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+                let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
+                let mut out = vec![[0u32; 3]; m.triangles.len()];
+                let mut cache = vec![7u64; n];
+                // Garbage on entry, including stamps that look current.
+                let mut keys = vec![[u32::MAX; KEY_LANES]; nk];
+                let mut src = SliceSource::new(&m.positions, &m.triangles);
+                let r = table
+                    .cluster_with_keys(
+                        &mut src,
+                        Some(&mut *quads),
+                        &config,
+                        &mut out,
+                        &mut cache,
+                        &mut keys,
+                    )
+                    .expect("cluster_with_keys");
+                out.truncate(r.triangles_out);
+                assert_eq!(r, wr, "{name} config {frac}, cache {n}, keys {nk}: report");
+                assert_eq!(
+                    out, want,
+                    "{name} config {frac}, cache {n}, keys {nk}: output"
+                );
+            }
             for n in [words, words / 2, 1] {
                 let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
                 let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
@@ -257,6 +282,16 @@ fn nan_position_is_a_typed_error() {
         let mut quads = Quadrics::<512>::new();
         let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
         assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+        let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
+        let e = table.cluster_with_keys(
+            &mut src,
+            Some(&mut quads),
+            &config,
+            &mut out,
+            &mut cache,
+            &mut keys,
+        );
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
         let e = table.cluster_with_seen(&mut src, Some(&mut quads), &config, &mut out, &mut bits);
         assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
     }
@@ -281,6 +316,22 @@ fn index_out_of_range_is_a_typed_error() {
     let mut quads = Quadrics::<512>::new();
     for config in [ClusterConfig::cell_size(0.3), ClusterConfig::target(100)] {
         let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
+        assert_eq!(
+            e,
+            Err(ClusterError::IndexOutOfRange {
+                triangle: 5,
+                index: 9999
+            })
+        );
+        let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
+        let e = table.cluster_with_keys(
+            &mut src,
+            Some(&mut quads),
+            &config,
+            &mut out,
+            &mut cache,
+            &mut keys,
+        );
         assert_eq!(
             e,
             Err(ClusterError::IndexOutOfRange {

@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, bail, Context, Result};
 use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, GridChoice, Quadrics,
-    SliceSource,
+    SliceSource, KEY_LANES,
 };
 use tinydecimate::{Config, Report};
 
@@ -50,8 +50,8 @@ pub struct Args {
     #[arg(long)]
     pub cleanup: bool,
     /// Memory per input vertex besides the table and the output (the same output; time
-    /// only): none (`Clusterer::cluster`), a bit (`cluster_with_seen`) or 8 bytes
-    /// (`cluster_with_cache`).
+    /// only): none (`Clusterer::cluster`), a bit (`cluster_with_seen`), 8 bytes
+    /// (`cluster_with_cache`) or 40 bytes (`cluster_with_keys`).
     #[arg(long, value_enum, default_value_t = VertexMemory::None)]
     pub vertex_memory: VertexMemory,
     /// Skip the Metro measurement.
@@ -71,6 +71,8 @@ pub enum VertexMemory {
     Bit,
     /// 8 bytes per vertex (`Clusterer::cluster_with_cache`).
     Cache,
+    /// 8 + 32 bytes per vertex (`Clusterer::cluster_with_keys`).
+    Keys,
 }
 
 /// Clusters `mesh` with the library: output, report, wall time of the call. The per-vertex
@@ -93,7 +95,9 @@ pub fn cluster(
             0
         }
     ];
-    let mut cache = vec![0u64; if mem == VertexMemory::Cache { n } else { 0 }];
+    let with_cache = matches!(mem, VertexMemory::Cache | VertexMemory::Keys);
+    let mut cache = vec![0u64; if with_cache { n } else { 0 }];
+    let mut keys = vec![[0u32; KEY_LANES]; if mem == VertexMemory::Keys { n } else { 0 }];
     let mut src = SliceSource::new(&mesh.positions, &mesh.triangles);
     let start = Instant::now();
     let q = if quadric { Some(&mut *quads) } else { None };
@@ -101,6 +105,9 @@ pub fn cluster(
         VertexMemory::None => table.cluster(&mut src, q, config, &mut out),
         VertexMemory::Bit => table.cluster_with_seen(&mut src, q, config, &mut out, &mut bits),
         VertexMemory::Cache => table.cluster_with_cache(&mut src, q, config, &mut out, &mut cache),
+        VertexMemory::Keys => {
+            table.cluster_with_keys(&mut src, q, config, &mut out, &mut cache, &mut keys)
+        }
     }
     .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
     let dt = start.elapsed();
@@ -305,6 +312,8 @@ pub struct Row {
     /// Ours (quadric representative, 8 B cache per vertex): count, median ms, Metro mean %,
     /// duplicates, degenerate.
     pub ours: (usize, f64, f64, usize, usize),
+    /// Ours with 40 B per vertex (cache and keys): median ms.
+    pub ours_keys_ms: f64,
     /// Ours with a bit per vertex: median ms.
     pub ours_bit_ms: f64,
     /// Ours with memory for the output only: median ms.
@@ -352,12 +361,19 @@ pub fn bench(
             let mut ours_t = Vec::new();
             let mut stream_t = Vec::new();
             let mut bit_t = Vec::new();
+            let mut keys_t = Vec::new();
             let mut sl_t = Vec::new();
             let mut ours = None;
             let mut sl = None;
             for _ in 0..reps.max(1) {
                 let (o, r, dt) = cluster(mesh, &config, true, VertexMemory::Cache)?;
                 ours_t.push(dt.as_secs_f64() * 1e3);
+                let (o2, r2, dt) = cluster(mesh, &config, true, VertexMemory::Keys)?;
+                keys_t.push(dt.as_secs_f64() * 1e3);
+                anyhow::ensure!(
+                    o2.triangles == o.triangles && r2 == r,
+                    "{name}: keys differ"
+                );
                 let (o2, r2, dt) = cluster(mesh, &config, true, VertexMemory::Bit)?;
                 bit_t.push(dt.as_secs_f64() * 1e3);
                 anyhow::ensure!(
@@ -393,6 +409,7 @@ pub fn bench(
                     od,
                     odg,
                 ),
+                ours_keys_ms: median(keys_t),
                 ours_bit_ms: median(bit_t),
                 ours_stream_ms: median(stream_t),
                 sloppy: (s.triangles.len(), median(sl_t), sd, sdg),
@@ -407,14 +424,16 @@ pub fn bench(
 
 fn markdown_row(r: &Row) -> String {
     format!(
-        "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2}x | {:.3} | {:.2}x | {:.3} | {:.2}x | {} / {} | {} / {} | {:.4} | {} | {:.4} | {:.2}x |",
+        "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2}x | {:.3} | {:.2}x | {:.3} | {:.2}x | {:.3} | {:.2}x | {} / {} | {} / {} | {:.4} | {} | {:.4} | {:.2}x |",
         r.mesh,
         r.triangles,
         r.ratio,
         r.ours.0,
-        r.ours.1,
+        r.ours_keys_ms,
         r.sloppy.0,
         r.sloppy.1,
+        r.ours_keys_ms / r.sloppy.1,
+        r.ours.1,
         r.ours.1 / r.sloppy.1,
         r.ours_bit_ms,
         r.ours_bit_ms / r.sloppy.1,
@@ -437,11 +456,11 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let _ = writeln!(s, "Command: `{command}`\n");
     let _ = writeln!(
         s,
-        "| mesh | triangles | ratio | ours | ours ms, 8 B/vertex | sloppy | sloppy ms | time ours/sloppy | ours ms, 1 bit/vertex | its time / sloppy | ours ms, output memory only | its time / sloppy | ours dup / degen | sloppy dup / degen | ours mean % | sloppy at our count | its mean % | error ours/sloppy |"
+        "| mesh | triangles | ratio | ours | ours ms, 40 B/vertex | sloppy | sloppy ms | time ours/sloppy | ours ms, 8 B/vertex | its time / sloppy | ours ms, 1 bit/vertex | its time / sloppy | ours ms, output memory only | its time / sloppy | ours dup / degen | sloppy dup / degen | ours mean % | sloppy at our count | its mean % | error ours/sloppy |"
     );
     let _ = writeln!(
         s,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for r in rows {
         let _ = writeln!(s, "{}", markdown_row(r));
@@ -460,6 +479,13 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
         (rows.iter().map(|r| f(r).ln()).sum::<f64>() / rows.len().max(1) as f64).exp()
     };
     let geo_t = geo(&|r| r.ours.1 / r.sloppy.1);
+    let geo_k = geo(&|r| r.ours_keys_ms / r.sloppy.1);
+    let worst_k = rows
+        .iter()
+        .map(|r| r.ours_keys_ms / r.sloppy.1)
+        .fold(0.0, f64::max);
+    let tot_k: f64 = rows.iter().map(|r| r.ours_keys_ms).sum::<f64>()
+        / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
     let geo_s = geo(&|r| r.ours_stream_ms / r.sloppy.1);
     let geo_b = geo(&|r| r.ours_bit_ms / r.sloppy.1);
     let worst_b = rows
@@ -476,7 +502,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let sdups: usize = rows.iter().map(|r| r.sloppy.2 + r.sloppy.3).sum();
     let _ = writeln!(
         s,
-        "\nTime ours/sloppy (8 B per input vertex, `Clusterer::cluster_with_cache`): worst row {worst_t:.2}x, all rows together {tot_t:.2}x, geometric mean {geo_t:.2}x. With a bit per vertex (`Clusterer::cluster_with_seen`): worst row {worst_b:.2}x, geometric mean {geo_b:.2}x. With memory for the output only (`Clusterer::cluster`, same output): worst row {worst_s:.2}x, all rows together {tot_s:.2}x, geometric mean {geo_s:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
+        "\nTime ours/sloppy (40 B per input vertex, `Clusterer::cluster_with_keys`): worst row {worst_k:.2}x, all rows together {tot_k:.2}x, geometric mean {geo_k:.2}x. With 8 B per vertex (`Clusterer::cluster_with_cache`): worst row {worst_t:.2}x, all rows together {tot_t:.2}x, geometric mean {geo_t:.2}x. With a bit per vertex (`Clusterer::cluster_with_seen`): worst row {worst_b:.2}x, geometric mean {geo_b:.2}x. With memory for the output only (`Clusterer::cluster`, same output): worst row {worst_s:.2}x, all rows together {tot_s:.2}x, geometric mean {geo_s:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
     );
     s
 }

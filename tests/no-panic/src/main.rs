@@ -16,7 +16,7 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
-    Quadrics, SliceSource, Source, ThenCollapseError,
+    Quadrics, SliceSource, Source, ThenCollapseError, KEY_LANES,
 };
 use tinydecimate::bound::{control_len, Bound};
 use tinydecimate::cost::{
@@ -495,6 +495,22 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
                 black_box(r);
             }
             Err(e) => cluster_error(&e),
+        }
+        // And 32 bytes of keys per vertex (any length).
+        let mut keys: [[u32; KEY_LANES]; 16] = black_box([[0; KEY_LANES]; 16]);
+        let nk = input(17) as usize;
+        if let Some(k) = keys.get_mut(..nk) {
+            let q = if input(18) & 1 == 0 {
+                Some(&mut quads)
+            } else {
+                None
+            };
+            match table.cluster_with_keys(&mut src, q, &config, &mut out, c, k) {
+                Ok(r) => {
+                    black_box(r);
+                }
+                Err(e) => cluster_error(&e),
+            }
         }
     }
     // A slice source, and the single-pass stream with an accessor.
