@@ -2109,15 +2109,16 @@ mod tests {
     }
 
     #[test]
-    fn keys_floor_and_clamp() {
-        let g = Grid::with_cell_size([0.0; 3], [10.0; 3], 1.0).unwrap();
+    fn keys_floor_and_clamp() -> Result<(), ClusterError> {
+        let g = Grid::with_cell_size([0.0; 3], [10.0; 3], 1.0)?;
         assert_eq!((g.n, g.dims), (10, [10; 3]));
         assert_eq!(g.key([0.5, 1.5, 2.5]), (2 << 20) | (1 << 10));
         assert_eq!(g.key([-5.0, 99.0, 10.0]), (9 << 20) | (9 << 10));
-        let g = Grid::with_resolution([0.0; 3], [1.0, 2.0, 0.0], 8).unwrap();
+        let g = Grid::with_resolution([0.0; 3], [1.0, 2.0, 0.0], 8)?;
         assert_eq!(g.dims, [5, 8, 1]);
-        let g = Grid::with_cell_size([0.0; 3], [1.0, 2.0, 0.0], 0.3).unwrap();
+        let g = Grid::with_cell_size([0.0; 3], [1.0, 2.0, 0.0], 0.3)?;
         assert_eq!(g.n, 7);
+        Ok(())
     }
 
     #[test]

@@ -1322,14 +1322,14 @@ mod tests {
     /// neighbours and the unchecked re-insert of a stale key rely on it). Fails without the
     /// one price, without `RAISED` set or without `RAISED` honoured.
     #[test]
-    fn stored_subset_keys_stay_lower_bounds() {
+    fn stored_subset_keys_stay_lower_bounds() -> Result<(), crate::Error> {
         let (p, mut t) = wavy(10, 0.0);
         let mut q = [[0.0f32; 10]; 121] as [VertexQuadric; 121];
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
         let cost = StoredQuadric::new(&mut q, 1.0, Placement::Subset);
-        let s = ws.start_with_cost(&p, &mut t, &config, cost).unwrap();
-        audit(s);
+        audit(ws.start_with_cost(&p, &mut t, &config, cost)?);
+        Ok(())
     }
 
     const NOISE: f32 = 0.4;
@@ -1337,14 +1337,14 @@ mod tests {
     /// The same with optimal placement: the kept vertex moves, so every neighbour's price
     /// onto it may fall as well as rise.
     #[test]
-    fn stored_optimal_keys_stay_lower_bounds() {
+    fn stored_optimal_keys_stay_lower_bounds() -> Result<(), crate::Error> {
         let (mut p, mut t) = wavy(10, NOISE);
         let mut q = [[0.0f32; 10]; 121] as [VertexQuadric; 121];
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
         let cost = StoredQuadric::new(&mut q, 1.0, Placement::Optimal);
-        let s = ws.start_moving(&mut p, &mut t, &config, cost).unwrap();
-        audit(s);
+        audit(ws.start_moving(&mut p, &mut t, &config, cost)?);
+        Ok(())
     }
 
     /// Runs `s` one operation at a time, checking the queue after each.

@@ -465,39 +465,26 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     for r in rows {
         let _ = writeln!(s, "{}", markdown_row(r));
     }
-    let worst_t = rows
-        .iter()
-        .map(|r| r.ours.1 / r.sloppy.1)
-        .fold(0.0, f64::max);
-    let worst_e = rows
-        .iter()
-        .map(|r| r.ours.2 / r.sloppy_same.1)
-        .fold(0.0, f64::max);
-    let tot_t: f64 =
-        rows.iter().map(|r| r.ours.1).sum::<f64>() / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
     let geo = |f: &dyn Fn(&Row) -> f64| {
         (rows.iter().map(|r| f(r).ln()).sum::<f64>() / rows.len().max(1) as f64).exp()
     };
+    let worst = |f: &dyn Fn(&Row) -> f64| rows.iter().map(f).fold(0.0, f64::max);
+    // A time of ours over sloppy's, all rows together.
+    let total = |f: &dyn Fn(&Row) -> f64| {
+        rows.iter().map(f).sum::<f64>() / rows.iter().map(|r| r.sloppy.1).sum::<f64>()
+    };
+    let worst_t = worst(&|r| r.ours.1 / r.sloppy.1);
+    let worst_e = worst(&|r| r.ours.2 / r.sloppy_same.1);
+    let tot_t = total(&|r| r.ours.1);
     let geo_t = geo(&|r| r.ours.1 / r.sloppy.1);
     let geo_k = geo(&|r| r.ours_keys_ms / r.sloppy.1);
-    let worst_k = rows
-        .iter()
-        .map(|r| r.ours_keys_ms / r.sloppy.1)
-        .fold(0.0, f64::max);
-    let tot_k: f64 = rows.iter().map(|r| r.ours_keys_ms).sum::<f64>()
-        / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
+    let worst_k = worst(&|r| r.ours_keys_ms / r.sloppy.1);
+    let tot_k = total(&|r| r.ours_keys_ms);
     let geo_s = geo(&|r| r.ours_stream_ms / r.sloppy.1);
     let geo_b = geo(&|r| r.ours_bit_ms / r.sloppy.1);
-    let worst_b = rows
-        .iter()
-        .map(|r| r.ours_bit_ms / r.sloppy.1)
-        .fold(0.0, f64::max);
-    let worst_s = rows
-        .iter()
-        .map(|r| r.ours_stream_ms / r.sloppy.1)
-        .fold(0.0, f64::max);
-    let tot_s: f64 = rows.iter().map(|r| r.ours_stream_ms).sum::<f64>()
-        / rows.iter().map(|r| r.sloppy.1).sum::<f64>();
+    let worst_b = worst(&|r| r.ours_bit_ms / r.sloppy.1);
+    let worst_s = worst(&|r| r.ours_stream_ms / r.sloppy.1);
+    let tot_s = total(&|r| r.ours_stream_ms);
     let dups: usize = rows.iter().map(|r| r.ours.3 + r.ours.4).sum();
     let sdups: usize = rows.iter().map(|r| r.sloppy.2 + r.sloppy.3).sum();
     let _ = writeln!(
