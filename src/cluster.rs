@@ -590,7 +590,8 @@ struct Pass<'a, I: Index> {
     /// empty without.
     cache: &'a mut [u64],
     /// The caller's key entries ([`Clusterer::cluster_with_keys`]): lane 6 holds the vertex's
-    /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`]; empty without.
+    /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`], and lane 0 the cell's slot
+    /// + 1 once it is known (0 before); empty without.
     keys: &'a mut [[u32; KEY_LANES]],
     /// A corner's vertex was beyond the cache (in a pass that reads the cache).
     beyond: bool,
@@ -707,6 +708,25 @@ impl<I: Index> Pass<'_, I> {
         None
     }
 
+    /// The slot of cell `k` of vertex `v`, as [`Pass::cell`]: from `hint` (slot + 1, from the
+    /// vertex's key entry) when not 0; else looked up, and a slot found is stored in the
+    /// vertex's key entry (lane 0) for its later corners. A slot never moves once its cell is
+    /// in the table, so the hint gives the lookup's answer; a table without room for the cell
+    /// stores nothing, and the next corner looks again (and fails again).
+    #[inline]
+    fn cell_of_vertex(&mut self, k: u32, hint: u32, v: u32) -> Option<usize> {
+        if hint != 0 {
+            return Some(hint as usize - 1);
+        }
+        let s = self.cell(k);
+        if let (Some(s), Some(e)) = (s, self.keys.get_mut(v as usize)) {
+            if let (Ok(h), [h0, .., FINAL]) = (u32::try_from(s + 1), e) {
+                *h0 = h;
+            }
+        }
+        s
+    }
+
     /// Offers vertex `v` at `p` as representative of the cell in slot `s`.
     #[inline]
     fn offer(&mut self, s: usize, k: u32, v: u32, p: V3) {
@@ -743,6 +763,8 @@ impl<I: Index> Pass<'_, I> {
             // first pass needs positions only for the triangles that survive, and takes the
             // cells from the cache when there is one.
             let offers = self.quad.is_none() || self.choose;
+            // Each corner's slot + 1 when its key entry has it (0: look the cell up).
+            let mut hint = [0u32; 3];
             let (k, mut p) = if offers || self.cache.is_empty() {
                 let p = corners(pos, t, index)?;
                 let k = [
@@ -762,10 +784,10 @@ impl<I: Index> Pass<'_, I> {
                             .key_q(quantised(self.cache, pos, &self.grid, v, index)?);
                     }
                 } else {
-                    for (kc, &v) in k.iter_mut().zip(t) {
+                    for ((kc, hc), &v) in k.iter_mut().zip(&mut hint).zip(t) {
                         let e = self.keys.get_mut(v as usize);
                         match e {
-                            Some(&mut [.., key, FINAL]) => *kc = key,
+                            Some(&mut [h, .., key, FINAL]) => (*kc, *hc) = (key, h),
                             e => {
                                 *kc = self
                                     .grid
@@ -781,14 +803,18 @@ impl<I: Index> Pass<'_, I> {
             };
             // A corner in the same cell as an earlier corner has that corner's slot (the
             // lookup would give the same answer, found or not).
-            let s0 = self.cell(k[0]);
-            let s1 = if k[1] == k[0] { s0 } else { self.cell(k[1]) };
+            let s0 = self.cell_of_vertex(k[0], hint[0], t[0]);
+            let s1 = if k[1] == k[0] {
+                s0
+            } else {
+                self.cell_of_vertex(k[1], hint[1], t[1])
+            };
             let s2 = if k[2] == k[0] {
                 s0
             } else if k[2] == k[1] {
                 s1
             } else {
-                self.cell(k[2])
+                self.cell_of_vertex(k[2], hint[2], t[2])
             };
             // The quadric representative is chosen in the second pass only.
             if let (true, Some(p)) = (offers, &p) {
@@ -1983,13 +2009,13 @@ fn choose_by_vertex<S: Source, I: Index>(
         if e >> 63 != 0 {
             continue;
         }
-        let k = match pass.keys.get(v) {
-            Some(&[.., key, FINAL]) => key,
-            _ => grid.key_q(unpack_q(e)),
+        let (k, hint) = match pass.keys.get(v) {
+            Some(&[h, .., key, FINAL]) => (key, h),
+            _ => (grid.key_q(unpack_q(e)), 0),
         };
         // Checked in an earlier pass already (the vertex was quantised).
         let p = checked_position(&mut SourcePositions(&mut *source), to_u32(v), 0)?;
-        if let Some(slot) = pass.cell(k) {
+        if let Some(slot) = pass.cell_of_vertex(k, hint, to_u32(v)) {
             pass.offer(slot, k, to_u32(v), p);
         }
     }

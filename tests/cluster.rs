@@ -588,3 +588,37 @@ fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
         a[0] * b[1] - a[1] * b[0],
     ]
 }
+
+/// A table too small for the grid fails the same way with key entries as without: a cell that
+/// found no room stores no slot in its vertices' entries, so every later corner in it is
+/// counted as missing again, and the error's figures are the same.
+#[test]
+fn a_full_table_fails_the_same_with_key_entries() {
+    let m = load_obj("cow.obj");
+    let (lo, hi) = bounds(&m);
+    let cell = (hi[0] - lo[0]) / 25.0;
+    for cells in [60usize, 300] {
+        let config = ClusterConfig::cell_size(cell).with_table_cells(cells);
+        let mut table = TABLE.lock().unwrap_or_else(|e| e.into_inner());
+        let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
+        let mut out = vec![[0u32; 3]; m.triangles.len()];
+        let mut src = SliceSource::new(&m.positions, &m.triangles);
+        let want = table.cluster(&mut src, Some(&mut *quads), &config, &mut out);
+        assert!(
+            matches!(want, Err(ClusterError::TableFull { capacity, .. }) if capacity == cells),
+            "{cells} cells: {want:?}"
+        );
+        let mut cache = vec![0u64; m.positions.len()];
+        let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
+        let mut src = SliceSource::new(&m.positions, &m.triangles);
+        let got = table.cluster_with_keys(
+            &mut src,
+            Some(&mut *quads),
+            &config,
+            &mut out,
+            &mut cache,
+            &mut keys,
+        );
+        assert_eq!(got, want, "{cells} cells");
+    }
+}
