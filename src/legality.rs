@@ -25,7 +25,7 @@
 
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::mesh::{flag, next3, prev3, Mesh, NIL};
+use crate::mesh::{corner, flag, next3, prev3, Mesh, NIL};
 use crate::report::Reject;
 use crate::{Config, Schedule};
 
@@ -225,6 +225,41 @@ fn shape_moved<L: Index, I: Index>(
     )
 }
 
+/// The triangle across edge `x-y` from live triangle `t`, whose slot `ky` holds `y` and whose
+/// next slot holds `x` (`t` is `(y, ·, x)` read from `y`), found in O(1) from `y`'s fan order:
+/// the triangle after `t` in `y`'s list is the one across `y-x` (see `mesh`). `Some(None)`:
+/// `x-y` is a boundary edge. `None`: `y`'s list is not in fan order (a locked vertex) or does
+/// not answer as fan order would; the caller then searches `x`'s triangles.
+#[inline]
+fn outer<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    t: usize,
+    ky: usize,
+    x: usize,
+    y: usize,
+) -> Option<Option<usize>> {
+    let fy = mesh.flags(y);
+    if fy & flag::LOCKED != 0 {
+        return None;
+    }
+    let mut n = mesh.after(corner(t, ky));
+    if n == NIL {
+        if fy & flag::BOUNDARY != 0 {
+            // y's last triangle: its edge y-x has no twin.
+            return Some(None);
+        }
+        // An interior fan is a cycle; its list starts anywhere.
+        n = mesh.first(y);
+    }
+    let u = n >> 2;
+    let tri = mesh.tri(u);
+    if u != t && tri.get(next3(n & 3)) == Some(&x) {
+        Some(Some(u))
+    } else {
+        None
+    }
+}
+
 /// Checks every rule for `a -> b`; with `at`, the rules on `a`'s triangles for `b` moved to
 /// `at` (optimal placement; [`check_placed`] adds `b`'s own triangles, which change too).
 pub(crate) fn check<L: Index, I: Index>(
@@ -346,9 +381,15 @@ pub(crate) fn check<L: Index, I: Index>(
                 }
             }
             // Outer edge x-y: every other triangle holding both (one, on a manifold edge).
-            for (u, _) in mesh.corners(x) {
-                if u != t && mesh.tri(u).contains(&y) {
-                    fold |= folded(&now, &after(u));
+            match outer(mesh, t, prev3(k), x, y) {
+                Some(Some(u)) => fold |= folded(&now, &after(u)),
+                Some(None) => {}
+                None => {
+                    for (u, _) in mesh.corners(x) {
+                        if u != t && mesh.tri(u).contains(&y) {
+                            fold |= folded(&now, &after(u));
+                        }
+                    }
                 }
             }
             if fold {
