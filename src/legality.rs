@@ -315,20 +315,28 @@ pub(crate) fn check<L: Index, I: Index>(
     // Link condition: the only common neighbours of a and b are o1 and o2. b's neighbours are
     // marked, so this is O(valence). The same walk finds b's triangles across (b, o1) and
     // (b, o2), for the fold test.
+    // The walk marks b's neighbours as `Mesh::for_each_neighbour` names them: each corner's
+    // `a`, and a boundary fan's last `b`.
     let (mut across_o1, mut across_o2) = (NIL, NIL);
     let mut c = mesh.first(b);
-    while c != NIL {
+    let (mut last, mut guard) = (NIL, mesh.triangle_count());
+    while c != NIL && guard > 0 {
+        guard -= 1;
         let tri = mesh.tri(c >> 2);
         let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+        mesh.mark(x, true);
         if y == o1 && x != a {
             across_o1 = c >> 2;
         }
         if x == o2 && y != a {
             across_o2 = c >> 2;
         }
+        last = c;
         c = mesh.after(c);
     }
-    mesh.for_each_neighbour(b, |x| mesh.mark(x, true));
+    if mesh.has(b, flag::BOUNDARY) && last != NIL {
+        mesh.mark(mesh.tri(last >> 2)[prev3(last & 3)], true);
+    }
     let mut common = false;
     mesh.for_each_neighbour(a, |x| {
         common |= x != b && x != o1 && x != o2 && mesh.has(x, flag::MARK);
