@@ -329,7 +329,11 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// slot `(c & 3)`).
     #[inline]
     pub(crate) fn after(&self, c: usize) -> usize {
-        let v = self.tri(c >> 2).get(c & 3).copied().unwrap_or(NIL);
+        // One index read, not the whole triangle.
+        let v = match self.tris.get(c >> 2).and_then(|t| t.get(c & 3)) {
+            Some(&x) => x.to_usize(),
+            None => NIL,
+        };
         match self.next.get(c >> 2).and_then(|n| n.get(c & 3)) {
             Some(&t) if t != L::NIL => self.corner_of(t.to_usize(), v),
             _ => NIL,
