@@ -312,11 +312,10 @@ pub(crate) fn check<L: Index, I: Index>(
         }
     }
 
-    // Link condition: the only common neighbours of a and b are o1 and o2. b's neighbours are
-    // marked, so this is O(valence). The same walk finds b's triangles across (b, o1) and
-    // (b, o2), for the fold test.
-    // The walk marks b's neighbours as `Mesh::for_each_neighbour` names them: each corner's
-    // `a`, and a boundary fan's last `b`.
+    // Link condition: the only common neighbours of a and b are o1 and o2. One walk of b's fan
+    // marks b's neighbours (as `Mesh::for_each_neighbour` names them: each corner's `a`, and a
+    // boundary fan's last `b`), so this is O(valence), and finds b's triangles across (b, o1)
+    // and (b, o2), for the fold test.
     let (mut across_o1, mut across_o2) = (NIL, NIL);
     let mut c = mesh.first(b);
     let (mut last, mut guard) = (NIL, mesh.triangle_count());
