@@ -465,9 +465,13 @@ pub(crate) fn check_placed<L: Index, I: Index>(
 }
 
 /// The shape, turn and fold rules on `b`'s surviving triangles with `b` at `p` (`a` merged
-/// into it). A fold is looked for across each of their edges, against the triangle there
-/// after the collapse. Never inlined: only optimal placement needs it, and inlined its locals
-/// would deepen [`check`]'s frame for every mode (the micro:bit has 4.5 KB of stack).
+/// into it). A fold is looked for across each of their edges, against the triangle there after
+/// the collapse, found as [`check`] finds a's: across a spoke `b-x` the survivor before in
+/// `b`'s fan order (the list is a rotated cycle, so the last one is before the first), across
+/// the outer edge `x-y` the triangle after in `y`'s. Across `b-o1` and `b-o2` the neighbours
+/// are a's survivors, and [`check`] has tested those pairs already. Never inlined: only optimal
+/// placement needs it, and inlined its locals would deepen [`check`]'s frame for every mode
+/// (the micro:bit has 4.5 KB of stack).
 #[inline(never)]
 fn check_moved_b<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
@@ -476,12 +480,15 @@ fn check_moved_b<L: Index, I: Index>(
     b: usize,
     p: V3,
 ) -> Result<(), Reject> {
-    let merged = |v: usize| if v == a { b } else { v };
+    let after = |u: usize| shape_moved(mesh, u, a, b, p);
+    let mut first: Option<(usize, Shape)> = None;
+    let mut prev: Option<(usize, Shape)> = None;
     for (t, k) in mesh.corners(b) {
         let old = mesh.tri(t);
         if old.contains(&a) {
             continue;
         }
+        let (x, y) = (old[next3(k)], old[prev3(k)]);
         let q = old.map(|v| mesh.p(v));
         let mut r = q;
         if let Some(v) = r.get_mut(k) {
@@ -491,28 +498,33 @@ fn check_moved_b<L: Index, I: Index>(
         let now = Shape::of(r);
         shape_rules(rules, &was, &now)?;
         if on::FOLD {
-            for (u, w) in [(old[0], old[1]), (old[1], old[2]), (old[2], old[0])] {
-                // Triangles holding u (for b: a's too), other than t and the removed ones.
-                let mut fold = false;
-                let lists = if u == b { [b, a] } else { [u, NIL] };
-                for l in lists {
-                    if l == NIL {
-                        continue;
-                    }
-                    for (s, _) in mesh.corners(l) {
-                        let tri = mesh.tri(s);
-                        if s == t || (tri.contains(&a) && tri.contains(&b)) {
-                            continue;
-                        }
-                        if tri.iter().any(|&x| merged(x) == w) {
-                            fold |= folded(&now, &shape_moved(mesh, s, a, b, p));
+            let mut fold = false;
+            if let Some((py, ps)) = prev {
+                fold |= py == x && folded(&ps, &now);
+            }
+            match outer(mesh, t, prev3(k), x, y) {
+                Some(Some(u)) => fold |= folded(&now, &after(u)),
+                Some(None) => {}
+                None => {
+                    for (u, _) in mesh.corners(x) {
+                        if u != t && mesh.tri(u).contains(&y) {
+                            fold |= folded(&now, &after(u));
                         }
                     }
-                }
-                if fold {
-                    return Err(Reject::Fold);
                 }
             }
+            if fold {
+                return Err(Reject::Fold);
+            }
+        }
+        if first.is_none() {
+            first = Some((x, now));
+        }
+        prev = Some((y, now));
+    }
+    if let (true, Some((fx, fs)), Some((ly, ls))) = (on::FOLD, first, prev) {
+        if fx == ly && folded(&fs, &ls) {
+            return Err(Reject::Fold);
         }
     }
     Ok(())
