@@ -529,3 +529,156 @@ fn check_moved_b<L: Index, I: Index>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{is_dead, Positions};
+
+    /// An accordion-folded open grid, `N` x `N` quads: interior vertices of valence 6 whose corner lists
+    /// start at their lowest-numbered triangle, so that most of `b`'s lists start inside the
+    /// fan (a first and a last survivor that share a spoke).
+    const N: usize = 7;
+    const NV: usize = (N + 1) * (N + 1);
+    const NT: usize = 2 * N * N;
+
+    fn grid() -> ([[f32; 3]; NV], [[u16; 3]; NT]) {
+        let mut p = [[0.0f32; 3]; NV];
+        for (i, q) in p.iter_mut().enumerate() {
+            let (x, y) = ((i % (N + 1)) as f32, (i / (N + 1)) as f32);
+            let h = (i as u32).wrapping_mul(2_654_435_761) >> 16;
+            *q = [
+                x,
+                y,
+                // Ridges along y (an accordion: steep dihedrals, so that a moved triangle can
+                // fold against one neighbour and not the others) and a bump per vertex.
+                if i % 2 == 0 { 0.9 } else { -0.9 } + 0.35 * (h as f32 / 65_536.0 - 0.5),
+            ];
+        }
+        let mut t = [[0u16; 3]; NT];
+        for y in 0..N {
+            for x in 0..N {
+                let a = (y * (N + 1) + x) as u16;
+                let (b, c, d) = (a + 1, a + N as u16 + 1, a + N as u16 + 2);
+                t[2 * (y * N + x)] = [a, b, d];
+                t[2 * (y * N + x) + 1] = [a, d, c];
+            }
+        }
+        (p, t)
+    }
+
+    /// Whether one of `b`'s survivors of `a -> b` with `b` at `p` folds against any other
+    /// triangle that shares an edge with it after the collapse: a search of every triangle,
+    /// what [`check_moved_b`]'s fan-order lookups (and [`check`]'s across `b-o1`, `b-o2`)
+    /// stand for.
+    fn folds_by_search(mesh: &Mesh<'_, u16, u16>, a: usize, b: usize, p: V3) -> bool {
+        let merged = |v: usize| if v == a { b } else { v };
+        let survives = |t: usize| {
+            let s = mesh.tri(t);
+            let removed = s.contains(&a) && s.contains(&b);
+            !is_dead(s) && !removed
+        };
+        for t in 0..mesh.triangle_count() {
+            let old = mesh.tri(t);
+            if !survives(t) || !old.contains(&b) || old.contains(&a) {
+                continue;
+            }
+            let now = shape_moved(mesh, t, a, b, p);
+            for (u, w) in [(old[0], old[1]), (old[1], old[2]), (old[2], old[0])] {
+                for s in 0..mesh.triangle_count() {
+                    let m = mesh.tri(s).map(merged);
+                    if s != t
+                        && survives(s)
+                        && m.contains(&u)
+                        && m.contains(&w)
+                        && folded(&now, &shape_moved(mesh, s, a, b, p))
+                    {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// The shape and turn rules alone on `b`'s survivors.
+    fn shapes_allow(mesh: &Mesh<'_, u16, u16>, rules: &Rules, a: usize, b: usize, p: V3) -> bool {
+        mesh.corners(b).all(|(t, _)| {
+            let old = mesh.tri(t);
+            old.contains(&a)
+                || shape_rules(
+                    rules,
+                    &Shape::of(old.map(|v| mesh.p(v))),
+                    &shape_moved(mesh, t, a, b, p),
+                )
+                .is_ok()
+        })
+    }
+
+    /// Optimal placement: on every edge of the grid, in both directions, with the kept vertex
+    /// moved to 26 positions around it, under the shipped limits and under limits loose enough
+    /// for many folds, [`check_placed`] says yes exactly when [`check`] does and `b`'s moved
+    /// triangles keep their shapes and fold against no neighbour found by a search of every
+    /// triangle. Fails when any of `check_moved_b`'s three fold lookups (spoke, outer edge,
+    /// first and last survivor) is left out.
+    #[test]
+    fn moved_b_rules_agree_with_a_search() {
+        let (p, mut t) = grid();
+        let (mut head, mut next, mut flags) = ([0u16; NV], [[0u16; 3]; NT], [0u8; NV]);
+        let (mut s0, mut s1) = ([0u16; NV], [0u16; NV]);
+        let Ok(mesh) = Mesh::build(
+            Positions::Read(&p),
+            &mut t,
+            &mut head,
+            &mut next,
+            &mut flags,
+            (&mut s0, &mut s1),
+        ) else {
+            panic!("the grid builds");
+        };
+        // The shipped limits, and limits so loose that the fold rule has the last word.
+        let mut loose = Config::stored();
+        loose.max_normal_turn_deg = 179.0;
+        loose.min_quality = 0.0;
+        let (mut cases, mut folds) = (0, 0);
+        for rules in [Rules::new(&Config::stored()), Rules::new(&loose)] {
+            for a in 0..NV {
+                for (t0, k) in mesh.corners(a) {
+                    let b = mesh.tri(t0)[next3(k)];
+                    let (pb, l) = (mesh.p(b), math::sub(mesh.p(a), mesh.p(b)));
+                    let l2 = math::dot(l, l);
+                    let l = l2 * math::rsqrt(l2);
+                    for i in 0..54 {
+                        if i % 27 == 13 {
+                            continue;
+                        }
+                        let d = [
+                            (i % 3) as f32 - 1.0,
+                            ((i / 3) % 3) as f32 - 1.0,
+                            ((i / 9) % 3) as f32 - 1.0,
+                        ];
+                        let r = if i < 27 { 0.6 } else { 1.5 };
+                        let at = math::add(pb, math::scale(d, r * l));
+                        if check(&mesh, &rules, a, b, Some(at)).is_err() {
+                            continue;
+                        }
+                        cases += 1;
+                        let fold = folds_by_search(&mesh, a, b, at);
+                        folds += usize::from(fold);
+                        let expected = shapes_allow(&mesh, &rules, a, b, at) && !fold;
+                        assert_eq!(
+                            check_placed(&mesh, &rules, a, b, at).is_ok(),
+                            expected,
+                            "{a} -> {b} at {at:?}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(
+            cases > 1000 && folds > 100,
+            "{cases} cases, {folds} with a fold"
+        );
+        eprintln!("{cases} cases, {folds} with a fold");
+    }
+}
