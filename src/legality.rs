@@ -4,10 +4,10 @@
 //! below fails. The engine keys vertices by cost alone and runs these rules only when a vertex
 //! reaches the top of the queue, on its candidates in cost order. The rules, in the order they
 //! are checked: the cheap flag and boundary tests; then, triangle by triangle of a's fan, the
-//! shape and fold rules; the link condition's walks of both fans last (then the folds across
-//! b's edges to o1 and o2, whose triangles that walk finds), since on flat,
-//! sliver-rich (CAD) meshes most candidates fail a shape rule first (fandisk to 10 %: 20 % fewer
-//! instructions than with the link condition before the shapes). A refusal is counted under the
+//! shape and fold rules; last the link condition's walks of both fans, and the folds across
+//! b's edges to o1 and o2, whose triangles that walk finds. On flat, sliver-rich (CAD) meshes
+//! most candidates fail a shape rule, so they never pay for the walks (fandisk to 10 %: 20 %
+//! fewer instructions than with the link condition first). A refusal is counted under the
 //! first rule that fails, so the order shapes `Report::rejected`, never the verdict.
 //!
 //! | rule       | refuses when                                                        | source |
@@ -266,10 +266,11 @@ fn outer<L: Index, I: Index>(
 }
 
 /// The rules on one surviving triangle `t` (vertices `old`) of a moved vertex's fan (the
-/// vertex in slot `k`, moved to `p`): its own shape and turn, and folds against the survivor before it in fan
-/// order (`prev`: its `y` and shape after the move; a fold across the spoke when that `y` is
-/// this one's `x`) and against the triangle across its outer edge `x-y` (`after`: a
-/// triangle's shape after the collapse). Returns this triangle's shape after the move.
+/// vertex in slot `k`, moved to `p`): its own shape and turn, and folds against the survivor
+/// before it in fan order (`prev`: its `y` and shape after the move; a fold across the spoke
+/// when that `y` is this one's `x`) and against the triangle across its outer edge `x-y`
+/// (`after`: a triangle's shape after the collapse). Returns its shape after the move. Shared
+/// by a's triangles ([`check`]) and b's ([`check_moved_b`]).
 #[inline(always)]
 fn survivor<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
@@ -527,13 +528,13 @@ mod tests {
     use super::*;
     use crate::mesh::{is_dead, Positions};
 
-    /// An accordion-folded open grid, `N` x `N` quads: interior vertices of valence 6 whose corner lists
-    /// start at their lowest-numbered triangle, so that most of `b`'s lists start inside the
-    /// fan (a first and a last survivor that share a spoke).
     const N: usize = 7;
     const NV: usize = (N + 1) * (N + 1);
     const NT: usize = 2 * N * N;
 
+    /// An accordion-folded open grid, `N` x `N` quads: interior vertices of valence 6 whose
+    /// corner lists start at their lowest-numbered triangle, so that most of `b`'s lists start
+    /// inside the fan (a first and a last survivor that share a spoke).
     fn grid() -> ([[f32; 3]; NV], [[u16; 3]; NT]) {
         let mut p = [[0.0f32; 3]; NV];
         for (i, q) in p.iter_mut().enumerate() {
@@ -608,7 +609,7 @@ mod tests {
     }
 
     /// Optimal placement: on every edge of the grid, in both directions, with the kept vertex
-    /// moved to 26 positions around it, under the shipped limits and under limits loose enough
+    /// moved to 52 positions around it (26 directions, two distances), under the shipped limits and under limits loose enough
     /// for many folds, [`check_placed`] says yes exactly when [`check`] does and `b`'s moved
     /// triangles keep their shapes and fold against no neighbour found by a search of every
     /// triangle. Fails when any of `check_moved_b`'s three fold lookups (spoke, outer edge,
