@@ -1,5 +1,6 @@
-//! The words of README.md, the scripts and the sources: citations and figures that were wrong
-//! once (issue 11, items 11 and 12) must not come back.
+//! The words of README.md, docs/, the scripts and the sources: citations and figures that were
+//! wrong once must not come back; the README stays a short front door; every relative link in
+//! the documentation resolves; and the published crate holds the library and nothing else.
 
 use std::path::{Path, PathBuf};
 
@@ -48,7 +49,7 @@ fn texts() -> Vec<(String, String)> {
     out
 }
 
-/// Item 11: seed 000 is Cheng, Pan and Shi (not Hoppe), seed 001 is Zhu, Wang and Meng (not
+/// Seed 000 is Cheng, Pan and Shi (not Hoppe), seed 001 is Zhu, Wang and Meng (not
 /// Garland-Heckbert); the link condition is seed 000 §3.2(1).
 #[test]
 fn seed_citations() {
@@ -86,7 +87,7 @@ fn seed_citations() {
     assert!(read("host-sim/src/metro.rs").contains("Zhu, Wang and Meng"));
 }
 
-/// Item 12: stale or overstated lines.
+/// Stale or overstated lines.
 #[test]
 fn stale_lines() {
     let test_sh = read("scripts/test.sh");
@@ -107,14 +108,19 @@ fn stale_lines() {
             "{name} mentions a Mesh::normal_of"
         );
     }
-    let readme = read("README.md");
-    assert!(!readme.contains("feature is never removed."));
-    assert!(readme.contains("never removed while it is one"));
-    let fuzz_row = readme.lines().find(|l| l.contains("6 714 088")).unwrap();
+    for (name, text) in texts() {
+        assert!(
+            !text.contains("feature is never removed."),
+            "{name}: a feature is only kept while it is one"
+        );
+    }
+    assert!(read("docs/algorithm.md").contains("never removed while it is one"));
+    let fuzzing = read("docs/fuzzing.md");
+    let fuzz_row = fuzzing.lines().find(|l| l.contains("6 714 088")).unwrap();
     assert!(fuzz_row.contains("interrupted"), "{fuzz_row}");
 }
 
-/// Items 9 and 10: the README shows the workspace as a `static`, says what static_cell needs on
+/// The README shows the workspace as a `static`, says what static_cell needs on
 /// thumbv6m, and points at the runnable firmware example that scripts/test.sh runs.
 #[test]
 fn firmware_advice_and_example() {
@@ -138,10 +144,10 @@ fn firmware_advice_and_example() {
     assert!(test_sh.contains("--example simplify_in_flash --target thumbv7em-none-eabihf"));
 }
 
-/// Item 13: the README names the cases the soft-float cores skip, as qemu.rs lists them.
+/// docs/devices.md names the cases the soft-float cores skip, as qemu.rs lists them.
 #[test]
-fn readme_names_the_expected_skips() {
-    let readme = read("README.md");
+fn devices_doc_names_the_expected_skips() {
+    let readme = read("docs/devices.md");
     let qemu = read("host-sim/src/qemu.rs");
     for (list, board) in [("MICROBIT_SKIPS", "Cortex-M0"), ("LM3S_SKIPS", "Cortex-M3")] {
         let line = qemu
@@ -157,4 +163,153 @@ fn readme_names_the_expected_skips() {
             );
         }
     }
+}
+
+/// The README is a front door: short, and no log (dates, issue numbers, seed labels). The pages
+/// of docs/ carry no dates or issue numbers either.
+#[test]
+fn readme_is_a_front_door() {
+    let readme = read("README.md");
+    let lines = readme.lines().count();
+    assert!(lines <= 250, "README.md has {lines} lines (at most 250)");
+    let mut pages = vec![("README.md".to_string(), readme)];
+    for (name, text) in texts() {
+        if name.contains("/docs/") && name.ends_with(".md") {
+            pages.push((name, text));
+        }
+    }
+    for (name, text) in &pages {
+        for bad in ["2026", "seed 0", "this session", "this round"] {
+            assert!(!text.contains(bad), "{name} says {bad:?}");
+        }
+        let lower = text.to_lowercase();
+        for (i, _) in lower.match_indices("issue ") {
+            let next = lower[i + 6..].chars().next();
+            assert!(
+                !next.is_some_and(|c| c.is_ascii_digit()),
+                "{name} names an issue number: {}",
+                &text[i..(i + 12).min(text.len())]
+            );
+        }
+    }
+    // The two commands a newcomer runs first, at the very top.
+    let top: Vec<&str> = pages[0].1.lines().take(12).collect();
+    assert!(
+        top.contains(&"cargo run -p host-sim --release -- demo"),
+        "{top:?}"
+    );
+    assert!(top.contains(&"scripts/test.sh"), "{top:?}");
+    // Every Cargo feature of the library is explained.
+    let manifest = read("Cargo.toml");
+    let features = &manifest[manifest.find("[features]").unwrap()..];
+    let features = &features[..features.find("\n[").unwrap()];
+    for line in features.lines().skip(1) {
+        if let Some((name, _)) = line.split_once(" = ") {
+            if name != "default" && !name.starts_with('#') {
+                assert!(pages[0].1.contains(&format!("`{name}`")), "feature {name}");
+            }
+        }
+    }
+}
+
+/// GitHub's anchor for a heading: lower case, punctuation dropped, spaces as hyphens.
+fn anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every relative link of README.md and docs/*.md names a file that exists, and a `#part` of a
+/// Markdown file names one of its headings.
+#[test]
+fn documentation_links_resolve() {
+    let mut pages = vec![root().join("README.md")];
+    for e in std::fs::read_dir(root().join("docs")).unwrap().flatten() {
+        if e.path().extension().is_some_and(|x| x == "md") {
+            pages.push(e.path());
+        }
+    }
+    let mut links = 0;
+    for page in &pages {
+        let text = std::fs::read_to_string(page).unwrap();
+        let dir = page.parent().unwrap();
+        for (i, _) in text.match_indices("](") {
+            let rest = &text[i + 2..];
+            let target = &rest[..rest.find(')').unwrap()];
+            if target.starts_with("http") {
+                continue;
+            }
+            links += 1;
+            let (file, part) = target.split_once('#').unwrap_or((target, ""));
+            let path = if file.is_empty() {
+                page.clone()
+            } else {
+                dir.join(file)
+            };
+            assert!(path.exists(), "{}: no file {target}", page.display());
+            if !part.is_empty() {
+                let doc = std::fs::read_to_string(&path).unwrap();
+                let found = doc
+                    .lines()
+                    .filter(|l| l.starts_with('#'))
+                    .any(|l| anchor(l.trim_start_matches('#')) == part);
+                assert!(found, "{}: no heading for {target}", page.display());
+            }
+        }
+    }
+    assert!(links > 30, "only {links} links checked");
+}
+
+/// `cargo package` ships the library, its README and both licences, and none of the harness,
+/// fuzzing, tests, benchmarks or docs.
+#[test]
+fn the_package_holds_the_library_only() {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args([
+            "package",
+            "--list",
+            "--allow-dirty",
+            "--no-verify",
+            "-p",
+            "tinydecimate",
+        ])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let list = String::from_utf8(out.stdout).unwrap();
+    let files: Vec<&str> = list.lines().collect();
+    for needed in [
+        "src/lib.rs",
+        "src/workspace.rs",
+        "Cargo.toml",
+        "README.md",
+        "LICENSE-MIT",
+        "LICENSE-APACHE",
+    ] {
+        assert!(files.contains(&needed), "{needed} missing: {files:?}");
+    }
+    for f in &files {
+        for dir in [
+            "host-sim/",
+            "fuzz/",
+            "tests/",
+            "bench/",
+            "docs/",
+            "examples/",
+            "scripts/",
+        ] {
+            assert!(!f.starts_with(dir), "{f} is packaged");
+        }
+    }
+    assert!(!stderr.contains("warning"), "{stderr}");
 }
