@@ -34,9 +34,11 @@ set +e
 "${qemu[@]}" | "$defmt_print" -e "$elf"
 status=("${PIPESTATUS[@]}")
 set -e
-if [ "${status[0]}" = 124 ]; then
-  echo "qemu-runner.sh: killed QEMU after ${QEMU_TIMEOUT:-60} s" >&2
-fi
+case ${status[0]} in
+  124) echo "qemu-runner.sh: killed QEMU after ${QEMU_TIMEOUT:-60} s" >&2 ;;
+  134) echo "qemu-runner.sh: QEMU aborted (a lockup: no vector table without -Tlink.x in" \
+    ".cargo/config.toml, or a memory.x that is not the board's)" >&2 ;;
+esac
 if [ "${status[0]}" = 0 ] && [ "${status[1]}" != 0 ]; then
   exit "${status[1]}" # the firmware succeeded but its log could not be decoded
 fi
