@@ -7,10 +7,12 @@
 #   4. streaming clustering of a mesh larger than RAM (the Stanford bunny, 69 451 triangles,
 #      read through semihosting on the 16 KB micro:bit) on the host and the five cores, both
 #      backends, against tests/golden/cluster.toml's golden files;
-#   5. the firmware example (examples/cortex-m4f) under QEMU, as its README line runs it.
+#   5. the firmware example (examples/cortex-m4f) under QEMU, as its README line runs it, in
+#      the repository and copied out of it as a project template.
 # The link-time proof that no panic path is left in the library (tests/no-panic/check.sh), the
 # fuzz smoke run and Miri are not run here: CI runs them after this script (see .ci/run).
-# It installs the rustup targets it needs; QEMU comes from `apt-get install qemu-system-arm`.
+# It installs the rustup targets it needs and defmt-print (the example's defmt decoder); QEMU
+# comes from `apt-get install qemu-system-arm`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,6 +29,7 @@ if ! command -v qemu-system-arm >/dev/null; then
     exit 2
   fi
 fi
+command -v defmt-print >/dev/null || cargo install defmt-print --locked
 
 echo "== host tests"
 cargo test --workspace --release
@@ -48,3 +51,6 @@ example_log=$(cd examples/cortex-m4f && cargo run -q --release --example simplif
 echo "$example_log"
 grep -q "in flash at 0x" <<<"$example_log"
 grep -q "target_reached: true" <<<"$example_log"
+
+echo "== the firmware example as a project template: copied out of the repository, built and run under QEMU"
+bash examples/cortex-m4f/check-template.sh

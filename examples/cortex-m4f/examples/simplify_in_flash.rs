@@ -4,14 +4,14 @@
 //! In QEMU (mps2-an386), from this folder, with `qemu-system-arm` installed:
 //!
 //! ```text
-//! cargo run --release --example simplify_in_flash --target thumbv7em-none-eabihf
+//! cargo run --release --example simplify_in_flash
 //! ```
 //!
-//! The runner in `.cargo/config.toml` starts QEMU through `host-sim run-elf`, which decodes
-//! the defmt log with this image's table and exits with the firmware's exit code (0: the target
-//! was reached). On a real board, switch to the commented probe-rs runner in the same file and
-//! to that board's `memory.x` (see build.rs); with probe-rs, defmt-rtt is the usual transport
-//! instead of defmt-semihosting (see Cargo.toml).
+//! The runner in `.cargo/config.toml` (qemu-runner.sh) starts QEMU and decodes the defmt log
+//! with defmt-print and this image's table; it exits with the firmware's exit code (0: the
+//! target was reached). On a real board, switch to the commented probe-rs runner in the same
+//! file and to that board's `memory.x`; with probe-rs, defmt-rtt is the usual transport instead
+//! of defmt-semihosting (see Cargo.toml).
 
 #![no_std]
 #![no_main]
