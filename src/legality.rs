@@ -4,9 +4,9 @@
 //! placement) is refused when any rule fails. Each rule is one row of [`RULES`]: the
 //! [`Reject`] it is counted under, its name (the report's label and its build-time switch),
 //! what it protects, its [`Kind`] and its source. The report's counts
-//! ([`Rejections`](crate::Rejections)), the
-//! host tools' reports, the QEMU result files, the golden files, `tests/rules.rs` and
-//! `scripts/rules-off.sh` all read this table; none of them lists the rules again.
+//! ([`Rejections`](crate::Rejections)), the host tools' reports, the QEMU result files, the
+//! golden files, `tests/rules.rs` and `scripts/rules-off.sh` all read this table; none of them
+//! lists the rules again.
 //!
 //! # Kinds
 //!
@@ -53,17 +53,21 @@
 //!
 //! # Adding a rule
 //!
-//! 1. a [`Reject`] variant and its row in [`RULES`], at the same position (a build error
-//!    otherwise);
+//! 1. a [`Reject`] variant and its row in [`RULES`], at the same position (a row out of
+//!    place, or a variant without a row that `on!` names, is a build error);
 //! 2. its function, called where it belongs in the order above, under `on!(Variant)`;
 //! 3. its test: a property of real output it keeps, in `tests/rules.rs`, listed in that file's
 //!    table (a test there fails when a rule of [`RULES`] has no row).
 //!
-//! Everything that counts or prints rejections iterates the table and follows. What else
-//! changes: a rule with a limit needs its [`Config`] field, checked in `Config::validate`
-//! under a new `ConfigField`, and carried by the QEMU case file if the golden cases set it;
-//! the QEMU result file has room for 16 rules (`meshfmt::REJECTION_SLOTS`); and the golden
-//! files' `.txt` show one more count, so they are re-blessed (`host-sim golden --bless`).
+//! Everything that counts or prints rejections iterates the table and follows: the report,
+//! `host-sim simplify` and `bench`, the QEMU result file (room for 16 rules,
+//! `meshfmt::REJECTION_SLOTS`), the golden files' text and `scripts/rules-off.sh`. What else
+//! changes, only when it applies: a rule with a limit needs its [`Config`] field, checked in
+//! `Config::validate` under a new `ConfigField`, and a field of the QEMU case file if golden
+//! cases set it; a rule on vertex flags (like `locked` and `feature`) also belongs in the
+//! queue's filters in `collapse` (`skip`, `rekey`), which keep such vertices out of the queue;
+//! and the golden files' `.txt` show one more count, so they are re-blessed once
+//! (`host-sim golden --bless`; the `.bin` outputs change only if the rule refuses something).
 
 use crate::index::Index;
 use crate::math::{self, V3};
@@ -123,18 +127,6 @@ pub enum Kind {
     Quality,
     /// A guarantee the caller asks for (the error bound).
     Guarantee,
-}
-
-impl Kind {
-    /// A short label: `validity`, `validity+quality`, `quality` or `guarantee`.
-    pub const fn label(self) -> &'static str {
-        match self {
-            Kind::Validity => "validity",
-            Kind::ValidityAndQuality => "validity+quality",
-            Kind::Quality => "quality",
-            Kind::Guarantee => "guarantee",
-        }
-    }
 }
 
 /// One legality rule: a row of [`RULES`].
