@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Shows that the test suite notices the loss of each legality rule (src/legality.rs).
 #
-# Builds the library with TINYDECIMATE_RULE_OFF set to each rule in turn (cargo rebuilds the
-# crate when the variable changes) and runs a fast subset of the tests, which must then FAIL;
-# and once with every rule on, which must pass. Prints `rule | failing tests | verdict` and
+# Builds the library with TINYDECIMATE_RULE_OFF set to each rule of its table in turn (cargo
+# rebuilds the crate when the variable changes) and runs a fast subset of the tests, which must
+# then FAIL; and once with every rule on, which must pass. Prints `rule | failing tests | verdict` and
 # exits non-zero if the all-rules run fails or any rule's removal goes unnoticed.
 #
 #   scripts/rules-off.sh                 # every rule
@@ -12,7 +12,13 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-all_rules=(locked feature boundary link duplicate sliver normal_turn fold bound)
+# The rules' names, read from their one table (`RULES` in src/legality.rs: a row's
+# `name: "..."` line); a name the table does not hold is a build error, not a silent pass.
+read -r -a all_rules <<<"$(sed -n 's/^ *name: "\([a-z_]*\)",$/\1/p' src/legality.rs | paste -sd' ' -)"
+if [ ${#all_rules[@]} -eq 0 ]; then
+  echo "no rule names found in src/legality.rs (RULES)" >&2
+  exit 2
+fi
 rules=("$@")
 [ ${#rules[@]} -eq 0 ] && rules=("${all_rules[@]}")
 # The subset: the rule tests (tests/rules.rs, one or more per rule, all asserting properties of

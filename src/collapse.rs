@@ -201,7 +201,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             Some(p) => legality::check_placed(&self.mesh, &self.rules, from, to, p)?,
             None => legality::check(&self.mesh, &self.rules, from, to, None)?,
         }
-        if B::ON && on::BOUND {
+        if B::ON && on!(Bound) {
             if let Some(c) = self.bound.controls() {
                 if !c.allows(&self.mesh, from, to) {
                     return Err(crate::Reject::Bound);
@@ -594,7 +594,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         let ff = mesh.flags(from);
         legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
         let mut retreat2 = 0.0;
-        if ff & flag::BOUNDARY != 0 && on::BOUNDARY {
+        if ff & flag::BOUNDARY != 0 && on!(Boundary) {
             // Only along its own boundary edges; the boundary retreats to the segment from
             // its other boundary neighbour to `to`.
             let (x1, x2) = w.ends;
@@ -735,13 +735,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             // Priced in full below: the key is a lower bound again.
             self.mesh.set_flag(v, flag::RAISED, false);
         }
-        if f & flag::USED == 0 || (on::LOCKED && f & flag::LOCKED != 0) {
+        if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
         }
         let w = self.walk(v);
         let is = self.config.features && self.is_feature_now(&w);
         self.mesh.set_flag(v, flag::FEATURE, is);
-        if is && on::FEATURE {
+        if is && on!(Feature) {
             return self.heap.remove(v);
         }
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
@@ -852,13 +852,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// locked vertices are not queued: their triangles are reached from their other vertices).
     fn rekey_triangles(&mut self, v: usize) {
         let f = self.mesh.flags(v);
-        if f & flag::USED == 0 || (on::LOCKED && f & flag::LOCKED != 0) {
+        if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
         }
         let w = self.walk(v);
         let is = self.config.features && self.is_feature_now(&w);
         self.mesh.set_flag(v, flag::FEATURE, is);
-        if is && on::FEATURE {
+        if is && on!(Feature) {
             return self.heap.remove(v);
         }
         let mut key = f32::INFINITY;
@@ -1239,9 +1239,9 @@ fn cand_less(a: (f32, usize, usize), b: (f32, usize, usize)) -> bool {
     a.0 < b.0 || (a.0 == b.0 && (a.1, a.2) < (b.1, b.2))
 }
 
-/// Flags that keep a vertex from moving (with the legality switches of `legality::on`).
+/// Flags that keep a vertex from moving (with the legality switches, `legality::on!`).
 const fn skip() -> u8 {
-    (if on::LOCKED { flag::LOCKED } else { 0 }) | (if on::FEATURE { flag::FEATURE } else { 0 })
+    (if on!(Locked) { flag::LOCKED } else { 0 }) | (if on!(Feature) { flag::FEATURE } else { 0 })
 }
 
 /// `(cost, vertex)` order: cheaper first, then the lower vertex number.

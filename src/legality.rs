@@ -1,25 +1,40 @@
-//! Which collapses keep the mesh valid.
+//! Which collapses keep the mesh valid: the legality rules, declared once, in [`RULES`].
 //!
-//! A half-edge collapse `a -> b` (a moves onto b, b stays where it is) is refused when any rule
-//! below fails. The engine keys vertices by cost alone and runs these rules only when a vertex
-//! reaches the top of the queue, on its candidates in cost order. The rules, in the order they
-//! are checked: the cheap flag and boundary tests; then, triangle by triangle of a's fan, the
-//! shape and fold rules; last the link condition's walks of both fans, and the folds across
-//! b's edges to o1 and o2, whose triangles that walk finds. On flat, sliver-rich (CAD) meshes
-//! most candidates fail a shape rule, so they never pay for the walks (fandisk to 10 %: 20 %
-//! fewer instructions than with the link condition first). A refusal is counted under the
-//! first rule that fails, so the order shapes `Report::rejected`, never the verdict.
+//! A half-edge collapse `a -> b` (a moves onto b, b stays where it is, or moves to the cost's
+//! placement) is refused when any rule fails. Each rule is one row of [`RULES`]: the
+//! [`Reject`] it is counted under, its name (the report's label and its build-time switch),
+//! what it protects, its [`Kind`] and its source. The report's counts
+//! ([`Rejections`](crate::Rejections)), the host tools' reports, the QEMU result files, the
+//! golden files, `tests/rules.rs` and `scripts/rules-off.sh` all read this table; none of them
+//! lists the rules again.
 //!
-//! | rule       | refuses when                                                        | source |
-//! |------------|---------------------------------------------------------------------|--------|
-//! | `Locked`   | a or b is on a non-manifold edge, a pinched fan or an inconsistently wound edge | seed 000 §3.1 (irregular vertices) |
-//! | `Feature`  | a is a feature vertex; or b is, unless feature targets are allowed  | seed 004 §3.3 |
-//! | `Boundary` | a is on the boundary and a-b is not a boundary edge; or the boundary loop through a-b has only three edges | seed 000 §3.2(1), second and third conditions |
-//! | `Duplicate`| a triangle of a would become a copy of one of b's                    | |
-//! | `Sliver`   | a surviving triangle gets zero area, or a quality below the limit that is also worse than before | |
-//! | `NormalTurn` | a surviving triangle's normal turns by more than the limit       | seed 000 §3.2(2), the dihedral threshold β |
-//! | `Fold`     | a surviving triangle and a neighbour across any of its edges end up with nearly opposite normals | seed 000 §3.2(2) |
-//! | `Link`     | a vertex adjacent to both a and b is not opposite a-b (the surface would pinch) | seed 000 §3.2(1), first condition |
+//! # Kinds
+//!
+//! - **validity** (`locked`, `boundary`, `link`, `duplicate`, `fold`): without the rule the
+//!   output can stop being a valid mesh of the same topology (a non-manifold edge, a pinched
+//!   vertex, a duplicate or folded triangle, a boundary loop closed or left).
+//! - **validity and quality** (`sliver`): a triangle of zero area is always refused
+//!   (validity); one whose quality falls below [`Config::min_quality`] is refused only when it
+//!   also got worse (a preference).
+//! - **quality** (`feature`, `normal_turn`): the output stays valid without them; they keep
+//!   the feature vertices of Lin Mouguang 2007 and bound how far a triangle may turn in one
+//!   collapse ([`Config::max_normal_turn_deg`]).
+//! - **guarantee** (`bound`): the error bound of Zhu, Wang and Meng 2007, a promise the caller
+//!   asks for ([`Config::max_error`]); checked after the others, in `collapse`, and only on the
+//!   bounded entry points (see [`crate::bound`]).
+//!
+//! # Order
+//!
+//! The engine keys vertices by cost alone and runs the rules only when a vertex reaches the
+//! top of the queue, on its candidates in cost order. The rules, in the order they are
+//! checked: the cheap flag tests (`locked`, `feature`) and `boundary`; then, triangle by
+//! triangle of a's fan, `duplicate`, `sliver`, `normal_turn` and `fold`; last the link
+//! condition's walks of both fans (`link`), the folds across b's edges to o1 and o2, whose
+//! triangles that walk finds, and the error bound. On flat, sliver-rich (CAD) meshes most
+//! candidates fail a shape rule, so they never pay for the walks (fandisk to 10 %: 20 % fewer
+//! instructions than with the link condition first). A refusal is counted under the first
+//! rule that fails, so the order shapes [`Report::rejected`](crate::Report::rejected), never
+//! the verdict. The table's order is the report's, not the checking order.
 //!
 //! Interior vertices may move onto boundary vertices (the boundary does not change), never the
 //! reverse. Together with the link condition this keeps a closed manifold closed, keeps the
@@ -27,48 +42,254 @@
 //!
 //! No square root anywhere: angles are compared as `dot² ≶ cos²·|n₁|²·|n₂|²` on normals scaled
 //! by powers of two (exact), which is both cheaper and scale-safe.
+//!
+//! # Switching a rule off
+//!
+//! Building with the environment variable `TINYDECIMATE_RULE_OFF` set to one rule's name
+//! switches that rule off, so that `scripts/rules-off.sh` (which reads the names from this
+//! table) can show that the test suite fails without each of them. A name that is not in the
+//! table is a build error. The switches are constants (`on!(Rule)` is `const { .. }` over the
+//! table), so a normal build carries no trace of them.
+//!
+//! # Adding a rule
+//!
+//! 1. a [`Reject`] variant and its row in [`RULES`], at the same position (a row out of
+//!    place, or a variant without a row that `on!` names, is a build error);
+//! 2. its function, called where it belongs in the order above, under `on!(Variant)`;
+//! 3. its test: a property of real output it keeps, in `tests/rules.rs`, listed in that file's
+//!    table (a test there fails when a rule of [`RULES`] has no row).
+//!
+//! Everything that counts or prints rejections iterates the table and follows: the report,
+//! `host-sim simplify` and `bench`, the QEMU result file (room for 16 rules,
+//! `meshfmt::REJECTION_SLOTS`), the golden files' text and `scripts/rules-off.sh`. What else
+//! changes, only when it applies: a rule with a limit needs its [`Config`] field, checked in
+//! `Config::validate` under a new `ConfigField`, and a field of the QEMU case file if golden
+//! cases set it; a rule on vertex flags (like `locked` and `feature`) also belongs in the
+//! queue's filters in `collapse` (`skip`, `rekey`), which keep such vertices out of the queue;
+//! and the golden files' `.txt` show one more count, so they are re-blessed once
+//! (`host-sim golden --bless`; the `.bin` outputs change only if the rule refuses something).
 
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::mesh::{corner, flag, next3, prev3, Mesh, NIL};
-use crate::report::Reject;
 use crate::{Config, Schedule};
 
-/// Which rules are on. All of them, in every normal build. Building with the environment
-/// variable `TINYDECIMATE_RULE_OFF` set to one rule's name (`locked`, `feature`, `boundary`,
-/// `link`, `duplicate`, `sliver`, `normal_turn`, `fold`) switches that rule off, so that
-/// `scripts/rules-off.sh` can show that the test suite fails without each of them. Constants,
-/// so a normal build carries no trace of the switch.
-pub(crate) mod on {
-    const OFF: &str = match option_env!("TINYDECIMATE_RULE_OFF") {
-        Some(s) => s,
-        None => "",
-    };
-    const fn off(name: &str) -> bool {
-        let (a, b) = (OFF.as_bytes(), name.as_bytes());
-        if a.len() != b.len() {
+/// Why a candidate collapse was refused: one variant per rule, in the order of [`RULES`],
+/// whose row says what the rule protects. The engine counts each in
+/// [`Rejections`](crate::Rejections).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Reject {
+    /// An endpoint is locked.
+    Locked,
+    /// An endpoint is a feature vertex.
+    Feature,
+    /// A boundary rule fails.
+    Boundary,
+    /// The link condition fails.
+    Link,
+    /// The collapse would create a triangle that already exists.
+    Duplicate,
+    /// A remaining triangle's normal would turn too far.
+    NormalTurn,
+    /// A triangle would become zero-area or a sliver.
+    Sliver,
+    /// Two adjacent triangles would fold onto each other.
+    Fold,
+    /// A control point would end too far from the new fan.
+    Bound,
+}
+
+impl Reject {
+    /// How many rules there are: the length of [`RULES`].
+    pub const COUNT: usize = RULES.len();
+
+    /// This rule's row of [`RULES`].
+    pub const fn rule(self) -> &'static Rule {
+        &RULES[self as usize]
+    }
+
+    /// This rule's name ([`Rule::name`]).
+    pub const fn name(self) -> &'static str {
+        self.rule().name
+    }
+}
+
+/// What a rule is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A hard rule: without it the output can stop being a valid mesh of the same topology.
+    Validity,
+    /// A validity part and a preference: zero area is always refused, a quality below the
+    /// limit only when it got worse.
+    ValidityAndQuality,
+    /// A preference: the output stays valid without it.
+    Quality,
+    /// A guarantee the caller asks for (the error bound).
+    Guarantee,
+}
+
+/// One legality rule: a row of [`RULES`].
+#[derive(Clone, Copy, Debug)]
+pub struct Rule {
+    /// What a refusal by this rule is counted under; its position in [`RULES`].
+    pub reject: Reject,
+    /// The rule's name: its label in reports and files, and its build-time switch
+    /// (`TINYDECIMATE_RULE_OFF=<name>`).
+    pub name: &'static str,
+    /// When it refuses a collapse, and so what it protects.
+    pub protects: &'static str,
+    /// Hard validity rule, quality preference or guarantee.
+    pub kind: Kind,
+    /// Where the rule comes from (empty: this library's own).
+    pub source: &'static str,
+}
+
+/// The legality rules, one row each, in the order of [`Reject`] (the report's order; the
+/// checking order is in the module documentation).
+pub const RULES: &[Rule] = &[
+    Rule {
+        reject: Reject::Locked,
+        name: "locked",
+        protects: "a or b is on a non-manifold edge, a pinched fan or an inconsistently wound \
+                   edge: such parts of the input stay as they are",
+        kind: Kind::Validity,
+        source: "Cheng, Pan and Shi §3.1 (irregular vertices)",
+    },
+    Rule {
+        reject: Reject::Feature,
+        name: "feature",
+        protects: "a is a feature vertex, or b is one and feature targets are not allowed: \
+                   features survive",
+        kind: Kind::Quality,
+        source: "Lin Mouguang 2007 §3.3",
+    },
+    Rule {
+        reject: Reject::Boundary,
+        name: "boundary",
+        protects: "a is on the boundary and a-b is not a boundary edge, or the boundary loop \
+                   through a-b has only three edges: boundaries only shrink along themselves",
+        kind: Kind::Validity,
+        source: "Cheng, Pan and Shi §3.2(1), second and third conditions",
+    },
+    Rule {
+        reject: Reject::Link,
+        name: "link",
+        protects: "a vertex adjacent to both a and b is not opposite a-b: the surface would \
+                   pinch or gain a non-manifold edge",
+        kind: Kind::Validity,
+        source: "Cheng, Pan and Shi §3.2(1), first condition (the link condition)",
+    },
+    Rule {
+        reject: Reject::Duplicate,
+        name: "duplicate",
+        protects: "a triangle of a would become a copy of one of b's",
+        kind: Kind::Validity,
+        source: "",
+    },
+    Rule {
+        reject: Reject::NormalTurn,
+        name: "normal_turn",
+        protects: "a surviving triangle's normal turns by more than \
+                   Config::max_normal_turn_deg",
+        kind: Kind::Quality,
+        source: "Cheng, Pan and Shi §3.2(2), the dihedral threshold",
+    },
+    Rule {
+        reject: Reject::Sliver,
+        name: "sliver",
+        protects: "a surviving triangle gets zero area (validity), or a quality below \
+                   Config::min_quality that is also worse than before (preference)",
+        kind: Kind::ValidityAndQuality,
+        source: "",
+    },
+    Rule {
+        reject: Reject::Fold,
+        name: "fold",
+        protects: "a surviving triangle and a neighbour across any of its edges end up with \
+                   nearly opposite normals (more than about 154° apart)",
+        kind: Kind::Validity,
+        source: "Cheng, Pan and Shi §3.2(2)",
+    },
+    Rule {
+        reject: Reject::Bound,
+        name: "bound",
+        protects: "a control point would end farther than Config::max_error from every \
+                   triangle of the new fan (bounded entry points only)",
+        kind: Kind::Guarantee,
+        source: "Zhu, Wang and Meng 2007 §3",
+    },
+];
+
+// Row i is `Reject` variant i, and names are distinct (they are switches and labels).
+const _: () = {
+    let mut i = 0;
+    while i < RULES.len() {
+        assert!(
+            RULES[i].reject as usize == i,
+            "RULES is not in the order of Reject"
+        );
+        let mut j = 0;
+        while j < i {
+            assert!(
+                !same(RULES[i].name, RULES[j].name),
+                "two rules share a name"
+            );
+            j += 1;
+        }
+        i += 1;
+    }
+};
+
+/// The rule switched off in this build (`TINYDECIMATE_RULE_OFF`), or `""`.
+const OFF: &str = match option_env!("TINYDECIMATE_RULE_OFF") {
+    Some(s) => s,
+    None => "",
+};
+
+/// Whether two strings are equal (in a `const fn`).
+const fn same(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
             return false;
         }
-        let mut i = 0;
-        while i < a.len() {
-            if a[i] != b[i] {
-                return false;
-            }
-            i += 1;
-        }
-        true
+        i += 1;
     }
-    pub(crate) const LOCKED: bool = !off("locked");
-    pub(crate) const FEATURE: bool = !off("feature");
-    pub(crate) const BOUNDARY: bool = !off("boundary");
-    pub(crate) const LINK: bool = !off("link");
-    pub(crate) const DUPLICATE: bool = !off("duplicate");
-    pub(crate) const SLIVER: bool = !off("sliver");
-    pub(crate) const NORMAL_TURN: bool = !off("normal_turn");
-    pub(crate) const FOLD: bool = !off("fold");
-    /// The error bound's veto (control points, `crate::bound`).
-    pub(crate) const BOUND: bool = !off("bound");
+    true
 }
+
+// A switch that names no rule would silently test nothing.
+const _: () = {
+    let mut known = OFF.is_empty();
+    let mut i = 0;
+    while i < RULES.len() {
+        known |= same(OFF, RULES[i].name);
+        i += 1;
+    }
+    assert!(
+        known,
+        "TINYDECIMATE_RULE_OFF names no rule of legality::RULES"
+    );
+};
+
+/// Whether rule `r` is on in this build: every rule, unless `TINYDECIMATE_RULE_OFF` names it.
+/// Used through [`on!`], which evaluates it at compile time.
+pub(crate) const fn is_on(r: Reject) -> bool {
+    !same(OFF, r.name())
+}
+
+/// `on!(Fold)`: whether the rule of `Reject::Fold` is on in this build, a constant.
+macro_rules! on {
+    ($rule:ident) => {
+        const { $crate::legality::is_on($crate::Reject::$rule) }
+    };
+}
+pub(crate) use on;
 
 /// Two adjacent triangles whose unit normals have a dot product below −0.9 are folded onto
 /// each other (more than about 154° apart); compared squared: 0.81.
@@ -175,13 +396,13 @@ fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
 /// `now` after it.
 #[inline]
 fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
-    if on::SLIVER
+    if on!(Sliver)
         && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
     {
         return Err(Reject::Sliver);
     }
     // A zero-area triangle has no direction to turn from.
-    if on::NORMAL_TURN && was.quality > 0.0 && turned(was, now, rules.cos_turn, rules.cos_turn2) {
+    if on!(NormalTurn) && was.quality > 0.0 && turned(was, now, rules.cos_turn, rules.cos_turn2) {
         return Err(Reject::NormalTurn);
     }
     Ok(())
@@ -203,10 +424,10 @@ fn shape_of<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, t: usize) -> Shape {
 /// The flag rules alone: whether `a` may move at all, and onto a vertex with flags `fb`.
 #[inline]
 pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
-    if fa & fb & flag::USED == 0 || (on::LOCKED && (fa | fb) & flag::LOCKED != 0) {
+    if fa & fb & flag::USED == 0 || (on!(Locked) && (fa | fb) & flag::LOCKED != 0) {
         return Err(Reject::Locked);
     }
-    if on::FEATURE
+    if on!(Feature)
         && (fa & flag::FEATURE != 0 || (fb & flag::FEATURE != 0 && !rules.feature_targets))
     {
         return Err(Reject::Feature);
@@ -289,7 +510,7 @@ fn survivor<L: Index, I: Index>(
     let was = Shape::of(q);
     let now = Shape::of(r);
     shape_rules(rules, &was, &now)?;
-    if on::FOLD {
+    if on!(Fold) {
         let mut fold = false;
         if let Some((py, ps)) = prev {
             fold |= py == x && folded(&ps, &now);
@@ -346,13 +567,13 @@ pub(crate) fn check<L: Index, I: Index>(
     if n_ab == 0 {
         return Err(Reject::Link);
     }
-    if on::LOCKED && n_ab > 2 {
+    if on!(Locked) && n_ab > 2 {
         return Err(Reject::Locked);
     }
 
     // Boundary: a boundary vertex only slides along its own boundary edge, and a boundary
     // loop of three edges must not close up (or a lone triangle vanish).
-    if fa & flag::BOUNDARY != 0 && on::BOUNDARY {
+    if fa & flag::BOUNDARY != 0 && on!(Boundary) {
         if n_ab != 1 {
             return Err(Reject::Boundary);
         }
@@ -390,7 +611,7 @@ pub(crate) fn check<L: Index, I: Index>(
             continue;
         }
         let (x, y) = (old[next3(k)], old[prev3(k)]);
-        if on::DUPLICATE
+        if on!(Duplicate)
             && ((x == o1 && y == o2) || (x == o2 && y == o1))
             && mesh.corners(b).any(|(u, _)| {
                 let s = mesh.tri(u);
@@ -440,12 +661,12 @@ pub(crate) fn check<L: Index, I: Index>(
         common |= x != b && x != o1 && x != o2 && mesh.has(x, flag::MARK);
     });
     mesh.for_each_neighbour(b, |x| mesh.mark(x, false));
-    if on::LINK && common {
+    if on!(Link) && common {
         return Err(Reject::Link);
     }
 
     // Folds across (b, o1) and (b, o2).
-    if on::FOLD {
+    if on!(Fold) {
         let across = |x: usize, y: usize, now: &Shape| {
             [(o1, across_o1), (o2, across_o2)]
                 .iter()
@@ -456,13 +677,13 @@ pub(crate) fn check<L: Index, I: Index>(
                 return Err(Reject::Fold);
             }
         }
-        if more && on::LOCKED {
+        if more && on!(Locked) {
             // Unreachable while the locked rule is on (see `near`); refused, not guessed at.
             return Err(Reject::Locked);
         }
     }
     // The spoke between the last survivor and the first (a's list is a rotated cycle).
-    if let (true, Some((fx, fs)), Some((ly, ls))) = (on::FOLD, first, prev) {
+    if let (true, Some((fx, fs)), Some((ly, ls))) = (on!(Fold), first, prev) {
         if fx == ly && fx != o1 && fx != o2 && folded(&fs, &ls) {
             return Err(Reject::Fold);
         }
@@ -515,7 +736,7 @@ fn check_moved_b<L: Index, I: Index>(
         }
         prev = Some((y, now));
     }
-    if let (true, Some((fx, fs)), Some((ly, ls))) = (on::FOLD, first, prev) {
+    if let (true, Some((fx, fs)), Some((ly, ls))) = (on!(Fold), first, prev) {
         if fx == ly && folded(&fs, &ls) {
             return Err(Reject::Fold);
         }

@@ -72,7 +72,7 @@ pub mod cost;
 mod feature;
 mod heap;
 mod index;
-mod legality;
+pub mod legality;
 mod math;
 mod mesh;
 pub mod progressive;
@@ -85,8 +85,9 @@ pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
 pub use index::Index;
+pub use legality::{Reject, RULES};
 pub use progressive::Progressive;
-pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
+pub use report::{Rejections, Report, Stop, PASS_LOG};
 pub use workspace::Workspace;
 
 /// The README's Rust examples, compiled and run as doctests.

@@ -1,84 +1,50 @@
-//! What a run did: counts, rejections by reason, why it stopped.
+//! What a run did: counts, rejections by rule, why it stopped.
+
+use crate::legality::{Reject, Rule, RULES};
 
 /// Maximum number of passes whose triangle counts a [`Report`] keeps.
 pub const PASS_LOG: usize = 32;
 
-/// Why a candidate collapse was refused. The engine counts each in [`Rejections`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Reject {
-    /// An endpoint is locked: on a non-manifold edge, a pinched fan or an inconsistently wound
-    /// edge.
-    Locked,
-    /// An endpoint is a feature vertex (seed 004 §3.3).
-    Feature,
-    /// A boundary vertex would leave its boundary, or two boundary vertices are joined across
-    /// the interior, or a boundary loop of three edges would close.
-    Boundary,
-    /// The link condition fails (seed 000 §3.2(1), first condition; Cheng/Pan/Shi): a common neighbour of both endpoints is not
-    /// opposite the edge, so the collapse would pinch the surface.
-    Link,
-    /// The collapse would create a triangle that already exists.
-    Duplicate,
-    /// A remaining triangle's normal would turn by more than the configured limit.
-    NormalTurn,
-    /// A triangle would become zero-area or a sliver below the quality limit.
-    Sliver,
-    /// Two adjacent triangles would fold onto each other (normals nearly opposite).
-    Fold,
-    /// A control point would end farther than [`Config::max_error`](crate::Config::max_error)
-    /// from every triangle of the new fan (seed 001 §3).
-    Bound,
-}
-
-/// Collapses refused, by reason. A candidate is counted once per evaluation, so the figures
-/// say which rule binds most, not how many distinct edges were refused.
+/// Collapses refused, by rule: one count per row of [`RULES`]. A candidate is counted once
+/// per evaluation, under the first rule that refuses it, so the figures say which rule binds
+/// most, not how many distinct edges were refused.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[allow(missing_docs)]
 pub struct Rejections {
-    pub locked: u32,
-    pub feature: u32,
-    pub boundary: u32,
-    pub link: u32,
-    pub duplicate: u32,
-    pub normal_turn: u32,
-    pub sliver: u32,
-    pub fold: u32,
-    pub bound: u32,
+    counts: [u32; Reject::COUNT],
 }
 
 impl Rejections {
     pub(crate) fn count(&mut self, r: Reject) {
-        let c = match r {
-            Reject::Locked => &mut self.locked,
-            Reject::Feature => &mut self.feature,
-            Reject::Boundary => &mut self.boundary,
-            Reject::Link => &mut self.link,
-            Reject::Duplicate => &mut self.duplicate,
-            Reject::NormalTurn => &mut self.normal_turn,
-            Reject::Sliver => &mut self.sliver,
-            Reject::Fold => &mut self.fold,
-            Reject::Bound => &mut self.bound,
-        };
-        *c = c.saturating_add(1);
+        if let Some(c) = self.counts.get_mut(r as usize) {
+            *c = c.saturating_add(1);
+        }
+    }
+
+    /// The refusals counted under `r`.
+    pub fn get(&self, r: Reject) -> u32 {
+        self.counts.get(r as usize).copied().unwrap_or(0)
+    }
+
+    /// Each rule of [`RULES`] with its count, in the table's order.
+    pub fn iter(&self) -> impl Iterator<Item = (&'static Rule, u32)> + '_ {
+        RULES.iter().zip(self.counts.iter().copied())
     }
 
     /// All rejections together.
     pub fn total(&self) -> u32 {
-        [
-            self.locked,
-            self.feature,
-            self.boundary,
-            self.link,
-            self.duplicate,
-            self.normal_turn,
-            self.sliver,
-            self.fold,
-            self.bound,
-        ]
-        .iter()
-        .fold(0u32, |a, b| a.saturating_add(*b))
+        self.counts.iter().fold(0u32, |a, b| a.saturating_add(*b))
+    }
+}
+
+/// `locked 0, feature 3, ..`: every rule's name and count, in the order of [`RULES`].
+impl core::fmt::Display for Rejections {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        for (i, (rule, n)) in self.iter().enumerate() {
+            let sep = if i == 0 { "" } else { ", " };
+            write!(f, "{sep}{} {n}", rule.name)?;
+        }
+        Ok(())
     }
 }
 

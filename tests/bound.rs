@@ -23,7 +23,7 @@ mod common;
 use common::{cube, fin_and_pinch, grid, icosphere, jitter, MeshData, Tri};
 use std::collections::HashMap;
 use tinydecimate::bound::control_len;
-use tinydecimate::{Capacity, Config, ConfigField, Error, Report};
+use tinydecimate::{Capacity, Config, ConfigField, Error, Reject, Report};
 
 type P = [f64; 3];
 
@@ -236,7 +236,9 @@ fn check(name: &str, m: &MeshData, fractions: &[f32], base: Config) -> Vec<usize
         eprintln!(
             "{name}: bound {f} of the diagonal = {bound:.6}: {} -> {} triangles, \
              independent max {worst:.6}, E_max {emax:.6}, E_mean {emean:.6}, {} bound rejections",
-            r.triangles_in, r.triangles_out, r.rejected.bound
+            r.triangles_in,
+            r.triangles_out,
+            r.rejected.get(Reject::Bound)
         );
         assert!(
             worst <= bound + tol,
@@ -361,7 +363,7 @@ fn no_bound_changes_nothing() {
     assert_eq!(plain.triangles, with.triangles);
     assert_eq!(rp.max_error, None);
     assert!(rb.max_error.expect("E_max") > 0.0);
-    assert_eq!(rb.rejected.bound, 0);
+    assert_eq!(rb.rejected.get(Reject::Bound), 0);
 }
 
 #[test]

@@ -1,6 +1,8 @@
-//! One test per legality rule (`src/legality.rs`), each asserting a property of real output
-//! that the rule exists to keep. `scripts/rules-off.sh` builds the library with each rule
-//! switched off in turn (`TINYDECIMATE_RULE_OFF`) and checks that these tests then fail.
+//! One test per legality rule (`tinydecimate::RULES`, in `src/legality.rs`), each asserting a
+//! property of real output that the rule exists to keep. `scripts/rules-off.sh` builds the
+//! library with each rule switched off in turn (`TINYDECIMATE_RULE_OFF`) and checks that these
+//! tests then fail. The table below has one row per rule of `RULES`, in its order, and
+//! `every_rule_has_a_row_and_a_test` fails when a rule has no row or a row names no test.
 //!
 //! | rule          | property                                                                  | test |
 //! |---------------|---------------------------------------------------------------------------|------|
@@ -9,15 +11,16 @@
 //! | `boundary`    | boundaries only shrink along themselves: loops, vertices, no longer length  | `boundaries_keep_loops_vertices_and_length` |
 //! | `link`        | no new pinched vertex or non-manifold edge (shared checker)                 | `no_new_pinch_or_non_manifold_edge` |
 //! | `duplicate`   | no duplicate output triangle (shared checker); redundant with `fold` on output, so also: the tetrahedra's collapses are refused as duplicates (`Report::rejected`) | `no_duplicate_triangles_on_tetrahedral_parts`, `tetrahedra_are_kept_whole_by_the_duplicate_rule` |
-//! | `sliver`      | no operation leaves a zero-area triangle, or one below `min_quality` that got worse | `no_operation_makes_a_sliver` |
 //! | `normal_turn` | no live triangle slot turns by more than `max_normal_turn_deg` in one operation | `no_operation_turns_a_triangle_too_far` |
+//! | `sliver`      | no operation leaves a zero-area triangle, or one below `min_quality` that got worse | `no_operation_makes_a_sliver` |
 //! | `fold`        | no new folded pair, even with the turn limit at 179° (shared checker)       | `no_new_folds_when_only_the_fold_rule_guards` |
+//! | `bound`       | no control point ends farther than `max_error` from the output (an independent f64 measure, in `tests/bound.rs`) | `generated_meshes_stay_within_the_bound`, `fixtures_stay_within_the_bound` |
 
 mod common;
 use std::collections::BTreeSet;
 
 use common::*;
-use tinydecimate::{Config, Report, Schedule};
+use tinydecimate::{Config, Reject, Report, Schedule, RULES};
 
 /// A mesh of `tests/fixtures`.
 fn fixture(name: &str) -> MeshData {
@@ -370,7 +373,7 @@ fn tetrahedra_are_kept_whole_by_the_duplicate_rule() {
             "{what}: every tetrahedron stays"
         );
         assert!(
-            report.rejected.duplicate > 0,
+            report.rejected.get(Reject::Duplicate) > 0,
             "{what}: no collapse refused as a duplicate: {:?}",
             report.rejected
         );
@@ -440,4 +443,56 @@ fn no_new_folds_when_only_the_fold_rule_guards() {
             assert_eq!(verdict(m, &out).new_folded_pairs, 0, "{what}");
         }
     }
+}
+
+/// The table at the top of this file has one row per rule of `RULES`, in its order, and every
+/// test a row names is a test of `tests/`: adding a rule to the library without its test here
+/// fails.
+#[test]
+fn every_rule_has_a_row_and_a_test() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let mut sources = String::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let path = e.unwrap().path();
+        if path.extension().is_some_and(|x| x == "rs") {
+            sources += &std::fs::read_to_string(&path).unwrap();
+        }
+    }
+    let ticked = |cell: &str| -> Vec<String> {
+        cell.split('`')
+            .skip(1)
+            .step_by(2)
+            .map(str::to_string)
+            .collect()
+    };
+    let mut names = Vec::new();
+    for line in include_str!("rules.rs").lines() {
+        let Some(row) = line.strip_prefix("//! | `") else {
+            continue;
+        };
+        let cells: Vec<&str> = row.split(" | ").collect();
+        let name = cells[0].trim().trim_end_matches('`').to_string();
+        let tests = ticked(cells.last().unwrap());
+        assert!(!tests.is_empty(), "rule `{name}` names no test");
+        for t in &tests {
+            assert!(
+                sources.contains(&format!("fn {t}(")),
+                "rule `{name}`: no test `{t}` in tests/"
+            );
+        }
+        names.push(name);
+    }
+    let rules: Vec<&str> = RULES.iter().map(|r| r.name).collect();
+    assert_eq!(names, rules, "the table's rows and RULES");
+    // scripts/rules-off.sh reads the names as the `name: "..."` lines of src/legality.rs.
+    let script: Vec<&str> = include_str!("../src/legality.rs")
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("name: \"")?.strip_suffix("\","))
+        .collect();
+    assert_eq!(script, rules, "the names scripts/rules-off.sh reads");
+    assert!(RULES
+        .iter()
+        .enumerate()
+        .all(|(i, r)| r.reject as usize == i));
+    assert_eq!(Reject::Bound.name(), "bound");
 }

@@ -39,7 +39,7 @@ use std::time::{Duration, Instant};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
-use tinydecimate::{Config, CostKind, Report};
+use tinydecimate::{Config, CostKind, Rejections, Report};
 
 use crate::check::{compare, Validity};
 use crate::io::MeshData;
@@ -262,61 +262,31 @@ impl Method {
     }
 }
 
-/// Refused candidate collapses by reason (the library's `Report::rejected`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-pub struct Rejected {
-    /// All reasons together.
-    pub total: u32,
-    /// An endpoint is locked (non-manifold edge, pinched fan, inconsistent winding).
-    pub locked: u32,
-    /// An endpoint is a feature vertex.
-    pub feature: u32,
-    /// Boundary rules.
-    pub boundary: u32,
-    /// Link condition.
-    pub link: u32,
-    /// Would duplicate a triangle.
-    pub duplicate: u32,
-    /// Normal-turn limit.
-    pub normal_turn: u32,
-    /// Sliver / zero-area limit.
-    pub sliver: u32,
-    /// Fold test.
-    pub fold: u32,
-    /// Error bound (control points).
-    pub bound: u32,
+/// Refused candidate collapses by rule (the library's `Report::rejected`); serialized as
+/// `{"total": n, "<rule>": n, ..}` with the rules' names in the order of `tinydecimate::RULES`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rejected(pub Rejections);
+
+impl Serialize for Rejected {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(1 + tinydecimate::RULES.len()))?;
+        m.serialize_entry("total", &self.0.total())?;
+        for (rule, n) in self.0.iter() {
+            m.serialize_entry(rule.name, &n)?;
+        }
+        m.end()
+    }
 }
 
 impl Rejected {
     fn of(r: &Report) -> Self {
-        let j = &r.rejected;
-        Rejected {
-            total: j.total(),
-            locked: j.locked,
-            feature: j.feature,
-            boundary: j.boundary,
-            link: j.link,
-            duplicate: j.duplicate,
-            normal_turn: j.normal_turn,
-            sliver: j.sliver,
-            fold: j.fold,
-            bound: j.bound,
-        }
+        Rejected(r.rejected)
     }
 
     /// The non-zero counts, largest first (`"boundary 18034, locked 8112"`).
     pub fn text(&self) -> String {
-        let mut v = [
-            ("locked", self.locked),
-            ("feature", self.feature),
-            ("boundary", self.boundary),
-            ("link", self.link),
-            ("duplicate", self.duplicate),
-            ("normal turn", self.normal_turn),
-            ("sliver", self.sliver),
-            ("fold", self.fold),
-            ("bound", self.bound),
-        ];
+        let mut v: Vec<(&str, u32)> = self.0.iter().map(|(rule, n)| (rule.name, n)).collect();
         v.sort_by_key(|x| std::cmp::Reverse(x.1));
         let parts: Vec<String> = v
             .iter()

@@ -728,13 +728,12 @@ impl Golden {
         writeln!(w, "locked_vertices = {}", h.locked_vertices)?;
         writeln!(w, "feature_vertices = {}", h.feature_vertices)?;
         writeln!(w, "passes = {}", h.passes)?;
-        let r = &h.rejected;
-        writeln!(
-            w,
-            "rejected = {{ locked = {}, feature = {}, boundary = {}, link = {}, duplicate = {}, \
-             normal_turn = {}, sliver = {}, fold = {} }}",
-            r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]
-        )?;
+        let rejected: Vec<String> = tinydecimate::RULES
+            .iter()
+            .zip(h.rejected)
+            .map(|(rule, n)| format!("{} = {n}", rule.name))
+            .collect();
+        writeln!(w, "rejected = {{ {} }}", rejected.join(", "))?;
         writeln!(
             w,
             "pass_triangles = {:?}",

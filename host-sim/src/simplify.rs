@@ -531,8 +531,7 @@ pub fn format_report(r: &Report) -> String {
          \x20 feature vertices       {}\n\
          \x20 passes                 {}\n\
          \x20 triangles after pass   [{}]\n\
-         \x20 rejected (total {}): locked {}, feature {}, boundary {}, link {}, duplicate {}, \
-         normal turn {}, sliver {}, fold {}, bound {}{}",
+         \x20 rejected (total {}): {}{}",
         r.triangles_in,
         r.degenerate_dropped,
         r.duplicates_dropped,
@@ -548,15 +547,7 @@ pub fn format_report(r: &Report) -> String {
         r.passes,
         passes.join(", "),
         j.total(),
-        j.locked,
-        j.feature,
-        j.boundary,
-        j.link,
-        j.duplicate,
-        j.normal_turn,
-        j.sliver,
-        j.fold,
-        j.bound,
+        j,
         match (r.max_error, r.mean_error) {
             (Some(a), Some(b)) => format!("\n  E_max, E_mean          {a:.6e}, {b:.6e}"),
             _ => String::new(),
@@ -601,6 +592,11 @@ pub fn simplify_with_progress(
 /// The report as JSON: every field of `Report`.
 pub fn report_json(r: &Report) -> serde_json::Value {
     let j = &r.rejected;
+    let mut rejected = serde_json::Map::new();
+    rejected.insert("total".into(), j.total().into());
+    for (rule, n) in j.iter() {
+        rejected.insert(rule.name.into(), n.into());
+    }
     serde_json::json!({
         "triangles_in": r.triangles_in,
         "degenerate_dropped": r.degenerate_dropped,
@@ -615,18 +611,7 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "feature_vertices": r.feature_vertices,
         "passes": r.passes,
         "pass_triangles": r.pass_triangles.iter().collect::<Vec<_>>(),
-        "rejected": {
-            "total": j.total(),
-            "locked": j.locked,
-            "feature": j.feature,
-            "boundary": j.boundary,
-            "link": j.link,
-            "duplicate": j.duplicate,
-            "normal_turn": j.normal_turn,
-            "sliver": j.sliver,
-            "fold": j.fold,
-            "bound": j.bound,
-        },
+        "rejected": rejected,
         "max_error": r.max_error,
         "mean_error": r.mean_error,
     })

@@ -10,7 +10,7 @@
 //! | offset | type    | field                                                        |
 //! |-------:|---------|--------------------------------------------------------------|
 //! |      0 | [u8; 4] | magic `TDCS`                                                 |
-//! |      4 | u16     | version ([`VERSION`])                                        |
+//! |      4 | u16     | version ([`CASE_VERSION`])                                   |
 //! |      6 | u8      | index type: 2 = `u16`, 4 = `u32` (the triangles' width)      |
 //! |      7 | u8      | schedule: 0 = greedy, 1 = passes                             |
 //! |      8 | u32     | vertex count V                                               |
@@ -32,7 +32,7 @@
 //! |     64 | f32     | positions: V × 3                                             |
 //! |        | u16/u32 | triangles: T × 3                                             |
 //!
-//! # Result file (firmware → host), [`RESULT_HEADER_LEN`] = 256 bytes of header
+//! # Result file (firmware → host), [`RESULT_HEADER_LEN`] = 288 bytes of header
 //!
 //! Bytes `0..COMPARED_LEN` and the triangles are what a golden comparison checks; the
 //! measurement block after them differs per board and is ignored by [`ResultHeader::same_outcome`].
@@ -40,7 +40,7 @@
 //! | offset | type     | field                                                     |
 //! |-------:|----------|-----------------------------------------------------------|
 //! |      0 | [u8; 4]  | magic `TDRS`                                              |
-//! |      4 | u16      | version                                                   |
+//! |      4 | u16      | version ([`RESULT_VERSION`])                              |
 //! |      6 | u8       | index type of the triangles that follow                   |
 //! |      7 | u8       | [`Status`]                                                |
 //! |      8 | u8       | [`ErrorKind`] (status 1) or 0                             |
@@ -50,16 +50,21 @@
 //! |     20 | u32 × 5  | triangles in, degenerate dropped, duplicates dropped, triangles out, target triangles |
 //! |     40 | u8 × 4   | target reached, stop code, pass log length, byte 3 of the positions hash |
 //! |     44 | u32 × 5  | collapses, vertices removed, locked vertices, feature vertices, passes |
-//! |     64 | u32 × 8  | rejections: locked, feature, boundary, link, duplicate, normal turn, sliver, fold |
-//! |     96 | u32 × 32 | triangles after each pass (first `pass log length` used)  |
-//! |    224 | u64      | SysTick ticks around the simplification (measurement)     |
-//! |    232 | u32      | stack bytes used below the caller's frame (measurement)   |
-//! |    236 | u32      | workspace bytes (measurement)                             |
-//! |    240 | u32 × 2  | board capacity: vertices, triangles of this index type    |
-//! |    248 | u32      | stack high-water mark from the stack top (measurement)    |
-//! |    252 | u8       | board id, [`Board`]                                        |
-//! |    253 | [u8; 3]  | reserved                                                  |
-//! |    256 | u16/u32  | triangles: triangles out × 3                              |
+//! |     64 | u32 × 16 | rejections by rule, in the order of the library's `RULES` (`Report::rejected`); unused slots 0 |
+//! |    128 | u32 × 32 | triangles after each pass (first `pass log length` used)  |
+//! |    256 | u64      | SysTick ticks around the simplification (measurement)     |
+//! |    264 | u32      | stack bytes used below the caller's frame (measurement)   |
+//! |    268 | u32      | workspace bytes (measurement)                             |
+//! |    272 | u32 × 2  | board capacity: vertices, triangles of this index type    |
+//! |    280 | u32      | stack high-water mark from the stack top (measurement)    |
+//! |    284 | u8       | board id, [`Board`]                                        |
+//! |    285 | [u8; 3]  | reserved                                                  |
+//! |    288 | u16/u32  | triangles: triangles out × 3                              |
+//!
+//! Result version 3 carries a count for every legality rule, the error bound's included, with
+//! room for 16; version 2 had eight slots and no `bound`. Result files are read as soon as
+//! the firmware writes them (the golden files keep text and triangles, not result headers),
+//! so only the current version is read.
 #![no_std]
 #![forbid(unsafe_code)]
 
@@ -77,14 +82,19 @@ pub mod cluster;
 pub const CASE_MAGIC: [u8; 4] = *b"TDCS";
 /// Result file magic.
 pub const RESULT_MAGIC: [u8; 4] = *b"TDRS";
-/// Format version of both files.
-pub const VERSION: u16 = 2;
+/// Format version of the case file.
+pub const CASE_VERSION: u16 = 2;
+/// Format version of the result file.
+pub const RESULT_VERSION: u16 = 3;
 /// Size of the case header.
 pub const CASE_HEADER_LEN: usize = 64;
 /// Size of the result header.
-pub const RESULT_HEADER_LEN: usize = 256;
+pub const RESULT_HEADER_LEN: usize = 288;
 /// The result header bytes that must match a golden result exactly.
-pub const COMPARED_LEN: usize = 224;
+pub const COMPARED_LEN: usize = 256;
+/// Rejection counts a result file holds: one per legality rule (the library's `RULES`, in its
+/// order), the rest zero; room to add rules without changing the format.
+pub const REJECTION_SLOTS: usize = 16;
 /// Length of the per-pass triangle log (the library's `PASS_LOG`).
 pub const PASS_LOG: usize = 32;
 
@@ -255,7 +265,7 @@ impl CaseHeader {
         let mut b = [0u8; CASE_HEADER_LEN];
         let mut w = W { b: &mut b, at: 0 };
         w.bytes(&CASE_MAGIC);
-        w.u16(VERSION);
+        w.u16(CASE_VERSION);
         w.u8(self.index_type as u8);
         w.u8(self.schedule as u8);
         w.u32(self.vertices);
@@ -282,7 +292,7 @@ impl CaseHeader {
         if r.take::<4>() != CASE_MAGIC {
             return Err(FormatError::Magic);
         }
-        if r.u16() != VERSION {
+        if r.u16() != CASE_VERSION {
             return Err(FormatError::Version);
         }
         let index_type = IndexType::from_code(r.u8()).ok_or(FormatError::Code)?;
@@ -413,8 +423,8 @@ pub struct ResultHeader {
     pub locked_vertices: u32,
     pub feature_vertices: u32,
     pub passes: u32,
-    /// locked, feature, boundary, link, duplicate, normal turn, sliver, fold.
-    pub rejected: [u32; 8],
+    /// Refusals by legality rule, in the order of the library's `RULES`; unused slots 0.
+    pub rejected: [u32; REJECTION_SLOTS],
     pub pass_triangles: [u32; PASS_LOG],
     /// FNV-1a (32 bit) of all positions after the run, little-endian f32 bytes, for cases
     /// whose positions move (stored quadrics, optimal placement); 0 otherwise. Stored in the
@@ -452,7 +462,7 @@ impl ResultHeader {
             locked_vertices: 0,
             feature_vertices: 0,
             passes: 0,
-            rejected: [0; 8],
+            rejected: [0; REJECTION_SLOTS],
             pass_triangles: [0; PASS_LOG],
             positions_hash: 0,
             ticks: 0,
@@ -470,7 +480,7 @@ impl ResultHeader {
         let mut b = [0u8; RESULT_HEADER_LEN];
         let mut w = W { b: &mut b, at: 0 };
         w.bytes(&RESULT_MAGIC);
-        w.u16(VERSION);
+        w.u16(RESULT_VERSION);
         w.u8(self.index_type as u8);
         w.u8(self.status as u8);
         w.u8(self.error_kind as u8);
@@ -517,7 +527,7 @@ impl ResultHeader {
         if r.take::<4>() != RESULT_MAGIC {
             return Err(FormatError::Magic);
         }
-        if r.u16() != VERSION {
+        if r.u16() != RESULT_VERSION {
             return Err(FormatError::Version);
         }
         let index_type = IndexType::from_code(r.u8()).ok_or(FormatError::Code)?;
@@ -614,6 +624,9 @@ pub mod pm;
 pub mod lib {
     use super::*;
     use tinydecimate::{Config, CostKind, Error, FeatureMode, Report, Schedule, Stop};
+
+    // Every rule has its slot in a result file.
+    const _: () = assert!(tinydecimate::RULES.len() <= REJECTION_SLOTS);
 
     /// The configuration a case asks for.
     pub fn config(h: &CaseHeader) -> Config {
@@ -733,17 +746,9 @@ pub mod lib {
                 h.locked_vertices = narrow(r.locked_vertices);
                 h.feature_vertices = narrow(r.feature_vertices);
                 h.passes = r.passes;
-                let j = &r.rejected;
-                h.rejected = [
-                    j.locked,
-                    j.feature,
-                    j.boundary,
-                    j.link,
-                    j.duplicate,
-                    j.normal_turn,
-                    j.sliver,
-                    j.fold,
-                ];
+                for (d, (_, n)) in h.rejected.iter_mut().zip(r.rejected.iter()) {
+                    *d = n;
+                }
                 h
             }
             Err(e) => {
@@ -976,12 +981,15 @@ mod tests {
         h.target_reached = true;
         h.pass_log_len = 3;
         h.pass_triangles[2] = 5;
-        h.rejected[7] = 11;
+        h.rejected[8] = 11;
         h.ticks = 1 << 40;
         h.stack_bytes = 1234;
         h.stack_high_water = 2000;
         let tris = [[1, 2, 3], [100000, 5, 6]];
         let bytes = encode_result(&h, &tris).unwrap();
+        // The ninth rule's count (the error bound's) is at 64 + 8 × 4, inside the compared part.
+        assert_eq!(&bytes[96..100], &11u32.to_le_bytes());
+        assert_eq!(&bytes[4..6], &RESULT_VERSION.to_le_bytes());
         let (h2, t2) = decode_result(&bytes).unwrap();
         assert_eq!(h2, h);
         assert_eq!(t2, tris);
