@@ -36,32 +36,66 @@ use crate::streamcase::StreamCase;
 /// An emulated board.
 #[derive(Clone, Copy, Debug)]
 pub struct Board {
-    /// QEMU machine name, and the firmware's feature `board-<name>`.
+    /// Board name, and the firmware's feature `board-<name>` (the QEMU machine name for the
+    /// Cortex-M boards).
     pub name: &'static str,
     /// The core.
     pub core: &'static str,
     /// Rust target.
     pub target: &'static str,
+    /// QEMU's system emulator for the core ([`QEMU_ARM`], [`QEMU_RISCV32`]).
+    pub qemu: &'static Qemu,
+    /// QEMU `-machine`.
+    pub machine: &'static str,
+    /// More QEMU arguments (RISC-V: no boot firmware, and the core without the extensions the
+    /// part lacks, so a stray floating-point or atomic instruction traps).
+    pub qemu_args: &'static [&'static str],
     /// RAM in bytes (the memory.x the firmware links with).
     pub ram: u32,
     /// Flash (code memory) in bytes.
     pub flash: u32,
-    /// The core clock QEMU's SysTick counts, in Hz. Under `-icount shift=0` one instruction is
-    /// 1 ns, so one tick is 1e9 / clock_hz instructions. Checked by [`calibrate`].
+    /// The rate of the counter the firmware reads, in Hz: the core clock QEMU's SysTick counts
+    /// on Cortex-M. Under `-icount shift=0` one instruction is 1 ns, so one tick is
+    /// 1e9 / clock_hz instructions. On RISC-V the firmware reads `mcycle`, which QEMU's icount
+    /// advances by one per instruction: 1 GHz. Checked by [`calibrate`].
     pub clock_hz: u32,
 }
+
+/// A QEMU system emulator and the Debian package that has it.
+#[derive(Debug)]
+pub struct Qemu {
+    /// The program.
+    pub program: &'static str,
+    /// The Debian/Ubuntu package (`apt-get install`).
+    pub package: &'static str,
+}
+
+/// QEMU's Arm system emulator (the Cortex-M boards).
+pub static QEMU_ARM: Qemu = Qemu {
+    program: "qemu-system-arm",
+    package: "qemu-system-arm",
+};
+
+/// QEMU's 32-bit RISC-V system emulator (the RISC-V boards).
+pub static QEMU_RISCV32: Qemu = Qemu {
+    program: "qemu-system-riscv32",
+    package: "qemu-system-misc",
+};
 
 /// The golden cases each board is expected to skip because their mesh does not fit its
 /// buffers (host-sim/firmware/src/board.rs). `qemu --check` fails on any other skip (a board
 /// whose buffers shrank would otherwise pass with its cases skipped) and on a listed case that
-/// ran after all (the list is stale). The soft-float cores (Cortex-M0, M3) are the only boards
-/// that skip; README.md names their cases. Checked against the boards' capacities in the tests.
+/// ran after all (the list is stale). The small-RAM boards (Cortex-M0 16 KB, Cortex-M3 64 KB,
+/// the 32 KB RISC-V) are the only ones that skip; README.md names their cases. Checked against
+/// the boards' capacities in the tests.
 pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
     ("microbit", MICROBIT_SKIPS),
     ("lm3s6965evb", LM3S_SKIPS),
     ("mps2-an386", &[]),
     ("mps2-an500", &[]),
     ("mps2-an505", &[]),
+    ("riscv32imc-virt-400k", RISCV_400K_SKIPS),
+    ("riscv32imac-virt-32k", RISCV_32K_SKIPS),
 ];
 const MICROBIT_SKIPS: &[&str] = &[
     "plate-new-u16",
@@ -82,6 +116,25 @@ const MICROBIT_SKIPS: &[&str] = &[
 /// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases either (they borrow it); the
 /// cow's progressive stream needs the 4 MB boards.
 const LM3S_SKIPS: &[&str] = &[
+    "cow-new-u16",
+    "grid12-stored-subset-u16",
+    "grid12-stored-optimal-u16",
+    "icosphere3-stored-optimal-u32",
+    "fin8-stored-optimal-u16",
+    "icosphere3-stored-subset-u32",
+    "fin8-stored-subset-u16",
+    "sphere2-bound-u16",
+    "icosphere3-bound-u32",
+    "fin10-bound-paper-u32",
+    "pm-cow-quantised",
+];
+
+/// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream).
+const RISCV_400K_SKIPS: &[&str] = &[];
+/// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
+/// no RAM for stored quadrics or bounds, and the plate and the cow are too big.
+const RISCV_32K_SKIPS: &[&str] = &[
+    "plate-new-u16",
     "cow-new-u16",
     "grid12-stored-subset-u16",
     "grid12-stored-optimal-u16",
@@ -116,12 +169,15 @@ pub fn against_expected_skips(board: &str, case: &str, v: Verdict) -> Verdict {
     }
 }
 
-/// The five boards, smallest first. QEMU 7.2+.
-pub const BOARDS: [Board; 5] = [
+/// The boards: five Cortex-M, smallest first, then two RISC-V. QEMU 7.2+.
+pub const BOARDS: [Board; 7] = [
     Board {
         name: "microbit",
         core: "Cortex-M0",
         target: "thumbv6m-none-eabi",
+        qemu: &QEMU_ARM,
+        machine: "microbit",
+        qemu_args: &[],
         ram: 16 << 10,
         flash: 256 << 10,
         clock_hz: 16_000_000,
@@ -130,6 +186,9 @@ pub const BOARDS: [Board; 5] = [
         name: "lm3s6965evb",
         core: "Cortex-M3",
         target: "thumbv7m-none-eabi",
+        qemu: &QEMU_ARM,
+        machine: "lm3s6965evb",
+        qemu_args: &[],
         ram: 64 << 10,
         flash: 256 << 10,
         clock_hz: 12_500_000,
@@ -138,6 +197,9 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an386",
         core: "Cortex-M4F",
         target: "thumbv7em-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an386",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 25_000_000,
@@ -146,6 +208,9 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an500",
         core: "Cortex-M7",
         target: "thumbv7em-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an500",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 25_000_000,
@@ -154,9 +219,37 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an505",
         core: "Cortex-M33",
         target: "thumbv8m.main-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an505",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 20_000_000,
+    },
+    // An ESP32-C3-class part: rv32imc, no FPU, 400 KB of RAM (the linker's RAM region; QEMU's
+    // virt has more). Its flash is external (4 MB on most modules).
+    Board {
+        name: "riscv32imc-virt-400k",
+        core: "RISC-V rv32imc",
+        target: "riscv32imc-unknown-none-elf",
+        qemu: &QEMU_RISCV32,
+        machine: "virt",
+        qemu_args: &["-bios", "none", "-cpu", "rv32,a=false,f=false,d=false"],
+        ram: 400 << 10,
+        flash: 4 << 20,
+        clock_hz: 1_000_000_000,
+    },
+    // A GD32VF103-class part: rv32imac, no FPU, 32 KB of RAM, 128 KB of flash.
+    Board {
+        name: "riscv32imac-virt-32k",
+        core: "RISC-V rv32imac",
+        target: "riscv32imac-unknown-none-elf",
+        qemu: &QEMU_RISCV32,
+        machine: "virt",
+        qemu_args: &["-bios", "none", "-cpu", "rv32,f=false,d=false"],
+        ram: 32 << 10,
+        flash: 128 << 10,
+        clock_hz: 1_000_000_000,
     },
 ];
 
@@ -330,17 +423,14 @@ fn runs(program: &str, arg: &str) -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// The exact command that installs QEMU's Arm system emulator on this machine.
-pub const QEMU_INSTALL: &str = "sudo apt-get install qemu-system-arm";
-
 /// Makes sure the tools for `boards` are there, on a fresh machine too:
 ///
 /// * the Rust targets of the boards: missing ones are installed with `rustup target add`
 ///   (harmless, per-user);
-/// * `qemu-system-arm`: if missing, and running as root with `CI` set (a throw-away CI
-///   machine), `apt-get install -y qemu-system-arm` is run; otherwise the exact install command
-///   is printed and the caller should exit with status 2 (`Ok(Some(2))`): installing system
-///   packages is the user's call.
+/// * the boards' QEMU (`qemu-system-arm`, `qemu-system-riscv32`): if one is missing, and
+///   running as root with `CI` set (a throw-away CI machine), `apt-get install -y <package>` is
+///   run; otherwise the exact install command is printed and the caller should exit with
+///   status 2 (`Ok(Some(2))`): installing system packages is the user's call.
 pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
     let mut targets: Vec<&str> = boards.iter().map(|b| b.target).collect();
     targets.sort_unstable();
@@ -376,34 +466,54 @@ pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
             targets.join(", ")
         ),
     }
-    if runs("qemu-system-arm", "--version") {
+    let mut qemus: Vec<&Qemu> = Vec::new();
+    for b in boards {
+        if !qemus.iter().any(|q| q.program == b.qemu.program) {
+            qemus.push(b.qemu);
+        }
+    }
+    let missing: Vec<&Qemu> = qemus
+        .into_iter()
+        .filter(|q| !runs(q.program, "--version"))
+        .collect();
+    if missing.is_empty() {
         return Ok(None);
     }
+    let programs: Vec<&str> = missing.iter().map(|q| q.program).collect();
+    let packages: Vec<&str> = missing.iter().map(|q| q.package).collect();
     let root = Command::new("id")
         .arg("-u")
         .output()
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
     if root && std::env::var_os("CI").is_some() && runs("apt-get", "--version") {
-        eprintln!("qemu-system-arm missing; CI as root: apt-get install -y qemu-system-arm");
+        eprintln!(
+            "{} missing; CI as root: apt-get install -y {}",
+            programs.join(", "),
+            packages.join(" ")
+        );
         let ok = Command::new("apt-get")
             .args(["update", "-qq"])
             .status()
             .is_ok_and(|s| s.success())
             && Command::new("apt-get")
-                .args(["install", "-y", "-qq", "qemu-system-arm"])
+                .args(["install", "-y", "-qq"])
+                .args(&packages)
                 .env("DEBIAN_FRONTEND", "noninteractive")
                 .status()
                 .is_ok_and(|s| s.success());
-        if ok && runs("qemu-system-arm", "--version") {
+        if ok && programs.iter().all(|p| runs(p, "--version")) {
             return Ok(None);
         }
-        bail!("apt-get install qemu-system-arm failed");
+        bail!("apt-get install {} failed", packages.join(" "));
     }
     eprintln!(
-        "error: qemu-system-arm (QEMU's Arm system emulator, 7.2 or newer) is not installed.\n\
-         Install it with:\n\n    {QEMU_INSTALL}\n\n\
-         (Debian/Ubuntu; Fedora: sudo dnf install qemu-system-arm; macOS: brew install qemu),\n\
-         then run this command again."
+        "error: {} (QEMU's system emulator, 7.2 or newer) is not installed.\n\
+         Install it with:\n\n    sudo apt-get install {}\n\n\
+         (Debian/Ubuntu; Fedora: sudo dnf install {}; macOS: brew install qemu),\n\
+         then run this command again.",
+        programs.join(", "),
+        packages.join(" "),
+        programs.join(" ")
     );
     Ok(Some(ExitCode::from(2)))
 }
@@ -451,17 +561,19 @@ impl Run {
     }
 }
 
-/// The `qemu-system-arm` command line for `board`, with semihosting arguments `args`.
+/// The QEMU command line for `board`, with semihosting arguments `args`.
 pub fn qemu_command(board: &Board, elf: &Path, args: &[&str]) -> Command {
     let mut sh = String::from("enable=on,target=native,arg=tinydecimate-firmware");
     for a in args {
         sh.push_str(",arg=");
         sh.push_str(a);
     }
-    let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-machine", board.name])
+    let mut cmd = Command::new(board.qemu.program);
+    cmd.args(["-machine", board.machine])
+        .args(board.qemu_args)
         .args(["-nographic", "-monitor", "none", "-serial", "null"])
-        // One instruction = 1 ns of virtual time: SysTick counts instructions, repeatably.
+        // One instruction = 1 ns of virtual time: SysTick (and RISC-V's mcycle) counts
+        // instructions, repeatably.
         .args(["-icount", "shift=0"])
         .args(["-semihosting-config", &sh])
         .arg("-kernel")
@@ -488,9 +600,12 @@ pub fn run_in(
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let start = Instant::now();
-    let mut child = cmd
-        .spawn()
-        .context("starting qemu-system-arm (apt-get install qemu-system-arm)")?;
+    let mut child = cmd.spawn().with_context(|| {
+        format!(
+            "starting {} (apt-get install {})",
+            board.qemu.program, board.qemu.package
+        )
+    })?;
     let mut stdout = child.stdout.take().context("qemu stdout")?;
     let mut stderr = child.stderr.take().context("qemu stderr")?;
     let out_thread = std::thread::spawn(move || {
@@ -984,7 +1099,7 @@ pub fn calibrate(board: &Board, elf: &Path) -> Result<f64> {
         .ok_or_else(|| anyhow!("calibration on {} failed: {}", board.name, run.describe()))?;
     let o = Outcome::decode(bytes)?;
     if o.header.ticks == 0 {
-        bail!("SysTick did not count on {}", board.name);
+        bail!("the timer did not count on {}", board.name);
     }
     Ok(f64::from(o.header.error_a) / o.header.ticks as f64)
 }
@@ -1504,8 +1619,8 @@ pub fn print_summary(ms: &[Measurement]) {
 /// `host-sim qemu ...`: runs the library on the emulated boards.
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
-    /// Board (QEMU machine) to use; repeat for several. Default: all five
-    /// (microbit, lm3s6965evb, mps2-an386, mps2-an500, mps2-an505).
+    /// Board to use; repeat for several. Default: all seven (microbit, lm3s6965evb,
+    /// mps2-an386, mps2-an500, mps2-an505, riscv32imc-virt-400k, riscv32imac-virt-32k).
     #[arg(long = "board", value_name = "MACHINE")]
     pub boards: Vec<String>,
     /// Math backend of the library (default: the one host-sim was built with). Another one
@@ -1742,6 +1857,8 @@ mod tests {
             ("mps2-an386", 53_000, 106_000, 4, 1_024),
             ("mps2-an500", 53_000, 106_000, 4, 1_024),
             ("mps2-an505", 53_000, 106_000, 4, 1_024),
+            ("riscv32imc-virt-400k", 6_000, 13_000, 2, 1_024),
+            ("riscv32imac-virt-32k", 500, 1_000, 2, 0),
         ];
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
         let streams = crate::streamcase::load(&golden::default_dir()).unwrap();
@@ -1768,6 +1885,7 @@ mod tests {
             let (pv, pbuf) = match board {
                 "microbit" => (44, 80),
                 "lm3s6965evb" => (100, 272),
+                "riscv32imac-virt-32k" => (100, 272),
                 _ => (3_000, 4_096),
             };
             let too_big: Vec<&str> = too_big
