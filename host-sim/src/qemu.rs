@@ -1,10 +1,11 @@
-//! The library on emulated Cortex-M cores: builds the firmware in `host-sim/firmware` for a
-//! board, runs it under `qemu-system-arm`, decodes its defmt log, collects its result file and
-//! compares it with the golden files ([`crate::golden`], `host-sim qemu --check`) or a fresh
-//! host run. Also measures each board (`--measure`): instructions (SysTick under
-//! `-icount shift=0`), stack high-water mark, image sizes of the firmware and of the library
-//! alone, the flash of one instantiation (the minimal firmware of `tests/flash`, as
-//! `scripts/flash.sh` builds it: [`one_instantiation`]), and the largest mesh it simplifies.
+//! The library on emulated Cortex-M and RISC-V cores: builds the firmware in `host-sim/firmware`
+//! for a board, runs it under `qemu-system-arm` or `qemu-system-riscv32`, decodes its defmt log,
+//! collects its result file and compares it with the golden files ([`crate::golden`],
+//! `host-sim qemu --check`) or a fresh host run. Also measures each board (`--measure`):
+//! instructions (SysTick, or RISC-V's `mcycle`, under `-icount shift=0`), stack high-water
+//! mark, image sizes of the firmware and of the library alone, the flash of one instantiation
+//! (the minimal firmware of `tests/flash`, as `scripts/flash.sh` builds it:
+//! [`one_instantiation`]), and the largest mesh it simplifies.
 //!
 //! `host-sim qemu` ([`Args`], [`run`]); `host-sim qemu --help` lists the modes. By hand (what
 //! [`build`] and [`run_in`] do):
@@ -18,7 +19,19 @@
 //!     -kernel target/thumbv7em-none-eabihf/release/tinydecimate-firmware > log.defmt
 //! ```
 //!
-//! (no `-cpu`: the mps2 machines refuse any but their own). `case.bin` and `result.bin` are
+//! (no `-cpu`: the mps2 machines refuse any but their own). A RISC-V board (`virt`, no boot
+//! firmware, the core without the extensions the part lacks):
+//!
+//! ```text
+//! DEFMT_LOG=info cargo build --release --target riscv32imc-unknown-none-elf \
+//!     --features board-riscv32imc-virt-400k
+//! qemu-system-riscv32 -machine virt -bios none -cpu rv32,a=false,f=false,d=false \
+//!     -nographic -monitor none -serial null -icount shift=0 \
+//!     -semihosting-config enable=on,target=native,arg=fw,arg=case.bin,arg=result.bin \
+//!     -kernel target/riscv32imc-unknown-none-elf/release/tinydecimate-firmware > log.defmt
+//! ```
+//!
+//! `case.bin` and `result.bin` are
 //! relative to QEMU's working directory; paths must not contain spaces (semihosting joins the
 //! arguments with spaces). `log.defmt` holds binary defmt frames: [`decode_defmt`].
 
@@ -265,7 +278,7 @@ pub fn board(name: &str) -> Result<&'static Board> {
 }
 
 impl Board {
-    /// Instructions per SysTick tick (exact for every board above).
+    /// Instructions per timer tick (exact for every board above).
     pub fn instructions_per_tick(&self) -> f64 {
         1e9 / f64::from(self.clock_hz)
     }
@@ -785,7 +798,7 @@ pub fn run_case(
 }
 
 impl Board {
-    /// Instructions in `ticks` SysTick ticks.
+    /// Instructions in `ticks` timer ticks.
     pub fn instructions(&self, ticks: u64) -> u64 {
         (ticks as f64 * self.instructions_per_tick()).round() as u64
     }
@@ -897,7 +910,7 @@ pub fn check(
             Ok(elf) => elf,
             Err(e) => {
                 let why = format!("firmware build failed: {e:#}");
-                eprintln!("{:<12} {why}", b.name);
+                eprintln!("{:<20} {why}", b.name);
                 columns.push((
                     b.name.to_string(),
                     names.iter().map(|_| Verdict::Failed(why.clone())).collect(),
@@ -938,7 +951,7 @@ pub fn check(
             col.push(against_expected_skips(b.name, sc.name(), v));
         }
         eprintln!(
-            "{:<12} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
+            "{:<20} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
             b.name,
             built.as_secs_f64(),
             names.len(),
@@ -1060,6 +1073,10 @@ pub fn elf_sizes(elf: &[u8]) -> Result<Sizes> {
             continue;
         }
         let name = name_of(i)?;
+        // riscv-rt's link.x marks the free RAM as `.heap` and `.stack` (NOLOAD): not statics.
+        if name == ".heap" || name == ".stack" {
+            continue;
+        }
         if ty == SHT_NOBITS {
             s.static_ram += size;
             s.bss += size;
@@ -1118,7 +1135,7 @@ pub struct Measurement {
     /// Flash of one instantiation on the board's target ([`one_instantiation`]): `.text +
     /// .rodata` of the minimal firmware without and with the call.
     pub instantiation: (u64, u64),
-    /// Measured instructions per SysTick tick.
+    /// Measured instructions per timer tick.
     pub instructions_per_tick: f64,
     /// Workspace bytes (the library's static RAM on this board).
     pub workspace_bytes: u32,
@@ -1317,7 +1334,7 @@ pub fn measure(
     let ipt = board.instructions_per_tick();
     if (measured - ipt).abs() > ipt * 1e-3 {
         bail!(
-            "{}: SysTick counts {measured:.4} instructions per tick, expected {ipt} \
+            "{}: the timer counts {measured:.4} instructions per tick, expected {ipt} \
              (QEMU not run with -icount shift=0, or another clock?)",
             board.name
         );
@@ -1462,7 +1479,7 @@ pub fn print_measurement(m: &Measurement) {
         delta(with, without) as f64 / 1024.0,
     );
     crate::outln!(
-        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per SysTick tick (calibrated)",
+        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per timer tick (calibrated)",
         m.capacity.0, m.capacity.1, m.capacity.2, m.instructions_per_tick
     );
     crate::outln!(
@@ -1565,7 +1582,7 @@ pub fn print_summary(ms: &[Measurement]) {
         ms[0].backend
     );
     crate::outln!(
-        "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+        "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
         "board",
         "fw flash",
         "fw RAM",
@@ -1596,7 +1613,7 @@ pub fn print_summary(ms: &[Measurement]) {
                 .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
         };
         crate::outln!(
-            "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+            "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
             m.board.name,
             m.sizes.flash,
             m.sizes.static_ram,
@@ -1642,8 +1659,8 @@ pub struct Args {
     /// never rewritten).
     #[arg(long, requires = "cluster")]
     pub bless: bool,
-    /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
-    /// collapse and stack; per golden progressive stream, instructions per split decoding and
+    /// Report, per case and board, instructions (SysTick or mcycle, -icount shift=0),
+    /// instructions per collapse and stack; per golden progressive stream, instructions per split decoding and
     /// per collapse / split moving the slider; per board the image sizes of the firmware and of the library alone,
     /// the flash of one instantiation (`tests/flash`, as `scripts/flash.sh` measures it) and the
     /// largest mesh it simplifies (bisection). Not pass/fail.
@@ -1723,7 +1740,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             };
             failed += usize::from(!echoed);
             crate::outln!(
-                "{:<12} echo {}",
+                "{:<20} echo {}",
                 b.name,
                 if echoed { "ok" } else { "FAILED" }
             );
@@ -1743,7 +1760,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 let ok = run.exit_code == Some(want);
                 failed += usize::from(!ok);
                 crate::outln!(
-                    "{:<12} {cmd:<9} {}",
+                    "{:<20} {cmd:<9} {}",
                     b.name,
                     if ok { "ok" } else { "FAILED" }
                 );
@@ -1764,7 +1781,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             let ok = run.exit_code == Some(EXIT_IO);
             failed += usize::from(!ok);
             crate::outln!(
-                "{:<12} {:<9} {}",
+                "{:<20} {:<9} {}",
                 b.name,
                 "missing",
                 if ok { "ok" } else { "FAILED" }

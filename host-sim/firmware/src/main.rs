@@ -1,4 +1,4 @@
-//! tinydecimate on an emulated Cortex-M.
+//! tinydecimate on an emulated Cortex-M or RISC-V core (the differences: src/arch.rs).
 //!
 //! The host (`host-sim qemu`) starts QEMU with three semihosting arguments,
 //! `<program> <case file> <result file>`: the firmware reads the case (mesh + configuration,
@@ -11,7 +11,7 @@
 //! Logs are defmt frames on semihosting stdout (defmt-semihosting), decoded by the host with
 //! the image's ELF. Nothing else writes to stdout. Exit status through SYS_EXIT_EXTENDED:
 //! 0 done (the result file says how the case went), 2 host file I/O failed, 101 panic,
-//! 102 HardFault or unexpected exception.
+//! 102 HardFault or unexpected exception (RISC-V: any trap).
 
 #![no_std]
 #![no_main]

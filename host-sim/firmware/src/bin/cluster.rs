@@ -1,5 +1,5 @@
-//! tinydecimate's streaming vertex clustering on an emulated Cortex-M: a mesh far bigger than
-//! the board's RAM, read through semihosting as it is needed.
+//! tinydecimate's streaming vertex clustering on an emulated Cortex-M or RISC-V core: a mesh far
+//! bigger than the board's RAM, read through semihosting as it is needed.
 //!
 //! Semihosting arguments `<program> <case> <result>` (format in host-sim/meshfmt/src/cluster.rs).
 //! The triangles are read from the case file in chunks of `tinydecimate::cluster::CHUNK`
