@@ -1972,5 +1972,20 @@ mod tests {
             .any(|a| a
                 == "enable=on,target=native,arg=tinydecimate-firmware,arg=case.bin,arg=out.bin"));
         assert!(!args.iter().any(|a| a == "-cpu"));
+
+        // RISC-V: virt without boot firmware, the core without the part's missing extensions.
+        let b = board("riscv32imc-virt-400k").unwrap();
+        let c = qemu_command(b, Path::new("fw.elf"), &["case.bin", "out.bin"]);
+        assert_eq!(c.get_program(), "qemu-system-riscv32");
+        let args: Vec<_> = c
+            .get_args()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
+        assert!(args.windows(2).any(|w| w == ["-machine", "virt"]));
+        assert!(args.windows(2).any(|w| w == ["-bios", "none"]));
+        assert!(args
+            .windows(2)
+            .any(|w| w == ["-cpu", "rv32,a=false,f=false,d=false"]));
+        assert!(args.windows(2).any(|w| w == ["-icount", "shift=0"]));
     }
 }
