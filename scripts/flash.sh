@@ -10,7 +10,8 @@
 #                 Workspace<u16, ..>) and a second link type (Workspace<u32, ..> over u32)
 #   --micromath   the library's micromath backend instead of libm
 #   --symbols N   how many of the largest symbols the call adds to list per target (default 15)
-#   --target T    a Rust target (repeatable; default thumbv7em-none-eabihf thumbv6m-none-eabi)
+#   --target T    a Rust target (repeatable; default thumbv7em-none-eabihf thumbv6m-none-eabi
+#                 riscv32imc-unknown-none-elf)
 # Needs the rustup targets and the llvm-tools component (rustup component add llvm-tools).
 # Images are kept in $CARGO_TARGET_DIR/images (default tests/flash/target).
 set -euo pipefail
@@ -27,12 +28,12 @@ while [ $# -gt 0 ]; do
         --micromath) extra=(micromath) ;;
         --symbols) nsym=$2; shift ;;
         --target) targets+=("$2"); shift ;;
-        -h | --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown argument: $1 (see --help)" >&2; exit 2 ;;
     esac
     shift
 done
-[ ${#targets[@]} -gt 0 ] || targets=(thumbv7em-none-eabihf thumbv6m-none-eabi)
+[ ${#targets[@]} -gt 0 ] || targets=(thumbv7em-none-eabihf thumbv6m-none-eabi riscv32imc-unknown-none-elf)
 
 bin="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
 for tool in llvm-size llvm-nm; do

@@ -2,30 +2,33 @@
 # The whole test suite, as README.md and CI run it:
 #   1. library and harness tests on the host (property tests, real meshes, bad input, ...);
 #   2. golden outputs on the host, with both math backends (libm, micromath);
-#   3. the same golden files under QEMU on five Cortex-M cores, both backends: the same bytes
-#      on every core and on the host;
+#   3. the same golden files under QEMU on five Cortex-M cores and two RISC-V cores (rv32imc
+#      400 KB, rv32imac 32 KB), both backends: the same bytes on every core and on the host;
 #   4. streaming clustering of a mesh larger than RAM (the Stanford bunny, 69 451 triangles,
-#      read through semihosting on the 16 KB micro:bit) on the host and the five cores, both
+#      read through semihosting on the 16 KB micro:bit) on the host and the seven cores, both
 #      backends, against tests/golden/cluster.toml's golden files;
 #   5. the firmware example (examples/cortex-m4f) under QEMU, as its README line runs it, in
 #      the repository and copied out of it as a project template.
 # The link-time proof that no panic path is left in the library (tests/no-panic/check.sh), the
 # fuzz smoke run and Miri are not run here: CI runs them after this script (see .ci/run).
 # It installs the rustup targets it needs and defmt-print (the example's defmt decoder); QEMU
-# comes from `apt-get install qemu-system-arm`.
+# comes from `apt-get install qemu-system-arm qemu-system-misc` (qemu-system-riscv32), installed
+# here when missing and running as root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-need_targets="thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf thumbv8m.main-none-eabihf"
+need_targets="thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf thumbv8m.main-none-eabihf
+  riscv32imc-unknown-none-elf riscv32imac-unknown-none-elf"
 installed=$(rustup target list --installed)
 for t in $need_targets; do
   grep -qx "$t" <<<"$installed" || rustup target add "$t"
 done
-if ! command -v qemu-system-arm >/dev/null; then
+if ! command -v qemu-system-arm >/dev/null || ! command -v qemu-system-riscv32 >/dev/null; then
   if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm
+    apt-get update -qq &&
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm qemu-system-misc
   else
-    echo "scripts/test.sh needs QEMU for the Cortex-M golden checks: sudo apt-get install qemu-system-arm" >&2
+    echo "scripts/test.sh needs QEMU for the golden checks on the boards: sudo apt-get install qemu-system-arm qemu-system-misc" >&2
     exit 2
   fi
 fi
@@ -38,7 +41,7 @@ echo "== golden outputs on the host (libm, micromath)"
 cargo run -q -p host-sim --release -- golden --check --backend libm
 cargo run -q -p host-sim --release -- golden --check --backend micromath
 
-echo "== golden outputs under QEMU: Cortex-M0, M3, M4F, M7, M33 (libm, micromath)"
+echo "== golden outputs under QEMU: Cortex-M0, M3, M4F, M7, M33, RISC-V rv32imc, rv32imac (libm, micromath)"
 cargo run -q -p host-sim --release -- qemu --check --backend libm
 cargo run -q -p host-sim --release -- qemu --check --backend micromath
 

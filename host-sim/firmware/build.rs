@@ -1,5 +1,5 @@
 //! Picks the memory layout of the selected board and puts it on the linker's search path as
-//! `memory.x` (cortex-m-rt's `link.x` includes it by that name).
+//! `memory.x` (cortex-m-rt's and riscv-rt's `link.x` include it by that name).
 //!
 //! The linker does not track `memory.x` as an input, so every candidate file is listed with
 //! `rerun-if-changed`: without it, switching boards or editing a layout would link with the
@@ -37,6 +37,17 @@ const BOARDS: &[(&str, &str, &[&str])] = &[
         "memory/mps2-an505.x",
         &["thumbv8m.main-none-eabihf", "thumbv8m.main-none-eabi"],
     ),
+    // QEMU's RISC-V `virt` machine with RAM regions the size of real parts (riscv-rt's link.x).
+    (
+        "BOARD_RISCV32IMC_VIRT_400K",
+        "memory/riscv32-virt-400k.x",
+        &["riscv32imc-unknown-none-elf"],
+    ),
+    (
+        "BOARD_RISCV32IMAC_VIRT_32K",
+        "memory/riscv32-virt-32k.x",
+        &["riscv32imac-unknown-none-elf"],
+    ),
 ];
 
 fn main() {
@@ -57,11 +68,14 @@ fn main() {
         [one] => **one,
         [] => panic!(
             "select a board: --features board-microbit | board-lm3s6965evb | board-mps2-an386 | \
-             board-mps2-an500 | board-mps2-an505"
+             board-mps2-an500 | board-mps2-an505 | board-riscv32imc-virt-400k | \
+             board-riscv32imac-virt-32k"
         ),
         _ => panic!("select exactly one board feature"),
     };
-    if target.starts_with("thumb") && !targets.contains(&target.as_str()) {
+    if (target.starts_with("thumb") || target.starts_with("riscv"))
+        && !targets.contains(&target.as_str())
+    {
         panic!("{feature} runs {targets:?}, not {target}");
     }
     let layout = fs::read(manifest.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));

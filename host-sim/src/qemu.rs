@@ -1,10 +1,11 @@
-//! The library on emulated Cortex-M cores: builds the firmware in `host-sim/firmware` for a
-//! board, runs it under `qemu-system-arm`, decodes its defmt log, collects its result file and
-//! compares it with the golden files ([`crate::golden`], `host-sim qemu --check`) or a fresh
-//! host run. Also measures each board (`--measure`): instructions (SysTick under
-//! `-icount shift=0`), stack high-water mark, image sizes of the firmware and of the library
-//! alone, the flash of one instantiation (the minimal firmware of `tests/flash`, as
-//! `scripts/flash.sh` builds it: [`one_instantiation`]), and the largest mesh it simplifies.
+//! The library on emulated Cortex-M and RISC-V cores: builds the firmware in `host-sim/firmware`
+//! for a board, runs it under `qemu-system-arm` or `qemu-system-riscv32`, decodes its defmt log,
+//! collects its result file and compares it with the golden files ([`crate::golden`],
+//! `host-sim qemu --check`) or a fresh host run. Also measures each board (`--measure`):
+//! instructions (SysTick, or RISC-V's `mcycle`, under `-icount shift=0`), stack high-water
+//! mark, image sizes of the firmware and of the library alone, the flash of one instantiation
+//! (the minimal firmware of `tests/flash`, as `scripts/flash.sh` builds it:
+//! [`one_instantiation`]), and the largest mesh it simplifies.
 //!
 //! `host-sim qemu` ([`Args`], [`run`]); `host-sim qemu --help` lists the modes. By hand (what
 //! [`build`] and [`run_in`] do):
@@ -18,7 +19,19 @@
 //!     -kernel target/thumbv7em-none-eabihf/release/tinydecimate-firmware > log.defmt
 //! ```
 //!
-//! (no `-cpu`: the mps2 machines refuse any but their own). `case.bin` and `result.bin` are
+//! (no `-cpu`: the mps2 machines refuse any but their own). A RISC-V board (`virt`, no boot
+//! firmware, the core without the extensions the part lacks):
+//!
+//! ```text
+//! DEFMT_LOG=info cargo build --release --target riscv32imc-unknown-none-elf \
+//!     --features board-riscv32imc-virt-400k
+//! qemu-system-riscv32 -machine virt -bios none -cpu rv32,a=false,f=false,d=false \
+//!     -nographic -monitor none -serial null -icount shift=0 \
+//!     -semihosting-config enable=on,target=native,arg=fw,arg=case.bin,arg=result.bin \
+//!     -kernel target/riscv32imc-unknown-none-elf/release/tinydecimate-firmware > log.defmt
+//! ```
+//!
+//! `case.bin` and `result.bin` are
 //! relative to QEMU's working directory; paths must not contain spaces (semihosting joins the
 //! arguments with spaces). `log.defmt` holds binary defmt frames: [`decode_defmt`].
 
@@ -36,32 +49,66 @@ use crate::streamcase::StreamCase;
 /// An emulated board.
 #[derive(Clone, Copy, Debug)]
 pub struct Board {
-    /// QEMU machine name, and the firmware's feature `board-<name>`.
+    /// Board name, and the firmware's feature `board-<name>` (the QEMU machine name for the
+    /// Cortex-M boards).
     pub name: &'static str,
     /// The core.
     pub core: &'static str,
     /// Rust target.
     pub target: &'static str,
+    /// QEMU's system emulator for the core ([`QEMU_ARM`], [`QEMU_RISCV32`]).
+    pub qemu: &'static Qemu,
+    /// QEMU `-machine`.
+    pub machine: &'static str,
+    /// More QEMU arguments (RISC-V: no boot firmware, and the core without the extensions the
+    /// part lacks, so a stray floating-point or atomic instruction traps).
+    pub qemu_args: &'static [&'static str],
     /// RAM in bytes (the memory.x the firmware links with).
     pub ram: u32,
     /// Flash (code memory) in bytes.
     pub flash: u32,
-    /// The core clock QEMU's SysTick counts, in Hz. Under `-icount shift=0` one instruction is
-    /// 1 ns, so one tick is 1e9 / clock_hz instructions. Checked by [`calibrate`].
+    /// The rate of the counter the firmware reads, in Hz: the core clock QEMU's SysTick counts
+    /// on Cortex-M. Under `-icount shift=0` one instruction is 1 ns, so one tick is
+    /// 1e9 / clock_hz instructions. On RISC-V the firmware reads `mcycle`, which QEMU's icount
+    /// advances by one per instruction: 1 GHz. Checked by [`calibrate`].
     pub clock_hz: u32,
 }
+
+/// A QEMU system emulator and the Debian package that has it.
+#[derive(Debug)]
+pub struct Qemu {
+    /// The program.
+    pub program: &'static str,
+    /// The Debian/Ubuntu package (`apt-get install`).
+    pub package: &'static str,
+}
+
+/// QEMU's Arm system emulator (the Cortex-M boards).
+pub static QEMU_ARM: Qemu = Qemu {
+    program: "qemu-system-arm",
+    package: "qemu-system-arm",
+};
+
+/// QEMU's 32-bit RISC-V system emulator (the RISC-V boards).
+pub static QEMU_RISCV32: Qemu = Qemu {
+    program: "qemu-system-riscv32",
+    package: "qemu-system-misc",
+};
 
 /// The golden cases each board is expected to skip because their mesh does not fit its
 /// buffers (host-sim/firmware/src/board.rs). `qemu --check` fails on any other skip (a board
 /// whose buffers shrank would otherwise pass with its cases skipped) and on a listed case that
-/// ran after all (the list is stale). The soft-float cores (Cortex-M0, M3) are the only boards
-/// that skip; README.md names their cases. Checked against the boards' capacities in the tests.
+/// ran after all (the list is stale). The small-RAM boards (Cortex-M0 16 KB, Cortex-M3 64 KB,
+/// the 32 KB RISC-V) are the only ones that skip; README.md names their cases. Checked against
+/// the boards' capacities in the tests.
 pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
     ("microbit", MICROBIT_SKIPS),
     ("lm3s6965evb", LM3S_SKIPS),
     ("mps2-an386", &[]),
     ("mps2-an500", &[]),
     ("mps2-an505", &[]),
+    ("riscv32imc-virt-400k", RISCV_400K_SKIPS),
+    ("riscv32imac-virt-32k", RISCV_32K_SKIPS),
 ];
 const MICROBIT_SKIPS: &[&str] = &[
     "plate-new-u16",
@@ -82,6 +129,25 @@ const MICROBIT_SKIPS: &[&str] = &[
 /// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases either (they borrow it); the
 /// cow's progressive stream needs the 4 MB boards.
 const LM3S_SKIPS: &[&str] = &[
+    "cow-new-u16",
+    "grid12-stored-subset-u16",
+    "grid12-stored-optimal-u16",
+    "icosphere3-stored-optimal-u32",
+    "fin8-stored-optimal-u16",
+    "icosphere3-stored-subset-u32",
+    "fin8-stored-subset-u16",
+    "sphere2-bound-u16",
+    "icosphere3-bound-u32",
+    "fin10-bound-paper-u32",
+    "pm-cow-quantised",
+];
+
+/// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream).
+const RISCV_400K_SKIPS: &[&str] = &[];
+/// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
+/// no RAM for stored quadrics or bounds, and the plate and the cow are too big.
+const RISCV_32K_SKIPS: &[&str] = &[
+    "plate-new-u16",
     "cow-new-u16",
     "grid12-stored-subset-u16",
     "grid12-stored-optimal-u16",
@@ -116,12 +182,15 @@ pub fn against_expected_skips(board: &str, case: &str, v: Verdict) -> Verdict {
     }
 }
 
-/// The five boards, smallest first. QEMU 7.2+.
-pub const BOARDS: [Board; 5] = [
+/// The boards: five Cortex-M, smallest first, then two RISC-V. QEMU 7.2+.
+pub const BOARDS: [Board; 7] = [
     Board {
         name: "microbit",
         core: "Cortex-M0",
         target: "thumbv6m-none-eabi",
+        qemu: &QEMU_ARM,
+        machine: "microbit",
+        qemu_args: &[],
         ram: 16 << 10,
         flash: 256 << 10,
         clock_hz: 16_000_000,
@@ -130,6 +199,9 @@ pub const BOARDS: [Board; 5] = [
         name: "lm3s6965evb",
         core: "Cortex-M3",
         target: "thumbv7m-none-eabi",
+        qemu: &QEMU_ARM,
+        machine: "lm3s6965evb",
+        qemu_args: &[],
         ram: 64 << 10,
         flash: 256 << 10,
         clock_hz: 12_500_000,
@@ -138,6 +210,9 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an386",
         core: "Cortex-M4F",
         target: "thumbv7em-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an386",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 25_000_000,
@@ -146,6 +221,9 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an500",
         core: "Cortex-M7",
         target: "thumbv7em-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an500",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 25_000_000,
@@ -154,9 +232,37 @@ pub const BOARDS: [Board; 5] = [
         name: "mps2-an505",
         core: "Cortex-M33",
         target: "thumbv8m.main-none-eabihf",
+        qemu: &QEMU_ARM,
+        machine: "mps2-an505",
+        qemu_args: &[],
         ram: 4 << 20,
         flash: 4 << 20,
         clock_hz: 20_000_000,
+    },
+    // An ESP32-C3-class part: rv32imc, no FPU, 400 KB of RAM (the linker's RAM region; QEMU's
+    // virt has more). Its flash is external (4 MB on most modules).
+    Board {
+        name: "riscv32imc-virt-400k",
+        core: "RISC-V rv32imc",
+        target: "riscv32imc-unknown-none-elf",
+        qemu: &QEMU_RISCV32,
+        machine: "virt",
+        qemu_args: &["-bios", "none", "-cpu", "rv32,a=false,f=false,d=false"],
+        ram: 400 << 10,
+        flash: 4 << 20,
+        clock_hz: 1_000_000_000,
+    },
+    // A GD32VF103-class part: rv32imac, no FPU, 32 KB of RAM, 128 KB of flash.
+    Board {
+        name: "riscv32imac-virt-32k",
+        core: "RISC-V rv32imac",
+        target: "riscv32imac-unknown-none-elf",
+        qemu: &QEMU_RISCV32,
+        machine: "virt",
+        qemu_args: &["-bios", "none", "-cpu", "rv32,f=false,d=false"],
+        ram: 32 << 10,
+        flash: 128 << 10,
+        clock_hz: 1_000_000_000,
     },
 ];
 
@@ -172,7 +278,7 @@ pub fn board(name: &str) -> Result<&'static Board> {
 }
 
 impl Board {
-    /// Instructions per SysTick tick (exact for every board above).
+    /// Instructions per timer tick (exact for every board above).
     pub fn instructions_per_tick(&self) -> f64 {
         1e9 / f64::from(self.clock_hz)
     }
@@ -330,17 +436,14 @@ fn runs(program: &str, arg: &str) -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// The exact command that installs QEMU's Arm system emulator on this machine.
-pub const QEMU_INSTALL: &str = "sudo apt-get install qemu-system-arm";
-
 /// Makes sure the tools for `boards` are there, on a fresh machine too:
 ///
 /// * the Rust targets of the boards: missing ones are installed with `rustup target add`
 ///   (harmless, per-user);
-/// * `qemu-system-arm`: if missing, and running as root with `CI` set (a throw-away CI
-///   machine), `apt-get install -y qemu-system-arm` is run; otherwise the exact install command
-///   is printed and the caller should exit with status 2 (`Ok(Some(2))`): installing system
-///   packages is the user's call.
+/// * the boards' QEMU (`qemu-system-arm`, `qemu-system-riscv32`): if one is missing, and
+///   running as root with `CI` set (a throw-away CI machine), `apt-get install -y <package>` is
+///   run; otherwise the exact install command is printed and the caller should exit with
+///   status 2 (`Ok(Some(2))`): installing system packages is the user's call.
 pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
     let mut targets: Vec<&str> = boards.iter().map(|b| b.target).collect();
     targets.sort_unstable();
@@ -376,34 +479,54 @@ pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
             targets.join(", ")
         ),
     }
-    if runs("qemu-system-arm", "--version") {
+    let mut qemus: Vec<&Qemu> = Vec::new();
+    for b in boards {
+        if !qemus.iter().any(|q| q.program == b.qemu.program) {
+            qemus.push(b.qemu);
+        }
+    }
+    let missing: Vec<&Qemu> = qemus
+        .into_iter()
+        .filter(|q| !runs(q.program, "--version"))
+        .collect();
+    if missing.is_empty() {
         return Ok(None);
     }
+    let programs: Vec<&str> = missing.iter().map(|q| q.program).collect();
+    let packages: Vec<&str> = missing.iter().map(|q| q.package).collect();
     let root = Command::new("id")
         .arg("-u")
         .output()
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
     if root && std::env::var_os("CI").is_some() && runs("apt-get", "--version") {
-        eprintln!("qemu-system-arm missing; CI as root: apt-get install -y qemu-system-arm");
+        eprintln!(
+            "{} missing; CI as root: apt-get install -y {}",
+            programs.join(", "),
+            packages.join(" ")
+        );
         let ok = Command::new("apt-get")
             .args(["update", "-qq"])
             .status()
             .is_ok_and(|s| s.success())
             && Command::new("apt-get")
-                .args(["install", "-y", "-qq", "qemu-system-arm"])
+                .args(["install", "-y", "-qq"])
+                .args(&packages)
                 .env("DEBIAN_FRONTEND", "noninteractive")
                 .status()
                 .is_ok_and(|s| s.success());
-        if ok && runs("qemu-system-arm", "--version") {
+        if ok && programs.iter().all(|p| runs(p, "--version")) {
             return Ok(None);
         }
-        bail!("apt-get install qemu-system-arm failed");
+        bail!("apt-get install {} failed", packages.join(" "));
     }
     eprintln!(
-        "error: qemu-system-arm (QEMU's Arm system emulator, 7.2 or newer) is not installed.\n\
-         Install it with:\n\n    {QEMU_INSTALL}\n\n\
-         (Debian/Ubuntu; Fedora: sudo dnf install qemu-system-arm; macOS: brew install qemu),\n\
-         then run this command again."
+        "error: {} (QEMU's system emulator, 7.2 or newer) is not installed.\n\
+         Install it with:\n\n    sudo apt-get install {}\n\n\
+         (Debian/Ubuntu; Fedora: sudo dnf install {}; macOS: brew install qemu),\n\
+         then run this command again.",
+        programs.join(", "),
+        packages.join(" "),
+        programs.join(" ")
     );
     Ok(Some(ExitCode::from(2)))
 }
@@ -451,17 +574,19 @@ impl Run {
     }
 }
 
-/// The `qemu-system-arm` command line for `board`, with semihosting arguments `args`.
+/// The QEMU command line for `board`, with semihosting arguments `args`.
 pub fn qemu_command(board: &Board, elf: &Path, args: &[&str]) -> Command {
     let mut sh = String::from("enable=on,target=native,arg=tinydecimate-firmware");
     for a in args {
         sh.push_str(",arg=");
         sh.push_str(a);
     }
-    let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-machine", board.name])
+    let mut cmd = Command::new(board.qemu.program);
+    cmd.args(["-machine", board.machine])
+        .args(board.qemu_args)
         .args(["-nographic", "-monitor", "none", "-serial", "null"])
-        // One instruction = 1 ns of virtual time: SysTick counts instructions, repeatably.
+        // One instruction = 1 ns of virtual time: SysTick (and RISC-V's mcycle) counts
+        // instructions, repeatably.
         .args(["-icount", "shift=0"])
         .args(["-semihosting-config", &sh])
         .arg("-kernel")
@@ -488,9 +613,12 @@ pub fn run_in(
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     let start = Instant::now();
-    let mut child = cmd
-        .spawn()
-        .context("starting qemu-system-arm (apt-get install qemu-system-arm)")?;
+    let mut child = cmd.spawn().with_context(|| {
+        format!(
+            "starting {} (apt-get install {})",
+            board.qemu.program, board.qemu.package
+        )
+    })?;
     let mut stdout = child.stdout.take().context("qemu stdout")?;
     let mut stderr = child.stderr.take().context("qemu stderr")?;
     let out_thread = std::thread::spawn(move || {
@@ -670,7 +798,7 @@ pub fn run_case(
 }
 
 impl Board {
-    /// Instructions in `ticks` SysTick ticks.
+    /// Instructions in `ticks` timer ticks.
     pub fn instructions(&self, ticks: u64) -> u64 {
         (ticks as f64 * self.instructions_per_tick()).round() as u64
     }
@@ -782,7 +910,7 @@ pub fn check(
             Ok(elf) => elf,
             Err(e) => {
                 let why = format!("firmware build failed: {e:#}");
-                eprintln!("{:<12} {why}", b.name);
+                eprintln!("{:<20} {why}", b.name);
                 columns.push((
                     b.name.to_string(),
                     names.iter().map(|_| Verdict::Failed(why.clone())).collect(),
@@ -823,7 +951,7 @@ pub fn check(
             col.push(against_expected_skips(b.name, sc.name(), v));
         }
         eprintln!(
-            "{:<12} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
+            "{:<20} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
             b.name,
             built.as_secs_f64(),
             names.len(),
@@ -945,6 +1073,10 @@ pub fn elf_sizes(elf: &[u8]) -> Result<Sizes> {
             continue;
         }
         let name = name_of(i)?;
+        // riscv-rt's link.x marks the free RAM as `.heap` and `.stack` (NOLOAD): not statics.
+        if name == ".heap" || name == ".stack" {
+            continue;
+        }
         if ty == SHT_NOBITS {
             s.static_ram += size;
             s.bss += size;
@@ -984,7 +1116,7 @@ pub fn calibrate(board: &Board, elf: &Path) -> Result<f64> {
         .ok_or_else(|| anyhow!("calibration on {} failed: {}", board.name, run.describe()))?;
     let o = Outcome::decode(bytes)?;
     if o.header.ticks == 0 {
-        bail!("SysTick did not count on {}", board.name);
+        bail!("the timer did not count on {}", board.name);
     }
     Ok(f64::from(o.header.error_a) / o.header.ticks as f64)
 }
@@ -1003,7 +1135,7 @@ pub struct Measurement {
     /// Flash of one instantiation on the board's target ([`one_instantiation`]): `.text +
     /// .rodata` of the minimal firmware without and with the call.
     pub instantiation: (u64, u64),
-    /// Measured instructions per SysTick tick.
+    /// Measured instructions per timer tick.
     pub instructions_per_tick: f64,
     /// Workspace bytes (the library's static RAM on this board).
     pub workspace_bytes: u32,
@@ -1202,7 +1334,7 @@ pub fn measure(
     let ipt = board.instructions_per_tick();
     if (measured - ipt).abs() > ipt * 1e-3 {
         bail!(
-            "{}: SysTick counts {measured:.4} instructions per tick, expected {ipt} \
+            "{}: the timer counts {measured:.4} instructions per tick, expected {ipt} \
              (QEMU not run with -icount shift=0, or another clock?)",
             board.name
         );
@@ -1347,7 +1479,7 @@ pub fn print_measurement(m: &Measurement) {
         delta(with, without) as f64 / 1024.0,
     );
     crate::outln!(
-        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per SysTick tick (calibrated)",
+        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per timer tick (calibrated)",
         m.capacity.0, m.capacity.1, m.capacity.2, m.instructions_per_tick
     );
     crate::outln!(
@@ -1450,7 +1582,7 @@ pub fn print_summary(ms: &[Measurement]) {
         ms[0].backend
     );
     crate::outln!(
-        "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+        "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
         "board",
         "fw flash",
         "fw RAM",
@@ -1481,7 +1613,7 @@ pub fn print_summary(ms: &[Measurement]) {
                 .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
         };
         crate::outln!(
-            "{:<12} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+            "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
             m.board.name,
             m.sizes.flash,
             m.sizes.static_ram,
@@ -1504,8 +1636,8 @@ pub fn print_summary(ms: &[Measurement]) {
 /// `host-sim qemu ...`: runs the library on the emulated boards.
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
-    /// Board (QEMU machine) to use; repeat for several. Default: all five
-    /// (microbit, lm3s6965evb, mps2-an386, mps2-an500, mps2-an505).
+    /// Board to use; repeat for several. Default: all seven (microbit, lm3s6965evb,
+    /// mps2-an386, mps2-an500, mps2-an505, riscv32imc-virt-400k, riscv32imac-virt-32k).
     #[arg(long = "board", value_name = "MACHINE")]
     pub boards: Vec<String>,
     /// Math backend of the library (default: the one host-sim was built with). Another one
@@ -1527,8 +1659,8 @@ pub struct Args {
     /// never rewritten).
     #[arg(long, requires = "cluster")]
     pub bless: bool,
-    /// Report, per case and board, instructions (SysTick, -icount shift=0), instructions per
-    /// collapse and stack; per golden progressive stream, instructions per split decoding and
+    /// Report, per case and board, instructions (SysTick or mcycle, -icount shift=0),
+    /// instructions per collapse and stack; per golden progressive stream, instructions per split decoding and
     /// per collapse / split moving the slider; per board the image sizes of the firmware and of the library alone,
     /// the flash of one instantiation (`tests/flash`, as `scripts/flash.sh` measures it) and the
     /// largest mesh it simplifies (bisection). Not pass/fail.
@@ -1608,7 +1740,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             };
             failed += usize::from(!echoed);
             crate::outln!(
-                "{:<12} echo {}",
+                "{:<20} echo {}",
                 b.name,
                 if echoed { "ok" } else { "FAILED" }
             );
@@ -1628,7 +1760,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 let ok = run.exit_code == Some(want);
                 failed += usize::from(!ok);
                 crate::outln!(
-                    "{:<12} {cmd:<9} {}",
+                    "{:<20} {cmd:<9} {}",
                     b.name,
                     if ok { "ok" } else { "FAILED" }
                 );
@@ -1649,7 +1781,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             let ok = run.exit_code == Some(EXIT_IO);
             failed += usize::from(!ok);
             crate::outln!(
-                "{:<12} {:<9} {}",
+                "{:<20} {:<9} {}",
                 b.name,
                 "missing",
                 if ok { "ok" } else { "FAILED" }
@@ -1742,6 +1874,8 @@ mod tests {
             ("mps2-an386", 53_000, 106_000, 4, 1_024),
             ("mps2-an500", 53_000, 106_000, 4, 1_024),
             ("mps2-an505", 53_000, 106_000, 4, 1_024),
+            ("riscv32imc-virt-400k", 6_000, 13_000, 2, 1_024),
+            ("riscv32imac-virt-32k", 500, 1_000, 2, 0),
         ];
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
         let streams = crate::streamcase::load(&golden::default_dir()).unwrap();
@@ -1768,6 +1902,7 @@ mod tests {
             let (pv, pbuf) = match board {
                 "microbit" => (44, 80),
                 "lm3s6965evb" => (100, 272),
+                "riscv32imac-virt-32k" => (100, 272),
                 _ => (3_000, 4_096),
             };
             let too_big: Vec<&str> = too_big
@@ -1837,5 +1972,20 @@ mod tests {
             .any(|a| a
                 == "enable=on,target=native,arg=tinydecimate-firmware,arg=case.bin,arg=out.bin"));
         assert!(!args.iter().any(|a| a == "-cpu"));
+
+        // RISC-V: virt without boot firmware, the core without the part's missing extensions.
+        let b = board("riscv32imc-virt-400k").unwrap();
+        let c = qemu_command(b, Path::new("fw.elf"), &["case.bin", "out.bin"]);
+        assert_eq!(c.get_program(), "qemu-system-riscv32");
+        let args: Vec<_> = c
+            .get_args()
+            .map(|a| a.to_string_lossy().into_owned())
+            .collect();
+        assert!(args.windows(2).any(|w| w == ["-machine", "virt"]));
+        assert!(args.windows(2).any(|w| w == ["-bios", "none"]));
+        assert!(args
+            .windows(2)
+            .any(|w| w == ["-cpu", "rv32,a=false,f=false,d=false"]));
+        assert!(args.windows(2).any(|w| w == ["-icount", "shift=0"]));
     }
 }

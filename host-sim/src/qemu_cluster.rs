@@ -371,7 +371,7 @@ pub fn check(
             Ok(e) => e,
             Err(e) => {
                 failed += cases.len();
-                crate::outln!("{:<12} FAILED: {e:#}", b.name);
+                crate::outln!("{:<20} FAILED: {e:#}", b.name);
                 continue;
             }
         };
@@ -415,13 +415,13 @@ pub fn check(
                     format!("FAILED: {}", br.run.describe())
                 }
             };
-            crate::outln!("  {:<12} {:<28} {line}", b.name, case.spec.name);
+            crate::outln!("  {:<20} {:<28} {line}", b.name, case.spec.name);
             if verbose {
                 crate::outln!("    {}", br.run.describe().replace('\n', "\n    "));
             }
         }
         eprintln!(
-            "{:<12} cluster firmware ({backend}) built in {built:.1} s",
+            "{:<20} cluster firmware ({backend}) built in {built:.1} s",
             b.name
         );
     }

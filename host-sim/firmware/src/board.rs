@@ -76,6 +76,45 @@ mod sel {
     pub const PM_BUFFER: usize = 4_096;
 }
 
+/// An ESP32-C3-class RISC-V part (riscv32imc, no FPU: soft float as on the M0 and M3) on QEMU's
+/// `virt` machine, linked into 400 KB of RAM (memory/riscv32-virt-400k.x).
+#[cfg(feature = "board-riscv32imc-virt-400k")]
+mod sel {
+    pub const BOARD: super::Board = super::Board::Riscv32ImcVirt400k;
+    pub const NAME: &str = "riscv32imc-virt-400k";
+    /// 400 KB of RAM, u16 links: positions 72 000 B, triangles 78 000 B, workspace ≈ 144 000 B;
+    /// quadrics 40 960 B and the stream arena 52 096 B below; the rest is stack. 13 000
+    /// triangles rather than 2 per vertex: the cow's stream (5 804 triangles and as many links
+    /// after the list heads) needs the bytes.
+    pub const MAX_VERTICES: usize = 6_000;
+    pub const MAX_TRIANGLES: usize = 13_000;
+    /// Stored quadrics (40 B per vertex) for meshes up to this many vertices, as on the 4 MB
+    /// boards: every stored-quadric and bounded golden case fits.
+    pub const QUADRIC_VERTICES: usize = 1_024;
+    pub type Link = u16;
+    /// Progressive streams: 3 000 vertex splits (48 000 B) and a 4 KB chunk buffer.
+    pub const PM_VERTICES: usize = 3_000;
+    pub const PM_BUFFER: usize = 4_096;
+}
+
+/// A GD32VF103-class RISC-V part (riscv32imac, no FPU) on QEMU's `virt` machine, linked into
+/// 32 KB of RAM (memory/riscv32-virt-32k.x).
+#[cfg(feature = "board-riscv32imac-virt-32k")]
+mod sel {
+    pub const BOARD: super::Board = super::Board::Riscv32ImacVirt32k;
+    pub const NAME: &str = "riscv32imac-virt-32k";
+    /// 32 KB of RAM, u16 links: positions 6 000 B, triangles 6 000 B, workspace ≈ 11 500 B.
+    pub const MAX_VERTICES: usize = 500;
+    pub const MAX_TRIANGLES: usize = 1_000;
+    /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
+    pub const QUADRIC_VERTICES: usize = 0;
+    pub type Link = u16;
+    /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer, as on the
+    /// lm3s6965evb.
+    pub const PM_VERTICES: usize = 100;
+    pub const PM_BUFFER: usize = 272;
+}
+
 pub use sel::*;
 
 /// Bytes a bounded case (`Workspace::simplify_bounded`) borrows from the quadric storage, which

@@ -1,4 +1,4 @@
-//! tinydecimate on an emulated Cortex-M.
+//! tinydecimate on an emulated Cortex-M or RISC-V core (the differences: src/arch.rs).
 //!
 //! The host (`host-sim qemu`) starts QEMU with three semihosting arguments,
 //! `<program> <case file> <result file>`: the firmware reads the case (mesh + configuration,
@@ -11,23 +11,27 @@
 //! Logs are defmt frames on semihosting stdout (defmt-semihosting), decoded by the host with
 //! the image's ELF. Nothing else writes to stdout. Exit status through SYS_EXIT_EXTENDED:
 //! 0 done (the result file says how the case went), 2 host file I/O failed, 101 panic,
-//! 102 HardFault or unexpected exception.
+//! 102 HardFault or unexpected exception (RISC-V: any trap).
 
 #![no_std]
 #![no_main]
 
+mod arch;
 mod board;
 mod hostio;
 mod measure;
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use cortex_m::peripheral::SYST;
+#[cfg(target_arch = "arm")]
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
 use meshfmt::{CaseHeader, IndexType, ResultHeader, Status, CASE_HEADER_LEN};
+#[cfg(target_arch = "riscv32")]
+use riscv_rt::entry;
 use static_cell::ConstStaticCell;
 
+use arch::Timer;
 use hostio::IoError;
 
 #[cfg(target_endian = "big")]
@@ -57,7 +61,7 @@ static TRIANGLES: ConstStaticCell<board::TriangleBytes> =
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
+    let Some(mut timer) = arch::timer() else {
         semihosting::process::exit(EXIT_FAULT)
     };
     let args = hostio::args();
@@ -73,7 +77,7 @@ fn main() -> ! {
     let triangles = &mut TRIANGLES.take().0;
     let result = RESULT.take();
     let code = match (args.get(1), args.get(2)) {
-        (Some("calibrate"), Some(out)) => match calibrate(&mut cp.SYST, out) {
+        (Some("calibrate"), Some(out)) => match calibrate(&mut timer, out) {
             Ok(()) => 0,
             Err(e) => {
                 defmt::error!("host file I/O failed: {}", e);
@@ -82,8 +86,8 @@ fn main() -> ! {
         },
         (Some(case), Some(out)) => {
             let run = match hostio::magic(case) {
-                Ok(m) if m == *b"TDPM" => run_stream(&mut cp.SYST, case, out, positions, triangles),
-                Ok(_) => run_case(&mut cp.SYST, case, out, positions, triangles, result),
+                Ok(m) if m == *b"TDPM" => run_stream(&mut timer, case, out, positions, triangles),
+                Ok(_) => run_case(&mut timer, case, out, positions, triangles, result),
                 Err(e) => Err(e),
             };
             match run {
@@ -96,11 +100,9 @@ fn main() -> ! {
         }
         // Checks that a panic and a fault end QEMU with a failure status.
         (Some("panic"), _) => defmt::panic!("panic requested"),
-        // A permanently undefined instruction: UsageFault escalated to HardFault (M3 and up),
-        // HardFault directly on the M0. (Loads from unmapped addresses do not fault on every
-        // QEMU machine.)
-        (Some("fault"), _) => cortex_m::asm::udf(),
-        _ => selftest(&mut cp.SYST, positions, triangles, result),
+        // An undefined instruction: HardFault on Cortex-M, an exception on RISC-V (arch.rs).
+        (Some("fault"), _) => arch::fault(),
+        _ => selftest(&mut timer, positions, triangles, result),
     };
     semihosting::process::exit(code)
 }
@@ -111,7 +113,7 @@ fn main() -> ! {
 /// header, the NUL-terminated paths, the encoded result header) are off the stack while the
 /// library runs: on the micro:bit every byte of stack is mesh capacity.
 fn run_case(
-    syst: &mut SYST,
+    syst: &mut Timer,
     case_path: &str,
     out_path: &str,
     positions: &mut [[f32; 3]],
@@ -203,7 +205,7 @@ fn write_result(out_path: &str, result: &ResultHeader, triangles: &[u8]) -> Resu
 /// the list heads, the triangles and their links; the positions buffer holds the positions.
 #[cfg(feature = "lib")]
 fn run_stream(
-    syst: &mut SYST,
+    syst: &mut Timer,
     in_path: &str,
     out_path: &str,
     positions: &mut [[f32; 3]],
@@ -279,7 +281,7 @@ fn run_stream(
 
 #[cfg(not(feature = "lib"))]
 fn run_stream(
-    _syst: &mut SYST,
+    _syst: &mut Timer,
     _in_path: &str,
     _out_path: &str,
     _positions: &mut [[f32; 3]],
@@ -294,7 +296,7 @@ fn run_stream(
 struct StreamDevice<'a> {
     input: semihosting::fs::File,
     output: semihosting::fs::File,
-    syst: &'a mut SYST,
+    syst: &'a mut Timer,
 }
 
 #[cfg(feature = "lib")]
@@ -322,23 +324,24 @@ impl meshfmt::pm::Device for StreamDevice<'_> {
     }
 }
 
-/// Instructions in [`calibrate`]'s loop: `cortex_m::asm::delay(n)` runs `subs; bne` n + 1 times.
+/// Passes of [`calibrate`]'s loop (`arch::delay`).
 const CALIBRATION_LOOPS: u32 = 5_000_000;
 
-/// Times a loop of 2 × (CALIBRATION_LOOPS + 1) instructions, so the host can check how many
-/// instructions one timer tick is on this board. Writes a result file with only the ticks.
-fn calibrate(syst: &mut SYST, out_path: &str) -> Result<(), IoError> {
+/// Times a loop of a known number of instructions (about 10 million), so the host can check
+/// how many instructions one timer tick is on this board. Writes a result file with only the
+/// ticks and the instructions.
+fn calibrate(syst: &mut Timer, out_path: &str) -> Result<(), IoError> {
     measure::start(syst);
-    cortex_m::asm::delay(CALIBRATION_LOOPS);
+    let instructions = arch::delay(CALIBRATION_LOOPS);
     let ticks = measure::stop(syst);
     defmt::info!(
         "calibration: {=u32} instructions in {=u64} ticks",
-        2 * (CALIBRATION_LOOPS + 1),
+        instructions,
         ticks
     );
     let mut r = ResultHeader::empty(IndexType::U16, Status::Ok, board::BOARD);
     r.ticks = ticks;
-    r.error_a = 2 * (CALIBRATION_LOOPS + 1);
+    r.error_a = instructions;
     let mut out = hostio::create(out_path)?;
     hostio::write_all(&mut out, &r.to_bytes())
 }
@@ -346,7 +349,7 @@ fn calibrate(syst: &mut SYST, out_path: &str) -> Result<(), IoError> {
 /// Simplifies the mesh in the buffers, measuring instructions and stack.
 #[cfg(feature = "lib")]
 fn simplify(
-    syst: &mut SYST,
+    syst: &mut Timer,
     h: &CaseHeader,
     pos: &mut [[f32; 3]],
     tri: &mut [u8],
@@ -468,7 +471,7 @@ fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).
 #[cfg(not(feature = "lib"))]
 fn simplify(
-    syst: &mut SYST,
+    syst: &mut Timer,
     h: &CaseHeader,
     _pos: &mut [[f32; 3]],
     _tri: &mut [u8],
@@ -490,7 +493,7 @@ fn simplify(
 
 /// No case given: simplify a bumpy grid of (n × n) quads that fits the board.
 fn selftest(
-    syst: &mut SYST,
+    syst: &mut Timer,
     positions: &mut [[f32; 3]],
     triangles: &mut [u8],
     r: &mut ResultHeader,
@@ -577,6 +580,7 @@ fn defmt_panic() -> ! {
     semihosting::process::exit(EXIT_PANIC)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
     if !PANICKED.load(Ordering::Relaxed) {
@@ -591,6 +595,7 @@ unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
     semihosting::process::exit(EXIT_FAULT)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
     defmt::error!("unexpected exception {=i16}", irqn);

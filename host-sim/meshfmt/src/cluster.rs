@@ -354,6 +354,8 @@ impl ClusterResult {
             3 => Board::Mps2An386,
             4 => Board::Mps2An500,
             5 => Board::Mps2An505,
+            6 => Board::Riscv32ImcVirt400k,
+            7 => Board::Riscv32ImacVirt32k,
             _ => return Err(FormatError::Code),
         };
         Ok(h)

@@ -399,6 +399,10 @@ pub enum Board {
     Mps2An386 = 3,
     Mps2An500 = 4,
     Mps2An505 = 5,
+    /// RISC-V `riscv32imc`, QEMU `virt`, 400 KB of RAM (an ESP32-C3-class part).
+    Riscv32ImcVirt400k = 6,
+    /// RISC-V `riscv32imac`, QEMU `virt`, 32 KB of RAM (a GD32VF103-class part).
+    Riscv32ImacVirt32k = 7,
 }
 
 /// The result header. Counts are `u32`, the library's `usize` narrowed (saturating).
@@ -587,6 +591,8 @@ impl ResultHeader {
             3 => Board::Mps2An386,
             4 => Board::Mps2An500,
             5 => Board::Mps2An505,
+            6 => Board::Riscv32ImcVirt400k,
+            7 => Board::Riscv32ImacVirt32k,
             _ => Board::Host,
         };
         Ok(h)

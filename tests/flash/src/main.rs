@@ -13,7 +13,6 @@
 
 use core::hint::black_box;
 
-use cortex_m_rt::entry;
 #[cfg(feature = "call")]
 use tinydecimate::Config;
 use tinydecimate::Workspace;
@@ -71,7 +70,8 @@ const CONFIG: Config = if cfg!(feature = "paper") {
     Config::new()
 };
 
-#[entry]
+#[cfg(target_arch = "arm")]
+#[cortex_m_rt::entry]
 fn main() -> ! {
     // cortex-m-rt turns these into `&'static mut` references (no `unsafe`): RAM statics, the
     // workspaces zeroed in `.bss` (`Workspace::new` is const and all zero).
@@ -79,10 +79,38 @@ fn main() -> ! {
     static mut WS32: Workspace<u32, 512, 1024> = Workspace::new();
     static mut TRIS: [[u16; 3]; 8] = OCTAHEDRON;
     static mut TRIS32: [[u32; 3]; 8] = octahedron_u32();
+    run(WS, WS32, TRIS, TRIS32)
+}
 
-    // The same statics with and without the call: only the library differs.
-    let (ws, ws32) = (black_box(WS), black_box(WS32));
-    let (tris, tris32) = (black_box(TRIS), black_box(TRIS32));
+#[cfg(target_arch = "riscv32")]
+#[riscv_rt::entry]
+fn main() -> ! {
+    static mut WS: Workspace<u16, 512, 1024> = Workspace::new();
+    static mut WS32: Workspace<u32, 512, 1024> = Workspace::new();
+    static mut TRIS: [[u16; 3]; 8] = OCTAHEDRON;
+    static mut TRIS32: [[u32; 3]; 8] = octahedron_u32();
+    // SAFETY: `main` runs once and nothing else names these statics: the references are
+    // unique, as the ones cortex-m-rt's `entry` makes on Cortex-M.
+    unsafe {
+        run(
+            &mut *core::ptr::addr_of_mut!(WS),
+            &mut *core::ptr::addr_of_mut!(WS32),
+            &mut *core::ptr::addr_of_mut!(TRIS),
+            &mut *core::ptr::addr_of_mut!(TRIS32),
+        )
+    }
+}
+
+/// The firmware: the same statics with and without the call, so only the library differs.
+#[inline(always)]
+fn run(
+    ws: &'static mut Workspace<u16, 512, 1024>,
+    ws32: &'static mut Workspace<u32, 512, 1024>,
+    tris: &'static mut [[u16; 3]; 8],
+    tris32: &'static mut [[u32; 3]; 8],
+) -> ! {
+    let (ws, ws32) = (black_box(ws), black_box(ws32));
+    let (tris, tris32) = (black_box(tris), black_box(tris32));
     black_box(&POSITIONS);
 
     #[cfg(feature = "call")]

@@ -1,5 +1,5 @@
-//! tinydecimate's streaming vertex clustering on an emulated Cortex-M: a mesh far bigger than
-//! the board's RAM, read through semihosting as it is needed.
+//! tinydecimate's streaming vertex clustering on an emulated Cortex-M or RISC-V core: a mesh far
+//! bigger than the board's RAM, read through semihosting as it is needed.
 //!
 //! Semihosting arguments `<program> <case> <result>` (format in host-sim/meshfmt/src/cluster.rs).
 //! The triangles are read from the case file in chunks of `tinydecimate::cluster::CHUNK`
@@ -15,6 +15,8 @@
 #![no_std]
 #![no_main]
 
+#[path = "../arch.rs"]
+mod arch;
 #[path = "../board.rs"]
 mod board;
 #[path = "../hostio.rs"]
@@ -24,16 +26,19 @@ mod measure;
 
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use cortex_m::peripheral::SYST;
+#[cfg(target_arch = "arm")]
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
 use meshfmt::cluster::{ClusterCase, ClusterResult, CLUSTER_CASE_LEN};
 use meshfmt::{IndexType, Status};
+#[cfg(target_arch = "riscv32")]
+use riscv_rt::entry;
 use semihosting::fs::File;
 use semihosting::io::{Read, Seek, SeekFrom};
 use static_cell::ConstStaticCell;
 use tinydecimate::cluster::{ClusterError, ClusterReport, Clusterer, Quadrics, Source};
 
+use arch::Timer;
 use hostio::IoError;
 
 #[cfg(target_endian = "big")]
@@ -78,6 +83,27 @@ mod cap {
     pub const RAM_VERTICES: usize = 40_000;
     pub const RAM_TRIANGLES: usize = 80_000;
 }
+/// RISC-V, 400 KB (an ESP32-C3-class part).
+#[cfg(feature = "board-riscv32imc-virt-400k")]
+mod cap {
+    /// Table 49 152 B, quadrics 163 840 B, output 96 000 B (16 000 u16 / 8 000 u32 triangles);
+    /// no room for a mesh in RAM.
+    pub const CELLS: usize = 4_096;
+    pub const OUT_BYTES: usize = 96_000;
+    pub const QUADRICS: bool = true;
+    pub const RAM_VERTICES: usize = 0;
+    pub const RAM_TRIANGLES: usize = 0;
+}
+/// RISC-V, 32 KB (a GD32VF103-class part).
+#[cfg(feature = "board-riscv32imac-virt-32k")]
+mod cap {
+    /// Table 14 400 B + output 12 000 B (2 000 u16 triangles); the rest is stack.
+    pub const CELLS: usize = 1_200;
+    pub const OUT_BYTES: usize = 12_000;
+    pub const QUADRICS: bool = false;
+    pub const RAM_VERTICES: usize = 0;
+    pub const RAM_TRIANGLES: usize = 0;
+}
 use cap::*;
 
 type Table = Clusterer<CELLS>;
@@ -87,7 +113,8 @@ static TABLE: ConstStaticCell<Table> = ConstStaticCell::new(Clusterer::new());
 #[cfg(any(
     feature = "board-mps2-an386",
     feature = "board-mps2-an500",
-    feature = "board-mps2-an505"
+    feature = "board-mps2-an505",
+    feature = "board-riscv32imc-virt-400k"
 ))]
 fn quadrics() -> Option<&'static mut Quadrics<CELLS>> {
     static QUADS: ConstStaticCell<Quadrics<CELLS>> = ConstStaticCell::new(Quadrics::new());
@@ -96,7 +123,8 @@ fn quadrics() -> Option<&'static mut Quadrics<CELLS>> {
 #[cfg(not(any(
     feature = "board-mps2-an386",
     feature = "board-mps2-an500",
-    feature = "board-mps2-an505"
+    feature = "board-mps2-an505",
+    feature = "board-riscv32imc-virt-400k"
 )))]
 fn quadrics() -> Option<&'static mut Quadrics<CELLS>> {
     None
@@ -116,7 +144,7 @@ static RESULT: ConstStaticCell<ClusterResult> = ConstStaticCell::new(ClusterResu
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
+    let Some(mut timer) = arch::timer() else {
         semihosting::process::exit(EXIT_FAULT)
     };
     let args = hostio::args();
@@ -132,7 +160,7 @@ fn main() -> ! {
     let result = RESULT.take();
     let code = match (args.get(1), args.get(2)) {
         (Some("panic"), _) => defmt::panic!("panic requested"),
-        (Some(case), Some(out)) => match run(&mut cp.SYST, case, out, result) {
+        (Some(case), Some(out)) => match run(&mut timer, case, out, result) {
             Ok(()) => 0,
             Err(e) => {
                 defmt::error!("host file I/O failed: {}", e);
@@ -212,7 +240,7 @@ impl Source for FileSource {
 }
 
 fn run(
-    syst: &mut SYST,
+    syst: &mut Timer,
     case_path: &str,
     out_path: &str,
     r: &mut ClusterResult,
@@ -366,6 +394,7 @@ fn defmt_panic() -> ! {
     semihosting::process::exit(EXIT_PANIC)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
     if !PANICKED.load(Ordering::Relaxed) {
@@ -380,6 +409,7 @@ unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
     semihosting::process::exit(EXIT_FAULT)
 }
 
+#[cfg(target_arch = "arm")]
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
     defmt::error!("unexpected exception {=i16}", irqn);
