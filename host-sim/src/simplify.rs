@@ -94,7 +94,7 @@ pub enum OperatorArg {
     /// Half-edge collapse.
     #[default]
     Edge,
-    /// Triangle collapse (seed 001 §3): weight of eq. 3, penalty re-insertion; greedy only.
+    /// Triangle collapse (Zhu, Wang and Meng 2007, §3): weight of eq. 3, penalty re-insertion; greedy only.
     Triangle,
 }
 
@@ -260,7 +260,7 @@ pub struct Args {
     /// Target triangle count (with --ratio, the higher target wins).
     #[arg(long, group = "target")]
     pub target_triangles: Option<usize>,
-    /// Guaranteed error bound (Zhu, Wang and Meng 2007, seed 001): no original triangle's
+    /// Guaranteed error bound (Zhu, Wang and Meng 2007): no original triangle's
     /// centroid and no vertex of an original feature edge ends farther than this from the
     /// result. `P%` of the bounding-box diagonal (`0.5%`) or an absolute distance in the
     /// input's units. Alone, simplifies as far as the bound allows; with --ratio or
@@ -282,7 +282,7 @@ pub struct Args {
     /// `--quadric stored` (`Config::stored()`).
     #[arg(long, conflicts_with = "features")]
     pub no_features: bool,
-    /// Turn feature detection on with `--quadric stored` (seed 004's rule on top of the
+    /// Turn feature detection on with `--quadric stored` (Lin Mouguang 2007's rule on top of the
     /// quadrics; on by default in every other mode).
     #[arg(long)]
     pub features: bool,
@@ -302,11 +302,11 @@ pub struct Args {
     /// normal for passes as in `Config::paper()`).
     #[arg(long, value_enum)]
     pub cost: Option<CostArg>,
-    /// Simplification operator: half-edge collapse, or the triangle collapse of seed 001
-    /// (Zhu, Wang and Meng 2007; greedy schedule only).
+    /// Simplification operator: half-edge collapse, or the triangle collapse of
+    /// Zhu, Wang and Meng 2007 (greedy schedule only).
     #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
     pub operator: OperatorArg,
-    /// Quadric: `stored` keeps a quadric per vertex (issue 15), replacing --cost.
+    /// Quadric: `stored` keeps a quadric per vertex, replacing --cost.
     #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
     pub quadric: QuadricArg,
     /// Placement of the kept vertex with `--quadric stored`.

@@ -1,0 +1,126 @@
+//! Problems users reported with the `host-sim` command line, one test (or more) each: the
+//! built binary on small generated files.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bin().args(args).output().unwrap()
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn write(dir: &Path, name: &str, body: impl AsRef<[u8]>) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, body).unwrap();
+    p
+}
+
+/// A bumpy n x n grid of triangles as OBJ text.
+fn grid_obj(n: usize) -> String {
+    let mut s = String::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            let (fx, fy) = (x as f32 / n as f32, y as f32 / n as f32);
+            let z = 0.08 * (fx * 7.0).sin() * (fy * 5.0).cos();
+            s += &format!("v {fx} {fy} {z}\n");
+        }
+    }
+    let v = |x: usize, y: usize| 1 + y * (n + 1) + x;
+    for y in 0..n {
+        for x in 0..n {
+            let (a, b, c, d) = (v(x, y), v(x + 1, y), v(x + 1, y + 1), v(x, y + 1));
+            s += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    s
+}
+
+/// Every subcommand's `--help`, nested ones included.
+fn all_help() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let cmds: &[&[&str]] = &[
+        &[],
+        &["simplify"],
+        &["cluster"],
+        &["metro"],
+        &["check"],
+        &["render"],
+        &["bench"],
+        &["qemu"],
+        &["golden"],
+        &["demo"],
+        &["pm"],
+        &["pm", "encode"],
+        &["pm", "decode"],
+        &["pm", "levels"],
+        &["pm", "stream"],
+        &["bound-table"],
+        &["run-elf"],
+    ];
+    for c in cmds {
+        let mut a = c.to_vec();
+        a.push("--help");
+        let o = run(&a);
+        assert_eq!(o.status.code(), Some(0), "{a:?}: {}", text(&o.stderr));
+        out.push((c.join(" "), text(&o.stdout)));
+    }
+    out
+}
+
+/// Whether `t` contains `word` followed by a space and a digit (case-insensitive).
+fn labelled(t: &str, word: &str) -> Option<String> {
+    let low = t.to_lowercase();
+    low.match_indices(word).find_map(|(i, _)| {
+        let rest = &low[i + word.len()..];
+        rest.chars()
+            .next()
+            .filter(char::is_ascii_digit)
+            .map(|_| low[i..(i + word.len() + 3).min(low.len())].to_string())
+    })
+}
+
+/// Internal labels ("issue 10", "seed 001") are not in what users read: help texts, printed
+/// output (its strings live in host-sim/src) or host-sim's doc comments; and `run-elf` names
+/// the example that exists.
+#[test]
+fn no_internal_labels_in_help_or_sources() {
+    for (cmd, help) in all_help() {
+        for w in ["issue ", "seed "] {
+            assert!(
+                labelled(&help, w).is_none(),
+                "host-sim {cmd} --help: {help}"
+            );
+        }
+    }
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        let body = std::fs::read_to_string(&p).unwrap();
+        for (no, line) in body.lines().enumerate() {
+            for w in ["issue ", "seed 0"] {
+                assert!(
+                    labelled(line, w).is_none(),
+                    "{}:{}: {line}",
+                    p.display(),
+                    no + 1
+                );
+            }
+        }
+    }
+    let help = text(&run(&["run-elf", "--help"]).stdout);
+    assert!(help.contains("examples/cortex-m4f"), "{help}");
+    assert!(!help.contains("examples/firmware"), "{help}");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    assert!(root.join("examples/cortex-m4f").is_dir());
+}
