@@ -124,3 +124,25 @@ fn no_internal_labels_in_help_or_sources() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     assert!(root.join("examples/cortex-m4f").is_dir());
 }
+
+/// `simplify --help`, one flag's paragraph (from its line to the next flag's).
+fn flag_help(help: &str, flag: &str) -> String {
+    let start = help
+        .find(&format!("      {flag}"))
+        .unwrap_or_else(|| panic!("{flag} not in {help}"));
+    let rest = &help[start + flag.len() + 6..];
+    let end = rest.find("\n      -").unwrap_or(rest.len());
+    rest[..end].to_string()
+}
+
+/// `--max-error` says what is guaranteed (the distance at the control points), not a
+/// "guaranteed error bound" of the whole surface.
+#[test]
+fn max_error_help_says_what_is_guaranteed() {
+    let help = text(&run(&["simplify", "--help"]).stdout);
+    let h = flag_help(&help, "--max-error");
+    assert!(!h.to_lowercase().contains("guaranteed error bound"), "{h}");
+    assert!(h.contains("control point"), "{h}");
+    assert!(h.contains("centroid") && h.contains("feature edge"), "{h}");
+    assert!(h.contains("not bounded") && h.contains("Hausdorff"), "{h}");
+}
