@@ -146,3 +146,44 @@ fn max_error_help_says_what_is_guaranteed() {
     assert!(h.contains("centroid") && h.contains("feature edge"), "{h}");
     assert!(h.contains("not bounded") && h.contains("Hausdorff"), "{h}");
 }
+
+/// `--help` says what each operator, cost, schedule, quadric and placement is for, and which
+/// ones are there for comparison with a paper.
+#[test]
+fn help_says_what_each_choice_is_for() {
+    let help = text(&run(&["simplify", "--help"]).stdout);
+    let op = flag_help(&help, "--operator");
+    assert!(
+        op.contains("edge:") && op.contains("the one to use"),
+        "{op}"
+    );
+    assert!(
+        op.contains("triangle:") && op.contains("For comparison") && op.contains("twice as long"),
+        "{op}"
+    );
+    let sc = flag_help(&help, "--schedule");
+    assert!(
+        sc.contains("greedy:") && sc.contains("the one to use"),
+        "{sc}"
+    );
+    assert!(
+        sc.contains("passes:") && sc.contains("For comparison"),
+        "{sc}"
+    );
+    let co = flag_help(&help, "--cost");
+    assert!(
+        co.contains("quadric:") && co.contains("lowest geometric error"),
+        "{co}"
+    );
+    assert!(
+        co.contains("normal:") && co.contains("for comparison"),
+        "{co}"
+    );
+    let q = flag_help(&help, "--quadric");
+    assert!(
+        q.contains("RAM is tight") && q.contains("40 B per vertex"),
+        "{q}"
+    );
+    let p = flag_help(&help, "--placement");
+    assert!(p.contains("--placement optimal"), "{p}");
+}
