@@ -287,6 +287,19 @@ pub fn check_writable(path: &Path, format: Option<Format>) -> Result<Format> {
     Ok(f)
 }
 
+/// Whether `output` names the file `input` is (standard input and output never do): the
+/// same canonical path, so `./a.stl`, `dir/../a.stl` and a symbolic link to it all count.
+/// An output that does not exist yet is not an input.
+pub fn same_file(input: &Path, output: &Path) -> bool {
+    if is_std(input) || is_std(output) || !output.exists() {
+        return false;
+    }
+    match (input.canonicalize(), output.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 /// Saves `mesh` to `path` (`-`: standard output) in `format`.
 pub fn save_as(path: &Path, format: Format, mesh: &MeshData) -> Result<()> {
     let name = if is_std(path) {

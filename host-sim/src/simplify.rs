@@ -336,6 +336,9 @@ pub struct Args {
     /// Print the report, the check and the Metro error as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Allow the output to be the input file (it is overwritten).
+    #[arg(long)]
+    pub force: bool,
 }
 
 impl Args {
@@ -656,6 +659,13 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         bail!("--json and an output of `-` would both write standard output: give an output file");
     }
     let out_format = crate::io::check_writable(&args.output, args.format)?;
+    if !args.force && crate::io::same_file(&args.input, &args.output) {
+        bail!(
+            "{}: the output is the input file and would overwrite it: give another output, or \
+             --force",
+            args.output.display()
+        );
+    }
     let mesh = crate::io::load_noting(&args.input)?;
     let mut config = args.config();
     if let Some(e) = args.max_error {

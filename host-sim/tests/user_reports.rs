@@ -187,3 +187,52 @@ fn help_says_what_each_choice_is_for() {
     let p = flag_help(&help, "--placement");
     assert!(p.contains("--placement optimal"), "{p}");
 }
+
+/// `simplify a.stl a.stl` (or any other spelling of the same file) refuses to overwrite its
+/// input unless `--force`, and leaves the file as it was.
+#[test]
+fn simplify_refuses_to_overwrite_its_input() {
+    let d = tempfile::tempdir().unwrap();
+    let input = write(d.path(), "a.obj", grid_obj(8));
+    let before = std::fs::read(&input).unwrap();
+    std::fs::create_dir(d.path().join("sub")).unwrap();
+    let other = d.path().join("sub/../a.obj");
+    for out in [input.clone(), other] {
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.5",
+            "--no-measure",
+        ]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains("is the input") && e.contains("--force"), "{e}");
+        assert_eq!(std::fs::read(&input).unwrap(), before, "input untouched");
+    }
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&input),
+        "--ratio",
+        "0.5",
+        "--no-measure",
+        "--force",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    assert_ne!(
+        std::fs::read(&input).unwrap(),
+        before,
+        "overwritten with --force"
+    );
+    // A new output next to it is fine.
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&d.path().join("b.obj")),
+        "--ratio",
+        "0.5",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+}
