@@ -236,3 +236,50 @@ fn simplify_refuses_to_overwrite_its_input() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
 }
+
+/// A NaN in a vertex no face uses is accepted, as the library accepts it (it only checks the
+/// vertices its triangles use); a NaN in a used vertex is refused with its line.
+#[test]
+fn nan_in_an_unused_vertex_is_accepted() {
+    let d = tempfile::tempdir().unwrap();
+    let body = format!("v nan 0 inf\n{}", grid_obj(8)).replace("f ", "f_");
+    // Shift the faces' indices by one for the extra first vertex.
+    let mut fixed = String::new();
+    for l in body.lines() {
+        if let Some(rest) = l.strip_prefix("f_") {
+            let idx: Vec<String> = rest
+                .split_whitespace()
+                .map(|i| (i.parse::<u32>().unwrap() + 1).to_string())
+                .collect();
+            fixed += &format!("f {}\n", idx.join(" "));
+        } else {
+            fixed += &format!("{l}\n");
+        }
+    }
+    let input = write(d.path(), "nan.obj", &fixed);
+    for extra in [&[][..], &["--keep-numbering"][..]] {
+        let out = d.path().join("out.obj");
+        let mut a = vec!["simplify", s(&input), s(&out), "--ratio", "0.5"];
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
+        assert!(so.contains("=> VALID"), "{so}");
+        let o = run(&["check", s(&input), s(&out)]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stdout));
+    }
+    let o = run(&["check", s(&input), s(&input)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    // Used by a face: refused, with the line.
+    let used = write(d.path(), "used.obj", format!("{fixed}f 1 2 3\n"));
+    let o = run(&[
+        "simplify",
+        s(&used),
+        s(&d.path().join("x.obj")),
+        "--ratio",
+        "0.5",
+    ]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("line 1") && e.contains("non-finite"), "{e}");
+}
