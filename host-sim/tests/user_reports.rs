@@ -283,3 +283,106 @@ fn nan_in_an_unused_vertex_is_accepted() {
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("line 1") && e.contains("non-finite"), "{e}");
 }
+
+/// Runs host-sim with its virtual memory limited to `kib` KiB (`ulimit -v`): a reader that
+/// reserves storage for what a file merely claims fails to allocate and aborts.
+fn run_limited(kib: u64, args: &[&str]) -> Output {
+    let mut a = vec![
+        "-c".to_string(),
+        format!("ulimit -v {kib}; exec \"$0\" \"$@\""),
+        env!("CARGO_BIN_EXE_host-sim").to_string(),
+    ];
+    a.extend(args.iter().map(|s| s.to_string()));
+    Command::new("sh").args(&a).output().unwrap()
+}
+
+/// Enough for host-sim to decode or read a small file (it needs about 100 MB of address
+/// space: a 12 MB static workspace, thread stacks), far below what the crafted files claim.
+const LIMIT_KIB: u64 = 400_000;
+
+/// A stream header (56 bytes, checksum right) claiming `v` vertices and `t` triangles.
+fn stream_header(v: u32, base_v: u32, base_t: u32, t: u32) -> Vec<u8> {
+    let mut h = vec![0u8; 56];
+    h[..4].copy_from_slice(b"TDPM");
+    h[4] = 1; // version
+    h[5] = 4; // index width
+    h[8..12].copy_from_slice(&v.to_le_bytes());
+    h[12..16].copy_from_slice(&base_v.to_le_bytes());
+    h[16..20].copy_from_slice(&base_t.to_le_bytes());
+    h[20..24].copy_from_slice(&t.to_le_bytes());
+    h[24..26].copy_from_slice(&256u16.to_le_bytes());
+    for k in 0..3 {
+        h[40 + 4 * k..44 + 4 * k].copy_from_slice(&1f32.to_le_bytes());
+    }
+    let c = tinydecimate::stream::crc32(&h[..52]);
+    h[52..].copy_from_slice(&c.to_le_bytes());
+    h
+}
+
+/// No reader allocates in proportion to a count a file merely claims: `pm decode` checks a
+/// stream's header (magic, version, checksum) before sizing anything and sizes storage from
+/// what the file holds; PLY element counts and binary STL triangle counts are held against the
+/// file's size. Each crafted file is read under a memory limit far below its claims, and is
+/// refused with a message saying what is wrong.
+#[test]
+fn no_allocation_from_claimed_counts() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("out.obj");
+    // 64 bytes of junk whose "counts" look plausible: not a stream.
+    let mut junk = vec![b'J'; 64];
+    junk[8..12].copy_from_slice(&50_000_000u32.to_le_bytes());
+    junk[20..24].copy_from_slice(&100_000_000u32.to_le_bytes());
+    let junk = write(d.path(), "JUNK", &junk);
+    let obj = write(d.path(), "a.obj", grid_obj(4));
+    for f in [&junk, &obj] {
+        let o = run_limited(LIMIT_KIB, &["pm", "decode", s(f), s(&out)]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains("not a progressive stream"), "{e}");
+        assert!(!e.contains("claims"), "{e}");
+    }
+    // A well-formed header (checksum right) claiming 50 million vertices, then the start of
+    // a chunk of 60 000 positions.
+    let mut h = stream_header(50_000_000, 1_000_000, 2_000_000, 100_000_000);
+    h.extend_from_slice(&[200, 0, 1, 0x60, 0xea, 0, 0, 0]);
+    let big = write(d.path(), "big.tdpm", &h);
+    for cmd in ["decode", "levels"] {
+        let mut a = vec!["pm", cmd, s(&big)];
+        if cmd == "decode" {
+            a.push(s(&out));
+        }
+        let o = run_limited(LIMIT_KIB, &a);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "pm {cmd}: {e}");
+        assert!(e.contains("before its base mesh"), "pm {cmd}: {e}");
+    }
+    // Mesh readers: a PLY vertex count and a binary STL triangle count past the file's end.
+    let ply = write(
+        d.path(),
+        "big.ply",
+        [
+            &b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\n\
+               property float y\nproperty float z\nelement face 1\nproperty list uchar int \
+               vertex_indices\nend_header\n"[..],
+            &[0u8; 64][..],
+        ]
+        .concat(),
+    );
+    let mut stl = vec![0u8; 80];
+    stl.extend_from_slice(&100_000_000u32.to_le_bytes());
+    stl.extend_from_slice(&[0u8; 150]);
+    let stl = write(d.path(), "big.stl", &stl);
+    for f in [&ply, &stl] {
+        let o = run_limited(LIMIT_KIB, &["check", s(f), s(f)]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(e.contains("truncated file"), "{e}");
+    }
+    // And a real stream still decodes under the same limit.
+    let mesh = write(d.path(), "g.obj", grid_obj(10));
+    let tdpm = d.path().join("g.tdpm");
+    let o = run(&["pm", "encode", s(&mesh), s(&tdpm)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let o = run_limited(LIMIT_KIB, &["pm", "decode", s(&tdpm), s(&out)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+}
