@@ -386,3 +386,54 @@ fn no_allocation_from_claimed_counts() {
     let o = run_limited(LIMIT_KIB, &["pm", "decode", s(&tdpm), s(&out)]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
 }
+
+/// A progressive file that has only partly arrived decodes to its finest complete level:
+/// written, exit 0, and a line saying it is partial and which level it is.
+#[test]
+fn partial_stream_decodes_its_finest_complete_level() {
+    let d = tempfile::tempdir().unwrap();
+    let mesh = write(d.path(), "g.obj", grid_obj(16));
+    let tdpm = d.path().join("g.tdpm");
+    let o = run(&["pm", "encode", s(&mesh), s(&tdpm), "--chunk", "64"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let full = std::fs::read(&tdpm).unwrap();
+    let out = d.path().join("out.obj");
+    let o = run(&["pm", "decode", s(&tdpm), s(&out)]);
+    let so = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
+    assert!(!so.contains("PARTIAL"), "{so}");
+    let faces = |p: &Path| {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("f "))
+            .count()
+    };
+    assert_eq!(faces(&out), 512);
+    let mut last = 0;
+    for cut in [full.len() * 2 / 3, full.len() - 1] {
+        let part = write(d.path(), "part.tdpm", &full[..cut]);
+        let o = run(&["pm", "decode", s(&part), s(&out)]);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
+        let line = so.lines().find(|l| l.starts_with("PARTIAL")).expect(&so);
+        assert!(line.contains("vertex splits") && line.contains("of 512 triangles"), "{line}");
+        let n = faces(&out);
+        assert!(n > last && n < 512, "{n} triangles from {cut} bytes");
+        assert!(line.contains(&format!("({n} of 512 triangles")), "{line}");
+        last = n;
+        // The level written is a valid mesh; `pm levels` measures against it.
+        let o = run(&["check", s(&out), s(&out)]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stdout));
+        let o = run(&["pm", "levels", s(&part)]);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
+        assert!(so.starts_with("PARTIAL"), "{so}");
+    }
+    // Cut inside the base mesh: nothing to show, and it says so.
+    let part = write(d.path(), "base.tdpm", &full[..70]);
+    let o = run(&["pm", "decode", s(&part), s(&out)]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("before its base mesh"), "{e}");
+}
