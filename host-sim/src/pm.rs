@@ -603,6 +603,38 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// What a board's streaming firmware holds (host-sim/firmware/src/board.rs): `PM_VERTICES`
+/// vertices, the triangle buffer less the list heads, halved between triangles and their
+/// links, and a `PM_BUFFER`-byte chunk buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StreamCapacity {
+    /// Vertices of the full mesh.
+    pub vertices: usize,
+    /// Triangles of the full mesh.
+    pub triangles: usize,
+    /// Chunk buffer bytes (largest payload plus `CHUNK_OVERHEAD`).
+    pub buffer: usize,
+}
+
+impl StreamCapacity {
+    /// The capacity of the firmware for the board `name`.
+    pub fn of(name: &str) -> Option<StreamCapacity> {
+        // (MAX_TRIANGLES, link bytes, PM_VERTICES, PM_BUFFER) of board.rs.
+        let (max_triangles, link, vertices, buffer) = match name {
+            "microbit" => (432, 2, 44, 80),
+            "lm3s6965evb" => (2_400, 2, 100, 272),
+            "mps2-an386" | "mps2-an500" | "mps2-an505" => (106_000, 4, 3_000, 4_096),
+            _ => return None,
+        };
+        let heads = (vertices * link + 3) & !3;
+        Some(StreamCapacity {
+            vertices,
+            triangles: (max_triangles * 3 * link - heads) / (6 * link),
+            buffer,
+        })
+    }
+}
+
 /// `host-sim pm stream`: the streaming demo on an emulated board.
 fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     use crate::qemu;
@@ -610,6 +642,42 @@ fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     let bytes =
         std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
     let board = qemu::board(&a.board)?;
+    // Before any build or run: is it a stream, and does the board hold it?
+    let h = extent(&bytes)
+        .with_context(|| a.input.display().to_string())?
+        .header;
+    let cap = StreamCapacity::of(board.name)
+        .ok_or_else(|| anyhow!("{}: no streaming firmware for this board", board.name))?;
+    let buffer = usize::from(h.max_payload) + stream::CHUNK_OVERHEAD;
+    if h.vertices as usize > cap.vertices
+        || h.triangles as usize > cap.triangles
+        || buffer > cap.buffer
+    {
+        bail!(
+            "{}: the stream's full mesh has {} vertices and {} triangles, in chunks of up to {} \
+             bytes; {} holds streams of up to {} vertices, {} triangles and chunks of up to {} \
+             bytes. Encode a mesh that fits (e.g. `host-sim simplify IN small.obj \
+             --target-triangles {}`, then `host-sim pm encode small.obj OUT.tdpm --chunk {}`){}",
+            a.input.display(),
+            h.vertices,
+            h.triangles,
+            h.max_payload,
+            board.name,
+            cap.vertices,
+            cap.triangles,
+            cap.buffer - stream::CHUNK_OVERHEAD,
+            // A closed mesh has about twice as many triangles as vertices: a margin below.
+            cap.triangles
+                .min(cap.vertices * 19 / 10)
+                .min(h.triangles as usize),
+            usize::from(h.max_payload).min(cap.buffer - stream::CHUNK_OVERHEAD),
+            if board.name.starts_with("mps2") {
+                ""
+            } else {
+                ", or a 4 MB board (--board mps2-an386)"
+            }
+        );
+    }
     if let Some(code) = qemu::preflight(&[board])? {
         return Ok(code);
     }

@@ -417,7 +417,10 @@ fn partial_stream_decodes_its_finest_complete_level() {
         let so = text(&o.stdout);
         assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
         let line = so.lines().find(|l| l.starts_with("PARTIAL")).expect(&so);
-        assert!(line.contains("vertex splits") && line.contains("of 512 triangles"), "{line}");
+        assert!(
+            line.contains("vertex splits") && line.contains("of 512 triangles"),
+            "{line}"
+        );
         let n = faces(&out);
         assert!(n > last && n < 512, "{n} triangles from {cut} bytes");
         assert!(line.contains(&format!("({n} of 512 triangles")), "{line}");
@@ -436,4 +439,34 @@ fn partial_stream_decodes_its_finest_complete_level() {
     let e = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{e}");
     assert!(e.contains("before its base mesh"), "{e}");
+}
+
+/// `pm stream` checks, before building or running anything, that the file is a progressive
+/// stream and that the board holds it, and says what fits.
+#[test]
+fn pm_stream_says_why_before_running() {
+    let d = tempfile::tempdir().unwrap();
+    let obj = write(d.path(), "g.obj", grid_obj(60)); // 3 721 vertices
+    let o = run(&["pm", "stream", s(&obj)]);
+    let e = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{e}");
+    assert!(e.contains("not a progressive stream"), "{e}");
+    assert!(!e.contains("malformed output"), "{e}");
+    let tdpm = d.path().join("g.tdpm");
+    let o = run(&["pm", "encode", s(&obj), s(&tdpm)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    for (board, holds) in [
+        ("mps2-an386", "up to 3000 vertices"),
+        ("microbit", "up to 44 vertices"),
+    ] {
+        let o = run(&["pm", "stream", s(&tdpm), "--board", board]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{e}");
+        assert!(
+            e.contains("3721 vertices")
+                && e.contains(holds)
+                && e.contains("Encode a mesh that fits"),
+            "{e}"
+        );
+    }
 }
