@@ -556,19 +556,20 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
     }
     let bytes =
         std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    // On a terminal, a bar once it takes over a second: decoding, then one Metro run per
+    // level; the table is printed after it.
+    let bar = crate::progress::Progress::new(
+        "levels {bar:40} {pos}/{len} levels measured ({elapsed})",
+        a.ladder.len() as u64 + 1,
+    );
+    bar.set(0);
     let d = decode_with(&bytes, bytes.len(), None, &a.ladder)?;
-    if let Some(e) = &d.partial {
-        crate::outln!(
-            "{} (errors below are against that level)",
-            partial_line(e, d.finest_triangles)
-        );
-    }
+    bar.set_len(d.levels.len() as u64);
     let full = MeshData {
         positions: d.positions.clone(),
         triangles: d.triangles.clone(),
     };
-    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
-    crate::outln!("|---:|---:|---:|---:|");
+    let mut rows = Vec::new();
     let mut meshes = Vec::new();
     for (lvl, tris) in &d.levels {
         let m = MeshData {
@@ -576,13 +577,26 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
             triangles: tris.clone(),
         };
         let r = metro(&full, &m, &MetroOptions::default());
-        crate::outln!(
+        rows.push(format!(
             "| {lvl} | {} | {:.4} | {:.4} |",
             m.triangles.len(),
             r.symmetric_mean_pct,
             r.hausdorff_pct
-        );
+        ));
         meshes.push(m);
+        bar.set(meshes.len() as u64);
+    }
+    bar.finish();
+    if let Some(e) = &d.partial {
+        crate::outln!(
+            "{} (errors below are against that level)",
+            partial_line(e, d.finest_triangles)
+        );
+    }
+    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
+    crate::outln!("|---:|---:|---:|---:|");
+    for r in rows {
+        crate::outln!("{r}");
     }
     if let Some(path) = &a.strip {
         let view = crate::render::View::fit(&full);

@@ -470,3 +470,34 @@ fn pm_stream_says_why_before_running() {
         );
     }
 }
+
+/// `pm levels` shows a progress bar on a terminal (as `simplify` does), and none on a pipe.
+/// The terminal is `script`'s pseudo-terminal; the bar's one-second delay is set to 0.
+#[test]
+fn pm_levels_shows_progress_on_a_terminal() {
+    let d = tempfile::tempdir().unwrap();
+    let mesh = write(d.path(), "g.obj", grid_obj(20));
+    let tdpm = d.path().join("g.tdpm");
+    let o = run(&["pm", "encode", s(&mesh), s(&tdpm)]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let o = bin()
+        .args(["pm", "levels", s(&tdpm)])
+        .env("HOST_SIM_PROGRESS_AFTER_MS", "0")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    assert!(!text(&o.stderr).contains("levels measured"), "a pipe");
+    let cmd = format!("{} pm levels {}", env!("CARGO_BIN_EXE_host-sim"), s(&tdpm));
+    let Ok(o) = Command::new("script")
+        .args(["-qec", &cmd, "/dev/null"])
+        .env("HOST_SIM_PROGRESS_AFTER_MS", "0")
+        .output()
+    else {
+        eprintln!("no `script` (util-linux): the terminal half is not run");
+        return;
+    };
+    let all = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{all}");
+    assert!(all.contains("levels measured"), "{all}");
+    assert!(all.contains("| level (splits) |"), "{all}");
+}
