@@ -678,6 +678,16 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if stored && config.schedule != Schedule::Greedy {
         bail!("--quadric stored runs the greedy schedule only (drop --schedule passes)");
     }
+    // Optimal placement moves vertices: only their numbering says which input vertex each
+    // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
+    let moved = stored && args.placement == PlacementArg::Optimal;
+    if moved && out_format == Format::Stl {
+        bail!(
+            "--placement optimal moves vertices, and STL has no vertex numbering to tell which \
+             input vertex each one was: write OBJ or PLY"
+        );
+    }
+    let keep_numbering = args.keep_numbering || moved;
     let bounded = args.max_error.is_some();
     if bounded && stored && args.placement == PlacementArg::Optimal {
         bail!(
@@ -691,7 +701,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     } else {
         simplify_with_progress(&mesh, &config)?
     };
-    let written = if args.keep_numbering {
+    let written = if keep_numbering {
         out.clone()
     } else {
         crate::io::compact(&out).0
@@ -708,6 +718,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         written.positions.len(),
         if args.keep_numbering {
             ", input numbering kept"
+        } else if moved {
+            ", input numbering kept: vertices moved"
         } else {
             ", unreferenced dropped"
         }
@@ -800,7 +812,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "output": args.output.display().to_string(),
         "output_format": format!("{out_format:?}"),
         "output_vertices": written.positions.len(),
-        "keep_numbering": args.keep_numbering,
+        "keep_numbering": keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
         "operator": format!("{:?}", config.operator),
@@ -816,8 +828,14 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if !args.no_measure {
         // The library drops degenerate and duplicate triangles before it starts; the check
         // compares the output with the input as the library saw it (`meshcheck::clean`).
-        let moved = stored && args.placement == PlacementArg::Optimal;
-        let validity = crate::check::compare_with(&mesh, &out, moved);
+        // One checker, one verdict: what `host-sim check` says of the file, as written and
+        // read back (an STL welded by position, a compact file matched back by position).
+        let ext = format!("{out_format:?}");
+        let as_read = crate::io::encode(out_format, &written)
+            .map_err(|e| anyhow!("{e}"))
+            .and_then(|b| crate::io::parse_bytes(&b, &ext))
+            .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
+        let (_, note, validity) = crate::check::verdict(&mesh, &as_read, moved)?;
         valid = validity.is_valid();
         let _ = writeln!(
             text,
@@ -825,6 +843,9 @@ pub fn run(args: &Args) -> Result<ExitCode> {
              duplicate triangles, as the library dropped them):",
             report.degenerate_dropped, report.duplicates_dropped
         );
+        if let Some(n) = &note {
+            let _ = writeln!(text, "note: {n}");
+        }
         let _ = writeln!(text, "{validity}");
         let opts = crate::metro::MetroOptions {
             samples_per_triangle: args.samples_per_triangle,

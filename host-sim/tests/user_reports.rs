@@ -501,3 +501,89 @@ fn pm_levels_shows_progress_on_a_terminal() {
     assert!(all.contains("levels measured"), "{all}");
     assert!(all.contains("| level (splits) |"), "{all}");
 }
+
+/// The validity block of a `simplify` run (after its "check (" line) or of `check` (after
+/// its "validity (" line), up to the verdict.
+fn validity_block(out: &str, after: &str) -> String {
+    let start = out
+        .find(after)
+        .unwrap_or_else(|| panic!("{after} not in {out}"));
+    let rest = &out[start..];
+    let rest = &rest[rest.find('\n').unwrap() + 1..];
+    let end = rest.find("=> ").expect(rest);
+    let block = &rest[..end + rest[end..].find('\n').unwrap_or(rest.len() - end)];
+    // The renumbering note, if any, sits before the block in both.
+    block
+        .lines()
+        .filter(|l| !l.starts_with("note:"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// One checker, one verdict: with optimal placement `simplify` keeps the input's numbering,
+/// `check --placement optimal` matches vertices by index (moved ones allowed), and both print
+/// the same check for the same file; without the flag `check` says why the moved vertices
+/// fail; a file in another numbering is refused rather than matched by position. With subset
+/// placement (compact output, matched back by position) the two print the same too.
+#[test]
+fn simplify_and_check_give_one_verdict() {
+    let d = tempfile::tempdir().unwrap();
+    let input = write(d.path(), "g.obj", grid_obj(24));
+    let out = d.path().join("o.obj");
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&out),
+        "--ratio",
+        "0.1",
+        "--quadric",
+        "stored",
+        "--placement",
+        "optimal",
+    ]);
+    let so = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{so}{}", text(&o.stderr));
+    assert!(so.contains("=> VALID"), "{so}");
+    assert!(so.contains("input numbering kept"), "{so}");
+    let mine = validity_block(&so, "check (");
+    let o = run(&["check", s(&input), s(&out), "--placement", "optimal"]);
+    let co = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{co}");
+    assert_eq!(mine, validity_block(&co, "validity ("));
+    assert!(co.contains("new boundary vertices    0") && co.contains("new pinched vertices     0"));
+    // Without the flag the moved vertices fail, and the note says what to do.
+    let o = run(&["check", s(&input), s(&out)]);
+    let co = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{co}");
+    assert!(co.contains("--placement optimal"), "{co}");
+    // STL has no numbering: refused with optimal placement.
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&d.path().join("o.stl")),
+        "--ratio",
+        "0.1",
+        "--quadric",
+        "stored",
+        "--placement",
+        "optimal",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("STL has no vertex numbering"));
+    // A compact file (another numbering) cannot be matched by index: refused.
+    let small = d.path().join("small.obj");
+    let o = run(&["simplify", s(&input), s(&small), "--ratio", "0.1"]);
+    let so = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{so}");
+    let o = run(&["check", s(&input), s(&small), "--placement", "optimal"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("by index"), "{}", text(&o.stderr));
+    // Subset placement, compact output matched back by position: the same block.
+    let o = run(&["check", s(&input), s(&small)]);
+    let co = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{co}");
+    assert_eq!(
+        validity_block(&so, "check ("),
+        validity_block(&co, "validity (")
+    );
+}
