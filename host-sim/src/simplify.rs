@@ -115,7 +115,7 @@ pub enum QuadricArg {
     /// choice when RAM is tight.
     #[default]
     Memoryless,
-    /// `tinydecimate::cost::StoredQuadric` (Garland and Heckbert): a 4x4 quadric per vertex
+    /// `tinydecimate::cost::StoredQuadric`: a 4x4 quadric per vertex
     /// (40 B), summed on collapse, boundary planes weighted by --boundary-weight (greedy
     /// schedule only). Lower error than memoryless when 40 B per vertex can be spared.
     Stored,
