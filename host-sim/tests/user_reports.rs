@@ -378,6 +378,26 @@ fn no_allocation_from_claimed_counts() {
         assert_eq!(o.status.code(), Some(2), "{e}");
         assert!(e.contains("truncated file"), "{e}");
     }
+    // A face list whose length (binary or ascii) is far past the file's end.
+    let mut bin = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+        property float y\nproperty float z\nelement face 1\nproperty list uint int \
+        vertex_indices\nend_header\n"
+        .to_vec();
+    for c in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+        bin.extend_from_slice(&c.to_le_bytes());
+    }
+    bin.extend_from_slice(&0xffff_fff0u32.to_le_bytes());
+    bin.extend_from_slice(&[0u8; 12]);
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n\
+        0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n";
+    for (name, body) in [("list.ply", bin), ("list_a.ply", ascii.as_bytes().to_vec())] {
+        let f = write(d.path(), name, body);
+        let o = run_limited(LIMIT_KIB, &["check", s(&f), s(&f)]);
+        let e = text(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{name}: {e}");
+        assert!(e.contains("PLY") && !e.contains("memory"), "{name}: {e}");
+    }
     // And a real stream still decodes under the same limit.
     let mesh = write(d.path(), "g.obj", grid_obj(10));
     let tdpm = d.path().join("g.tdpm");
