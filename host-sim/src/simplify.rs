@@ -4,7 +4,8 @@
 //!
 //! The output path and format are checked before anything else; the input may be standard
 //! input and the output standard output (`-`). Output files keep only the vertices the result
-//! uses unless `--keep-numbering`.
+//! uses unless `--keep-numbering` (or optimal placement, whose moved vertices only their
+//! numbering ties to the input's).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -258,7 +259,7 @@ pub struct Args {
     pub input: PathBuf,
     /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
     /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no
-    /// output triangle uses are dropped (see --keep-numbering).
+    /// output triangle uses are dropped (see --keep-numbering; kept with `--placement optimal`).
     pub output: PathBuf,
     /// Output format, instead of the output's extension.
     #[arg(long, value_enum)]
