@@ -58,7 +58,7 @@ pub const QUICK_MESHES: [&str; 2] = ["cow.obj", "plate_holes.obj"];
 pub const QUICK_RATIOS: [f32; 2] = [0.5, 0.1];
 /// The messy multi-part meshes of `../shared/meshes` (see its SOURCES.md: many open parts,
 /// non-manifold edges, pinched vertices). The summary reports their worst error ratios apart
-/// from the other meshes': issue 10 asks ≤ 1.5x meshoptimizer at the same triangle count there,
+/// from the other meshes': the targets are ≤ 1.5x meshoptimizer at the same triangle count there,
 /// ≤ 0.8x mean and ≤ 1.0x max elsewhere.
 pub const MESSY_MESHES: [&str; 2] = ["wuson.obj", "pr2_sensor_mount.obj"];
 
@@ -67,7 +67,7 @@ pub fn is_messy(mesh: &str) -> bool {
     MESSY_MESHES.contains(&mesh)
 }
 
-/// The ratios the summary's time figure is the geometric mean over (issue 10: 50 % and 10 %).
+/// The ratios the summary's time figure is the geometric mean over (50 % and 10 %).
 pub const TIME_RATIOS: [f32; 2] = [0.5, 0.1];
 
 /// `../shared/meshes` beside the checkout (the default mesh directory).
@@ -454,7 +454,7 @@ impl WorstPair {
 }
 
 /// The worst error ratios of one mode at one ratio: over the clean meshes and over the messy
-/// ones ([`MESSY_MESHES`]), which issue 10 holds to different targets.
+/// ones ([`MESSY_MESHES`]), which are held to different targets.
 #[derive(Clone, Debug, Serialize)]
 pub struct Worst {
     /// Target ratio.
@@ -1181,7 +1181,7 @@ pub fn markdown(r: &Results) -> String {
         s,
         "\nWorst error ratio vs meshoptimizer over the meshes, per mode and ratio, and the mesh \
          it is on; † at the same triangle count (the mode stopped short there). Clean meshes: \
-         all but the messy multi-part ones ({}); issue 10 asks ≤ 0.8x mean and ≤ 1.0x max of \
+         all but the messy multi-part ones ({}); the targets are ≤ 0.8x mean and ≤ 1.0x max of \
          the default there (paper passes: ≤ 2.0x mean), and ≤ 1.5x at the same count on the \
          messy ones.\n",
         messy.join(", ")

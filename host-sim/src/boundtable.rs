@@ -1,6 +1,6 @@
 //! `host-sim bound-table`: the error-bound figures of the README ("Error bound"). For each
 //! mesh: the triangles tinydecimate reaches under a guaranteed bound (a fraction of the
-//! bounding-box diagonal; control points of seed 001, Zhu, Wang and Meng 2007), with the edge
+//! bounding-box diagonal; control points of Zhu, Wang and Meng 2007), with the edge
 //! and the triangle operator, their E_max / E_mean (eq. 4-5) and the Metro one-sided maximum
 //! from the original to the result; next to meshoptimizer at the same `target_error` (its
 //! count, and its Metro maximum: measured, not guaranteed). Prints a Markdown table.

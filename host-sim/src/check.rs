@@ -49,6 +49,48 @@ pub struct Args {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// How the simplified mesh was placed: `optimal` allows kept vertices to have moved
+    /// (`simplify --quadric stored --placement optimal`); its vertices are then matched to the
+    /// input's by index, so the file must keep the input's numbering (as simplify writes it
+    /// with optimal placement), never by position.
+    #[arg(long, value_enum, default_value_t = crate::simplify::PlacementArg::Subset)]
+    pub placement: crate::simplify::PlacementArg,
+}
+
+/// The one verdict on a simplified mesh as read from its file, shared by `check` and
+/// `simplify` (which checks what it wrote, read back): `output` in `input`'s numbering
+/// (matched by position unless `moved`, see [`renumbered`]), the note on how, and the
+/// validity. With `moved` (optimal placement) kept vertices may have moved and vertices are
+/// matched by index: an output with another vertex count is refused, as nothing else says
+/// which input vertex an output vertex was.
+pub fn verdict(
+    input: &MeshData,
+    output: &MeshData,
+    moved: bool,
+) -> anyhow::Result<(MeshData, Option<String>, Validity)> {
+    if moved {
+        if output.positions.len() != input.positions.len() {
+            anyhow::bail!(
+                "with --placement optimal the simplified mesh's vertices are matched to the \
+                 input's by index, so it must keep the input's numbering: it has {} vertices, \
+                 the input {} (`simplify --placement optimal` writes OBJ and PLY files that way)",
+                output.positions.len(),
+                input.positions.len()
+            );
+        }
+        let v = compare_with(input, output, true);
+        return Ok((output.clone(), None, v));
+    }
+    let (b, mut note) = renumbered(input, output);
+    let v = compare(input, &b);
+    if v.new_vertices > 0 && note.is_none() {
+        note = Some(format!(
+            "{} vertices are not at their input position: a result of optimal placement \
+             (written in the input's numbering) is checked with `--placement optimal`",
+            v.new_vertices
+        ));
+    }
+    Ok((b, note, v))
 }
 
 /// Whether `output` uses `input`'s numbering: every vertex an output triangle uses is an
@@ -90,8 +132,9 @@ pub fn renumbered(input: &MeshData, output: &MeshData) -> (MeshData, Option<Stri
 pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     let a = crate::io::load_noting(&args.original)?;
     let b = crate::io::load_noting(&args.simplified)?;
-    let (b, note) = renumbered(&a, &b);
-    let (ta, tb, v) = (analyse(&a), analyse(&b), compare(&a, &b));
+    let moved = args.placement == crate::simplify::PlacementArg::Optimal;
+    let (b, note, v) = verdict(&a, &b, moved)?;
+    let (ta, tb) = (analyse(&a), analyse(&b));
     if args.json {
         let j = serde_json::json!({
             "original": ta,
@@ -108,7 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
         if let Some(n) = note {
             crate::outln!("note: {n}");
         }
-        crate::outln!("validity (against the cleaned original: degenerate and duplicate triangles dropped as the library does):\n{v}");
+        crate::outln!("validity (against the cleaned original: degenerate and duplicate triangles dropped as the library does{}):\n{v}", if moved { "; kept vertices may have moved" } else { "" });
     }
     Ok(if v.is_valid() {
         std::process::ExitCode::SUCCESS

@@ -77,6 +77,44 @@ pub fn subset_that_fits(case: &Case, max_vertices: usize, max_triangles: usize) 
     }
 }
 
+/// The stop reason of a result header's code (`meshfmt::ResultHeader::stop`).
+pub fn stop_reason(code: u8) -> &'static str {
+    match code {
+        0 => "still running",
+        1 => "target reached",
+        2 => "no legal collapse left",
+        3 => "every collapse left costs more than max_cost",
+        4 => "max passes run",
+        5 => "collapse log full",
+        _ => "unknown",
+    }
+}
+
+/// A run's status: `ok` only when it ran without error and reached its target; a run that
+/// stopped short says so and why.
+pub fn status_text(h: &meshfmt::ResultHeader) -> String {
+    match h.status {
+        Status::Ok if h.target_reached => "ok".to_string(),
+        Status::Ok => format!("target MISSED ({})", stop_reason(h.stop)),
+        s => format!("{s:?} {:?}", h.error_kind),
+    }
+}
+
+/// The target row: the target, as a share of the input, and whether it was reached.
+pub fn target_text(h: &meshfmt::ResultHeader) -> String {
+    let pct = |n: u32| 100.0 * f64::from(n) / f64::from(h.triangles_in.max(1));
+    format!(
+        "{} ({:.1} %): {}",
+        thousands(h.target_triangles.into()),
+        pct(h.target_triangles),
+        if h.target_reached {
+            "reached".to_string()
+        } else {
+            format!("NOT reached, stopped at {:.1} %", pct(h.triangles_out))
+        }
+    )
+}
+
 /// Groups digits by thousands.
 fn thousands(n: u64) -> String {
     let s = n.to_string();
@@ -199,11 +237,14 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     let dev_col = format!("{} ({}, QEMU)", board.name, board.core);
     let row = |k: &str, x: String, y: String| crate::outln!("{k:<22} {x:<46} {y}");
     row("", host_col, dev_col);
-    let status = |o: &Outcome| match o.header.status {
-        Status::Ok => "ok".to_string(),
-        s => format!("{s:?} {:?}", o.header.error_kind),
-    };
+    let status = |o: &Outcome| status_text(&o.header);
     row("status", status(&host), status(&device));
+    row("target", target_text(h), target_text(d));
+    row(
+        "stop",
+        stop_reason(h.stop).to_string(),
+        stop_reason(d.stop).to_string(),
+    );
     row(
         "triangles in",
         thousands(h.triangles_in.into()),
@@ -298,6 +339,33 @@ pub fn run(a: &Args) -> Result<ExitCode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A run that stopped at 47 % of a 10 % target is not `ok`: the status says the target
+    /// was missed and why, the target row says how far it got. A reached target is `ok`.
+    #[test]
+    fn a_missed_target_is_not_ok() {
+        let mut h = meshfmt::ResultHeader::empty(IndexType::U32, Status::Ok, meshfmt::Board::Host);
+        h.triangles_in = 1000;
+        h.target_triangles = 100;
+        h.triangles_out = 470;
+        h.target_reached = false;
+        h.stop = 2;
+        let s = status_text(&h);
+        assert!(!s.contains("ok"), "{s}");
+        assert_eq!(s, "target MISSED (no legal collapse left)");
+        assert_eq!(
+            target_text(&h),
+            "100 (10.0 %): NOT reached, stopped at 47.0 %"
+        );
+        h.triangles_out = 100;
+        h.target_reached = true;
+        h.stop = 1;
+        assert_eq!(status_text(&h), "ok");
+        assert_eq!(target_text(&h), "100 (10.0 %): reached");
+        assert_eq!(stop_reason(h.stop), "target reached");
+        let e = meshfmt::ResultHeader::empty(IndexType::U32, Status::TooBig, meshfmt::Board::Host);
+        assert!(status_text(&e).starts_with("TooBig"));
+    }
 
     #[test]
     fn subset_fits_and_is_compact() {

@@ -234,7 +234,7 @@ pub struct CaseSpec {
     /// cost; boundary planes weighted by the config's boundary weight).
     #[serde(default)]
     pub quadric: Option<QuadricName>,
-    /// Optional: the guaranteed error bound (seed 001's control points,
+    /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
     /// `Workspace::simplify_bounded`) as a fraction of the bounding-box diagonal; the case file
     /// carries it in input units.
     #[serde(default)]

@@ -22,8 +22,9 @@
 //!   alone would take such a file for ascii and fail).
 //!
 //! Every error names the file and, where it can, the line (text) or byte offset (binary).
-//! A file without any triangle is an error, and so is a non-finite coordinate or a face index
-//! past the last vertex.
+//! A file without any triangle is an error, and so is a non-finite coordinate of a vertex a
+//! face uses or a face index past the last vertex. A vertex no face uses may hold NaN, as it
+//! may in the library (which only checks the vertices its triangles use).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -217,7 +218,10 @@ pub fn parse_bytes(bytes: &[u8], ext: &str) -> Result<MeshData> {
     Ok(mesh)
 }
 
-/// Checks what every loader promises: some triangles, indices in range, finite coordinates.
+/// Checks what every loader promises: some triangles, indices in range, finite coordinates
+/// for every vertex a triangle uses. A vertex no triangle uses may hold anything, NaN
+/// included: the library never reads it (it checks only the vertices its triangles use), and
+/// output files drop it unless the numbering is kept.
 fn validate(mesh: &MeshData) -> std::result::Result<(), String> {
     if mesh.triangles.is_empty() {
         return Err("no triangles in file".into());
@@ -232,12 +236,17 @@ fn validate(mesh: &MeshData) -> std::result::Result<(), String> {
             ));
         }
     }
+    let used = used_vertices(&mesh.positions, &mesh.triangles, &[]);
     if let Some(v) = mesh
         .positions
         .iter()
-        .position(|p| p.iter().any(|c| !c.is_finite()))
+        .zip(&used)
+        .position(|(p, &u)| u && p.iter().any(|c| !c.is_finite()))
     {
-        return Err(format!("vertex {} has a non-finite coordinate", v + 1));
+        return Err(format!(
+            "vertex {} has a non-finite coordinate and a triangle uses it",
+            v + 1
+        ));
     }
     Ok(())
 }
@@ -285,6 +294,19 @@ pub fn check_writable(path: &Path, format: Option<Format>) -> Result<Format> {
         let _ = std::fs::remove_file(path);
     }
     Ok(f)
+}
+
+/// Whether `output` names the file `input` is (standard input and output never do): the
+/// same canonical path, so `./a.stl`, `dir/../a.stl` and a symbolic link to it all count.
+/// An output that does not exist yet is not an input.
+pub fn same_file(input: &Path, output: &Path) -> bool {
+    if is_std(input) || is_std(output) || !output.exists() {
+        return false;
+    }
+    match (input.canonicalize(), output.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }
 
 /// Saves `mesh` to `path` (`-`: standard output) in `format`.
@@ -533,6 +555,9 @@ fn parse_obj(bytes: &[u8]) -> Parsed {
     // Largest vertex index referenced by a face and the line it is on, checked at the end
     // (an OBJ face may refer to a vertex defined later).
     let mut max_ref: Option<(usize, usize)> = None;
+    // Vertices with a NaN or infinite coordinate (vertex, line, token): refused only if a
+    // face uses one, as the library only reads the vertices its triangles use.
+    let mut non_finite: Vec<(usize, usize, String)> = Vec::new();
     for (no, raw) in text.lines().enumerate() {
         let line_no = no + 1;
         let line = raw.split('#').next().unwrap_or("");
@@ -553,10 +578,8 @@ fn parse_obj(bytes: &[u8]) -> Parsed {
                     *c = tok
                         .parse::<f32>()
                         .map_err(|_| format!("line {line_no}: bad vertex coordinate {tok:?}"))?;
-                    if !c.is_finite() {
-                        return Err(format!(
-                            "line {line_no}: non-finite vertex coordinate {tok:?}"
-                        ));
+                    if !c.is_finite() && non_finite.len() < MAX_NON_FINITE_NOTED {
+                        non_finite.push((mesh.positions.len(), line_no, tok.to_string()));
                     }
                 }
                 mesh.positions.push(p);
@@ -616,6 +639,14 @@ fn parse_obj(bytes: &[u8]) -> Parsed {
             ));
         }
     }
+    if !non_finite.is_empty() {
+        let used = used_vertices(&mesh.positions, &mesh.triangles, &polygons);
+        if let Some((_, line_no, tok)) = non_finite.iter().find(|(v, _, _)| used[*v]) {
+            return Err(format!(
+                "line {line_no}: non-finite vertex coordinate {tok:?} (the vertex is used by a face)"
+            ));
+        }
+    }
     if !polygons.is_empty() {
         // Splice each polygon's triangles in at its place in the file.
         let tris = std::mem::take(&mut mesh.triangles);
@@ -643,6 +674,30 @@ fn parse_obj(bytes: &[u8]) -> Parsed {
         notes.dropped.push(format!("`{}` lines", o.join("`, `")));
     }
     Ok((mesh, notes))
+}
+
+/// Non-finite vertices of an OBJ file noted with their line; past this many, the first used
+/// one is still found by [`validate`] (without its line).
+const MAX_NON_FINITE_NOTED: usize = 1024;
+
+/// Which of `positions` a triangle or a polygon uses (indices past the end are ignored: they
+/// are reported apart).
+fn used_vertices(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    polygons: &[(usize, Vec<u32>)],
+) -> Vec<bool> {
+    let mut used = vec![false; positions.len()];
+    let corners = triangles
+        .iter()
+        .flatten()
+        .chain(polygons.iter().flat_map(|(_, p)| p));
+    for &i in corners {
+        if let Some(u) = used.get_mut(i as usize) {
+            *u = true;
+        }
+    }
+    used
 }
 
 fn obj_bytes(mesh: &MeshData) -> Vec<u8> {
@@ -1080,8 +1135,9 @@ mod tests {
         assert!(err_of(&p).contains("no triangles"));
         std::fs::write(&p, b"v 0 0 0\n\xff\xfe\n").unwrap();
         assert!(err_of(&p).contains("line 2"));
-        std::fs::write(&p, "v 0 0 nan\n").unwrap();
-        assert!(err_of(&p).contains("non-finite"));
+        std::fs::write(&p, "v 0 0 0\nv 1 0 0\nv 0 0 nan\nf 1 2 3\n").unwrap();
+        let e = err_of(&p);
+        assert!(e.contains("non-finite") && e.contains("line 3"), "{e}");
         assert!(err_of(&d.path().join("missing.obj")).contains("missing.obj"));
         assert!(err_of(&d.path().join("x.off")).contains("unknown mesh format"));
     }

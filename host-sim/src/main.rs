@@ -45,11 +45,11 @@ enum Command {
     /// Progressive meshes: encode a mesh as a base mesh plus vertex splits, decode a stream to
     /// a level, measure and draw a ladder of levels.
     Pm(pm::Args),
-    /// The error-bound figures: triangles under a guaranteed bound (control points, seed 001)
+    /// The error-bound figures: triangles under a guaranteed bound (control points, Zhu, Wang and Meng 2007)
     /// next to meshoptimizer at the same target_error, with E_max, E_mean and Metro.
     BoundTable(boundtable::Args),
     /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
-    /// examples/firmware (`cargo run --example … --target thumbv7em-none-eabihf`).
+    /// examples/cortex-m4f (`cargo run --example … --target thumbv7em-none-eabihf`).
     RunElf(qemu::RunElfArgs),
 }
 

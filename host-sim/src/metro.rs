@@ -1,6 +1,6 @@
 //! Metro-style surface distance between two meshes (Cignoni, Rocchini, Scopigno, "Metro:
-//! measuring error on simplified surfaces", 1998; the error definitions are quoted in seed 001
-//! §4, Zhu, Wang and Meng, mesh simplification with control-point error control, 2007:
+//! measuring error on simplified surfaces", 1998; the error definitions are quoted in
+//! §4 of Zhu, Wang and Meng, mesh simplification with control-point error control, 2007:
 //! `E_max = max q(v, S2)` and `E_mean = ∫ q(v, S2) ds / |S1|`).
 //!
 //! For each direction (a→b, then b→a) the source mesh is sampled and each sample's exact

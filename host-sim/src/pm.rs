@@ -258,62 +258,248 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
 
 /// A decoded stream, at a level.
 pub struct Decoded {
-    /// The header.
+    /// The header (of the whole stream, also when the file holds only part of it).
     pub header: stream::Header,
-    /// Positions of every vertex of the full mesh.
+    /// Positions of every vertex decoded (the full mesh's, unless the file is partial).
     pub positions: Vec<[f32; 3]>,
     /// The level's triangles.
     pub triangles: Vec<[u32; 3]>,
-    /// Triangles of every level, base first (only when asked for).
-    pub levels: Vec<Vec<[u32; 3]>>,
+    /// The levels asked for by ladder, base first: (level, its triangles).
+    pub levels: Vec<(usize, Vec<[u32; 3]>)>,
+    /// Triangles of the finest level decoded.
+    pub finest_triangles: usize,
+    /// Set when the file ends before the full mesh: what it holds.
+    pub partial: Option<Extent>,
+}
+
+/// What a stream file holds, read without decoding it: the header (checked by the library's
+/// decoder first: magic, version, checksum, consistent counts) and the framing of the complete
+/// chunks after it. Every count here is backed by bytes of the file (a chunk's item count is
+/// capped by the bits its payload has), so storage sized from it is bounded by the file's
+/// size, whatever the header claims.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extent {
+    /// The stream's header.
+    pub header: stream::Header,
+    /// Bytes of the header and the complete chunks: the part that can be decoded.
+    pub bytes: usize,
+    /// Base positions in those chunks.
+    pub positions: usize,
+    /// Base triangles in those chunks.
+    pub base_triangles: usize,
+    /// Vertex splits in those chunks.
+    pub splits: usize,
+}
+
+impl Extent {
+    /// Whether the file holds the whole stream.
+    pub fn complete(&self) -> bool {
+        let h = &self.header;
+        self.positions == h.base_vertices as usize
+            && self.base_triangles == h.base_triangles as usize
+            && self.splits == (h.vertices - h.base_vertices) as usize
+    }
+
+    /// Vertex splits of the full mesh.
+    pub fn total_splits(&self) -> usize {
+        (self.header.vertices - self.header.base_vertices) as usize
+    }
+
+    /// Whether the base mesh has arrived whole (else no level can be shown).
+    pub fn has_base(&self) -> bool {
+        self.positions == self.header.base_vertices as usize
+            && self.base_triangles == self.header.base_triangles as usize
+    }
+}
+
+/// Bits needed for a number below `n` (the stream's `bits(n)`).
+fn bits(n: usize) -> usize {
+    if n <= 1 {
+        0
+    } else {
+        (usize::BITS - (n - 1).leading_zeros()) as usize
+    }
+}
+
+/// Reads a stream file's header and chunk framing ([`Extent`]); allocates nothing that
+/// depends on a count the file claims.
+pub fn extent(bytes: &[u8]) -> Result<Extent> {
+    if !bytes.starts_with(b"TDPM") {
+        bail!(
+            "not a progressive stream: a .tdpm file (`host-sim pm encode`) starts with `TDPM`, \
+             this one with {:?}",
+            String::from_utf8_lossy(&bytes[..bytes.len().min(4)])
+        );
+    }
+    if bytes.len() < HEADER {
+        bail!(
+            "progressive stream cut inside its {HEADER}-byte header ({} bytes)",
+            bytes.len()
+        );
+    }
+    // The library checks the header (magic, version, checksum, counts) before anything is
+    // sized from it: a decoder with no storage at all stops at its first capacity check,
+    // which comes after those.
+    let mut store = Store::new(0, 0);
+    let mut none: [[f32; 3]; 0] = [];
+    let mut buf = [0u8; HEADER];
+    let mut d = Decoder::new(store.storage(), &mut none, &mut buf);
+    match d.push(&bytes[..HEADER]) {
+        Ok(()) | Err(stream::StreamError::Capacity { .. }) => {}
+        Err(stream::StreamError::BadMagic) => bail!("not a progressive stream (bad magic)"),
+        Err(e) => bail!("progressive stream header: {e}"),
+    }
+    let u32_at =
+        |o: usize| u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    let f32_at = |o: usize| f32::from_bits(u32_at(o));
+    let header = stream::Header {
+        index_width: bytes[5],
+        quantised: bytes[6] & 1 != 0,
+        vertices: u32_at(8),
+        base_vertices: u32_at(12),
+        base_triangles: u32_at(16),
+        triangles: u32_at(20),
+        max_payload: u16::from_le_bytes([bytes[24], bytes[25]]),
+        min: [f32_at(28), f32_at(32), f32_at(36)],
+        max: [f32_at(40), f32_at(44), f32_at(48)],
+    };
+    let mut e = Extent {
+        header,
+        bytes: HEADER,
+        positions: 0,
+        base_triangles: 0,
+        splits: 0,
+    };
+    // Chunks: len (u16), kind (u8), count (u16), payload, CRC-32.
+    let position_bits = if header.quantised { 48 } else { 96 };
+    let mut at = HEADER;
+    let mut chunks = 0u32;
+    while let Some(head) = bytes.get(at..at + 5) {
+        let len = usize::from(u16::from_le_bytes([head[0], head[1]]));
+        let count = usize::from(u16::from_le_bytes([head[3], head[4]]));
+        let end = at + len + stream::CHUNK_OVERHEAD;
+        if len > usize::from(header.max_payload) || !(1..=3).contains(&head[2]) {
+            bail!(
+                "progressive stream: chunk {} (byte offset {at}) is malformed",
+                chunks + 1
+            );
+        }
+        if end > bytes.len() {
+            break; // the file ends inside this chunk
+        }
+        chunks += 1;
+        let payload_bits = 8 * len;
+        let fits = |per_item: usize| count.min(payload_bits / per_item.max(1));
+        match head[2] {
+            1 => e.positions += fits(position_bits),
+            2 => e.base_triangles += fits(3 * bits(header.base_vertices as usize)),
+            // At least: mode bit, restored bit, the position.
+            _ => e.splits += fits(2 + position_bits),
+        }
+        e.bytes = end;
+        at = end;
+    }
+    Ok(e)
 }
 
 /// Feeds `bytes` to the library's decoder `piece` bytes at a time; goes to `level` (finest
 /// with at most that many triangles) at the end.
 pub fn decode_bytes(bytes: &[u8], piece: usize, level: Option<usize>) -> Result<Decoded> {
-    decode_with(bytes, piece, level, false)
+    decode_with(bytes, piece, level, &[])
 }
 
-fn decode_with(bytes: &[u8], piece: usize, level: Option<usize>, keep: bool) -> Result<Decoded> {
-    if bytes.len() < HEADER {
-        bail!(
-            "stream: {} bytes, shorter than its {HEADER}-byte header",
-            bytes.len()
-        );
-    }
-    let u32_at =
-        |o: usize| u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
-    // Storage sized from the header's counts (the decoder checks them against it).
-    let (v, t) = (u32_at(8) as usize, u32_at(20) as usize);
-    if v > 1 << 26 || t > 1 << 27 {
-        bail!("stream: header claims {v} vertices and {t} triangles");
-    }
+/// [`decode_bytes`], keeping the base mesh and, for each fraction of `ladder`, the finest level
+/// with at most that fraction of the finest level's triangles. A file that holds only the
+/// first part of a stream (as it arrives) decodes to its finest complete level, and
+/// [`Decoded::partial`] says how far it got.
+pub fn decode_with(
+    bytes: &[u8],
+    piece: usize,
+    level: Option<usize>,
+    ladder: &[f64],
+) -> Result<Decoded> {
+    let e = extent(bytes)?;
+    let h = e.header;
+    // Storage from what the file holds, never from what the header claims alone.
+    let (v, t, input): (usize, usize, std::borrow::Cow<'_, [u8]>) = if e.complete() {
+        let t = h.triangles as usize;
+        if t > h.base_triangles as usize + 2 * e.splits {
+            bail!(
+                "progressive stream: the header claims {t} triangles, more than its base mesh \
+                 and {} vertex splits can make",
+                e.splits
+            );
+        }
+        (h.vertices as usize, t, bytes.into())
+    } else {
+        if !e.has_base() {
+            bail!(
+                "progressive stream ends before its base mesh ({} of {} positions, {} of {} \
+                 triangles in {} bytes): nothing to show yet",
+                e.positions,
+                h.base_vertices,
+                e.base_triangles,
+                h.base_triangles,
+                bytes.len()
+            );
+        }
+        // The complete chunks, under a header that says they are all there is (the splits
+        // of a stream do not depend on its length), so the decoder ends at the finest level
+        // that arrived.
+        let v = h.base_vertices as usize + e.splits;
+        let t = (h.triangles as usize).min(h.base_triangles as usize + 2 * e.splits);
+        let mut prefix = bytes[..e.bytes].to_vec();
+        prefix[8..12].copy_from_slice(&(v as u32).to_le_bytes());
+        prefix[20..24].copy_from_slice(&(t as u32).to_le_bytes());
+        let c = stream::crc32(&prefix[..52]);
+        prefix[52..56].copy_from_slice(&c.to_le_bytes());
+        (v, t, prefix.into())
+    };
     let mut store = Store::new(v, t);
     let mut positions = vec![[0f32; 3]; v];
-    let mut buf = vec![0u8; 65_535 + stream::CHUNK_OVERHEAD];
+    let mut buf = vec![0u8; usize::from(h.max_payload) + stream::CHUNK_OVERHEAD];
     let mut d = Decoder::new(store.storage(), &mut positions, &mut buf);
-    for p in bytes.chunks(piece.max(1)) {
+    for p in input.chunks(piece.max(1)) {
         d.push(p).map_err(|e| anyhow!("stream: {e}"))?;
     }
     d.finish().map_err(|e| anyhow!("stream: {e}"))?;
-    let header = d.header().ok_or_else(|| anyhow!("stream: no header"))?;
     let pm = d.progressive();
+    let finest = pm.level();
+    let finest_triangles = pm.triangles().len();
     let mut levels = Vec::new();
-    if keep {
+    if !ladder.is_empty() {
+        // Triangles per level, then the picks: the base, and the finest level under each
+        // fraction.
         pm.set_level(0);
-        levels.push(pm.triangles().to_vec());
+        let mut counts = vec![pm.triangles().len()];
         while pm.refine(1) == 1 {
-            levels.push(pm.triangles().to_vec());
+            counts.push(pm.triangles().len());
         }
+        let mut picks = vec![0usize];
+        for f in ladder {
+            let n = (f * finest_triangles as f64).floor() as usize;
+            let lvl = counts.iter().rposition(|&c| c <= n).unwrap_or(0);
+            if !picks.contains(&lvl) {
+                picks.push(lvl);
+            }
+        }
+        for lvl in picks {
+            pm.set_level(0);
+            pm.refine(lvl);
+            levels.push((lvl, pm.triangles().to_vec()));
+        }
+        pm.refine(finest);
     }
     pm.set_level(level.unwrap_or(usize::MAX));
     let triangles = pm.triangles().to_vec();
     let positions = d.positions().to_vec();
     Ok(Decoded {
-        header,
+        header: h,
         positions,
         triangles,
         levels,
+        finest_triangles,
+        partial: (!e.complete()).then_some(e),
     })
 }
 
@@ -338,6 +524,9 @@ fn decode(a: &DecodeArgs) -> Result<()> {
         d.header.triangles,
         d.header.vertices
     );
+    if let Some(e) = &d.partial {
+        crate::outln!("{}", partial_line(e, d.finest_triangles));
+    }
     crate::outln!(
         "wrote {} triangles to {} ({:.1} ms)",
         d.triangles.len(),
@@ -347,43 +536,67 @@ fn decode(a: &DecodeArgs) -> Result<()> {
     Ok(())
 }
 
+/// What a partial file decoded to, in one line.
+fn partial_line(e: &Extent, triangles: usize) -> String {
+    format!(
+        "PARTIAL stream: the full mesh has not arrived ({} bytes of whole chunks); finest \
+         complete level: {} of {} vertex splits ({triangles} of {} triangles, {} of {} vertices)",
+        e.bytes,
+        e.splits,
+        e.total_splits(),
+        e.header.triangles,
+        e.header.base_vertices as usize + e.splits,
+        e.header.vertices
+    )
+}
+
 fn levels(a: &LevelsArgs) -> Result<ExitCode> {
+    if let Some(f) = a.ladder.iter().find(|f| !(0.0..=1.0).contains(*f)) {
+        bail!("--ladder {f}: fractions must be in [0, 1]");
+    }
     let bytes =
         std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
-    let d = decode_with(&bytes, bytes.len(), None, true)?;
+    // On a terminal, a bar once it takes over a second: decoding, then one Metro run per
+    // level; the table is printed after it.
+    let bar = crate::progress::Progress::new(
+        "levels {bar:40} {pos}/{len} levels measured ({elapsed})",
+        a.ladder.len() as u64 + 1,
+    );
+    bar.set(0);
+    let d = decode_with(&bytes, bytes.len(), None, &a.ladder)?;
+    bar.set_len(d.levels.len() as u64);
     let full = MeshData {
         positions: d.positions.clone(),
         triangles: d.triangles.clone(),
     };
-    let nt = d.triangles.len();
-    let mut picks: Vec<usize> = vec![0];
-    for f in &a.ladder {
-        if !(0.0..=1.0).contains(f) {
-            bail!("--ladder {f}: fractions must be in [0, 1]");
-        }
-        let n = (f * nt as f64).floor() as usize;
-        // The finest level with at most n triangles.
-        let lvl = d.levels.iter().rposition(|l| l.len() <= n).unwrap_or(0);
-        if !picks.contains(&lvl) {
-            picks.push(lvl);
-        }
-    }
-    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
-    crate::outln!("|---:|---:|---:|---:|");
+    let mut rows = Vec::new();
     let mut meshes = Vec::new();
-    for &lvl in &picks {
+    for (lvl, tris) in &d.levels {
         let m = MeshData {
             positions: d.positions.clone(),
-            triangles: d.levels[lvl].clone(),
+            triangles: tris.clone(),
         };
         let r = metro(&full, &m, &MetroOptions::default());
-        crate::outln!(
+        rows.push(format!(
             "| {lvl} | {} | {:.4} | {:.4} |",
             m.triangles.len(),
             r.symmetric_mean_pct,
             r.hausdorff_pct
-        );
+        ));
         meshes.push(m);
+        bar.set(meshes.len() as u64);
+    }
+    bar.finish();
+    if let Some(e) = &d.partial {
+        crate::outln!(
+            "{} (errors below are against that level)",
+            partial_line(e, d.finest_triangles)
+        );
+    }
+    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
+    crate::outln!("|---:|---:|---:|---:|");
+    for r in rows {
+        crate::outln!("{r}");
     }
     if let Some(path) = &a.strip {
         let view = crate::render::View::fit(&full);
@@ -404,6 +617,38 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// What a board's streaming firmware holds (host-sim/firmware/src/board.rs): `PM_VERTICES`
+/// vertices, the triangle buffer less the list heads, halved between triangles and their
+/// links, and a `PM_BUFFER`-byte chunk buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StreamCapacity {
+    /// Vertices of the full mesh.
+    pub vertices: usize,
+    /// Triangles of the full mesh.
+    pub triangles: usize,
+    /// Chunk buffer bytes (largest payload plus `CHUNK_OVERHEAD`).
+    pub buffer: usize,
+}
+
+impl StreamCapacity {
+    /// The capacity of the firmware for the board `name`.
+    pub fn of(name: &str) -> Option<StreamCapacity> {
+        // (MAX_TRIANGLES, link bytes, PM_VERTICES, PM_BUFFER) of board.rs.
+        let (max_triangles, link, vertices, buffer) = match name {
+            "microbit" => (432, 2, 44, 80),
+            "lm3s6965evb" => (2_400, 2, 100, 272),
+            "mps2-an386" | "mps2-an500" | "mps2-an505" => (106_000, 4, 3_000, 4_096),
+            _ => return None,
+        };
+        let heads = (vertices * link + 3) & !3;
+        Some(StreamCapacity {
+            vertices,
+            triangles: (max_triangles * 3 * link - heads) / (6 * link),
+            buffer,
+        })
+    }
+}
+
 /// `host-sim pm stream`: the streaming demo on an emulated board.
 fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     use crate::qemu;
@@ -411,6 +656,42 @@ fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     let bytes =
         std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
     let board = qemu::board(&a.board)?;
+    // Before any build or run: is it a stream, and does the board hold it?
+    let h = extent(&bytes)
+        .with_context(|| a.input.display().to_string())?
+        .header;
+    let cap = StreamCapacity::of(board.name)
+        .ok_or_else(|| anyhow!("{}: no streaming firmware for this board", board.name))?;
+    let buffer = usize::from(h.max_payload) + stream::CHUNK_OVERHEAD;
+    if h.vertices as usize > cap.vertices
+        || h.triangles as usize > cap.triangles
+        || buffer > cap.buffer
+    {
+        bail!(
+            "{}: the stream's full mesh has {} vertices and {} triangles, in chunks of up to {} \
+             bytes; {} holds streams of up to {} vertices, {} triangles and chunks of up to {} \
+             bytes. Encode a mesh that fits (e.g. `host-sim simplify IN small.obj \
+             --target-triangles {}`, then `host-sim pm encode small.obj OUT.tdpm --chunk {}`){}",
+            a.input.display(),
+            h.vertices,
+            h.triangles,
+            h.max_payload,
+            board.name,
+            cap.vertices,
+            cap.triangles,
+            cap.buffer - stream::CHUNK_OVERHEAD,
+            // A closed mesh has about twice as many triangles as vertices: a margin below.
+            cap.triangles
+                .min(cap.vertices * 19 / 10)
+                .min(h.triangles as usize),
+            usize::from(h.max_payload).min(cap.buffer - stream::CHUNK_OVERHEAD),
+            if board.name.starts_with("mps2") {
+                ""
+            } else {
+                ", or a 4 MB board (--board mps2-an386)"
+            }
+        );
+    }
     if let Some(code) = qemu::preflight(&[board])? {
         return Ok(code);
     }

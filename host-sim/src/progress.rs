@@ -1,5 +1,6 @@
 //! Progress bars for long steps (indicatif), on stderr only, only when stderr is a terminal,
-//! and only once a step has run for a second: pipes, files and CI logs never see them.
+//! and only once a step has run for a second (`HOST_SIM_PROGRESS_AFTER_MS` sets another
+//! delay, for tests): pipes, files and CI logs never see them.
 
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
@@ -13,6 +14,7 @@ pub const AFTER: Duration = Duration::from_secs(1);
 /// a terminal.
 pub struct Progress {
     bar: ProgressBar,
+    after: Duration,
     start: Instant,
     enabled: bool,
     shown: std::cell::Cell<bool>,
@@ -25,8 +27,13 @@ impl Progress {
         if let Ok(style) = ProgressStyle::with_template(template) {
             bar.set_style(style);
         }
+        let after = std::env::var("HOST_SIM_PROGRESS_AFTER_MS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .map_or(AFTER, Duration::from_millis);
         Progress {
             bar,
+            after,
             start: Instant::now(),
             enabled: std::io::stderr().is_terminal(),
             shown: std::cell::Cell::new(false),
@@ -38,13 +45,24 @@ impl Progress {
         self.enabled
     }
 
-    /// Sets the position; draws from the first call after [`AFTER`].
+    /// Sets the position; draws from the first call after [`AFTER`] (or the delay the
+    /// environment sets).
     pub fn set(&self, pos: u64) {
-        if self.enabled && !self.shown.get() && self.start.elapsed() >= AFTER {
+        if self.enabled && !self.shown.get() && self.start.elapsed() >= self.after {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
             self.shown.set(true);
         }
         self.bar.set_position(pos);
+    }
+
+    /// Changes the total.
+    pub fn set_len(&self, total: u64) {
+        self.bar.set_length(total);
+    }
+
+    /// The position last set.
+    pub fn position(&self) -> u64 {
+        self.bar.position()
     }
 
     /// Removes the bar.

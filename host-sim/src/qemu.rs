@@ -702,7 +702,7 @@ pub fn run_command(board: &Board, elf: &Path, command: &str, timeout: Duration) 
     run
 }
 
-/// `host-sim run-elf ELF`: the Cargo runner of the firmware example (examples/firmware).
+/// `host-sim run-elf ELF`: the Cargo runner of the firmware example (examples/cortex-m4f).
 #[derive(Clone, Debug, clap::Args)]
 pub struct RunElfArgs {
     /// The firmware image (as Cargo hands it to a runner).

@@ -1,4 +1,4 @@
-//! The `host-sim` command line as a new user meets it (issue 11, items 1-8): each test runs the
+//! The `host-sim` command line as a new user meets it: each test runs the
 //! built binary on small generated files.
 
 use std::io::Write;
