@@ -34,7 +34,7 @@ enum Command {
     /// Every tinydecimate mode (default, greedy W, paper passes) against meshoptimizer: time,
     /// memory, error (also at the same triangle count when the library stops short), validity.
     Bench(bench::Args),
-    /// The library on QEMU-emulated Cortex-M0/M3/M4F/M7/M33 boards, compared with the host;
+    /// The library on QEMU-emulated Cortex-M0/M3/M4F/M7/M33 and RISC-V (RV32IMC, RV32IMAC) boards, compared with the host;
     /// --measure for instructions, stack, image sizes and the largest mesh per board.
     Qemu(qemu::Args),
     /// The golden files in tests/golden: --check them on the host, or --bless (rewrite) them.

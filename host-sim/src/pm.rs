@@ -638,6 +638,8 @@ impl StreamCapacity {
             "microbit" => (432, 2, 44, 80),
             "lm3s6965evb" => (2_400, 2, 100, 272),
             "mps2-an386" | "mps2-an500" | "mps2-an505" => (106_000, 4, 3_000, 4_096),
+            "riscv32imc-virt-400k" => (13_000, 2, 3_000, 4_096),
+            "riscv32imac-virt-32k" => (1_000, 2, 100, 272),
             _ => return None,
         };
         let heads = (vertices * link + 3) & !3;
@@ -800,4 +802,62 @@ fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
+}
+
+#[cfg(test)]
+mod capacity_tests {
+    use super::StreamCapacity;
+
+    /// The value of `pub const NAME...: ... = VALUE;` in one board's block of board.rs.
+    fn constant(block: &str, name: &str) -> usize {
+        let line = block
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("pub const {name}:")))
+            .unwrap_or_else(|| panic!("no {name} in {block}"));
+        let v = line.split('=').nth(1).unwrap().trim().trim_end_matches(';');
+        v.replace('_', "").parse().unwrap()
+    }
+
+    /// `StreamCapacity::of` is a copy of the firmware's constants: it must agree with
+    /// host-sim/firmware/src/board.rs for every board there.
+    #[test]
+    fn stream_capacity_agrees_with_the_firmware() {
+        let src = include_str!("../firmware/src/board.rs");
+        let blocks: Vec<&str> = src.split("mod sel {").skip(1).collect();
+        let mut boards = 0;
+        for block in blocks {
+            let block = &block[..block.find("\n}").unwrap_or(block.len())];
+            let names: Vec<&str> = block
+                .lines()
+                .filter(|l| l.contains("pub const NAME: &str ="))
+                .map(|l| l.split('"').nth(1).unwrap())
+                .collect();
+            let link = if block.contains("pub type Link = u32;") {
+                4
+            } else {
+                2
+            };
+            let (t, v, b) = (
+                constant(block, "MAX_TRIANGLES"),
+                constant(block, "PM_VERTICES"),
+                constant(block, "PM_BUFFER"),
+            );
+            let heads = (v * link + 3) & !3;
+            for name in names {
+                boards += 1;
+                let c = StreamCapacity::of(name)
+                    .unwrap_or_else(|| panic!("StreamCapacity::of({name}) is missing"));
+                assert_eq!(
+                    c,
+                    StreamCapacity {
+                        vertices: v,
+                        triangles: (t * 3 * link - heads) / (6 * link),
+                        buffer: b,
+                    },
+                    "{name}"
+                );
+            }
+        }
+        assert_eq!(boards, crate::qemu::BOARDS.len(), "boards in board.rs");
+    }
 }
