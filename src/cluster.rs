@@ -1852,7 +1852,7 @@ impl core::fmt::Display for ThenCollapseError {
     }
 }
 
-/// Cluster, then collapse: clusters `source` down to what fits `workspace` (at most its
+/// Cluster, then collapse: clusters `source` down to what fits `storage` (at most its
 /// triangle capacity, `out.len()` and twice `vertices.len()` triangles; the grid is searched
 /// as for [`GridChoice::TargetTriangles`] unless `cluster_config` fixes it), copies the
 /// surviving vertices' positions into `positions` (RAM: 12 bytes per vertex), then runs the
@@ -1862,17 +1862,10 @@ impl core::fmt::Display for ThenCollapseError {
 /// numbers**; `vertices` and `positions` are scratch. A small device thus gets collapse
 /// quality from a mesh it could never hold.
 #[allow(clippy::too_many_arguments)]
-pub fn cluster_then_collapse<
-    S: Source,
-    I: Index,
-    L: Index,
-    const CELLS: usize,
-    const V: usize,
-    const T: usize,
->(
+pub fn cluster_then_collapse<S: Source, I: Index, L: Index, const CELLS: usize>(
     table: &mut Clusterer<CELLS>,
     quadrics: Option<&mut Quadrics<CELLS>>,
-    workspace: &mut crate::Workspace<L, V, T>,
+    mut storage: crate::Storage<'_, L>,
     source: &mut S,
     cluster_config: &ClusterConfig,
     config: &crate::Config,
@@ -1881,12 +1874,13 @@ pub fn cluster_then_collapse<
     positions: &mut [[f32; 3]],
 ) -> Result<(ClusterReport, crate::Report), ThenCollapseError> {
     let mut cc = *cluster_config;
+    let (cap_v, cap_t) = storage.capacity();
     if let GridChoice::TargetTriangles(t) = cc.grid {
-        let fit = T
+        let fit = cap_t
             .min(out.len())
             .min(vertices.len().saturating_mul(2))
             .min(positions.len().saturating_mul(2))
-            .min(V.saturating_mul(2));
+            .min(cap_v.saturating_mul(2));
         cc.grid = GridChoice::TargetTriangles(t.min(fit));
     }
     let nv_cap = vertices.len().min(positions.len());
@@ -1911,7 +1905,7 @@ pub fn cluster_then_collapse<
                 index: v as usize,
             }))?;
     }
-    let report = workspace
+    let report = storage
         .simplify(ps, tris, config)
         .map_err(ThenCollapseError::Collapse)?;
     let done = tris.get_mut(..report.triangles_out).unwrap_or(&mut []);

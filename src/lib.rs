@@ -16,7 +16,7 @@
 //! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
 //! A guaranteed error bound (Zhu, Wang and Meng 2007, seed 001 §2-§4) is a policy of the same
-//! engine: [`Config::with_max_error`] with [`Workspace::start_bounded`] checks control points
+//! engine: [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control points
 //! (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
 //! seed's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
 //!
@@ -84,10 +84,11 @@ mod workspace;
 pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
+pub use cost::{Builtin, Placement, StoredQuadric};
 pub use index::Index;
 pub use progressive::Progressive;
 pub use report::{Reject, Rejections, Report, Stop, PASS_LOG};
-pub use workspace::Workspace;
+pub use workspace::{Positions, Storage, Workspace};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]
@@ -98,16 +99,26 @@ pub struct ReadmeDoctests;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Capacity {
-    /// More positions than the workspace (or its link type) can number.
+    /// More positions than the [`Storage`] (or its link type) can number.
     Vertices,
-    /// More triangles than the workspace (or its link type) can number.
+    /// More triangles than the [`Storage`] (or its link type) can number.
     Triangles,
-    /// Fewer stored quadrics than positions ([`Workspace::simplify_stored`]).
+    /// Fewer stored quadrics than positions ([`StoredQuadric`]).
     Quadrics,
-    /// Fewer control links than [`bound::control_len`], more control points than the link
-    /// type numbers, or a finite [`Config::max_error`] on an entry point without control
-    /// points ([`Workspace::start_bounded`]).
+    /// Fewer control links than [`bound::control_len`], or more control points than the
+    /// link type numbers ([`Controls`]).
     Controls,
+}
+
+impl core::fmt::Display for Capacity {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Capacity::Vertices => "vertices",
+            Capacity::Triangles => "triangles",
+            Capacity::Quadrics => "stored quadrics",
+            Capacity::Controls => "control links",
+        })
+    }
 }
 
 /// Which configuration field is out of range.
@@ -125,6 +136,13 @@ pub enum ConfigField {
     MaxError,
     ControlAngle,
     Operator,
+    /// The schedule cannot run this cost ([`StoredQuadric`]: greedy only).
+    Schedule,
+    /// Optimal placement without [`Positions::Write`], or with an error bound (its control
+    /// points are read at the positions placement would move).
+    Placement,
+    /// [`Config::cost`] names another cost than the one given to [`Storage::start`].
+    Cost,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
@@ -173,19 +191,48 @@ impl core::fmt::Display for Error {
                 what,
                 needed,
                 available,
-            } => write!(
-                f,
-                "mesh has {needed} {what:?} but the workspace holds {available}"
-            ),
+            } => {
+                let holds = match what {
+                    Capacity::Vertices | Capacity::Triangles => "the workspace holds",
+                    Capacity::Quadrics => "there are",
+                    Capacity::Controls => "there are",
+                };
+                write!(f, "mesh needs {needed} {what} but {holds} {available}")?;
+                if matches!(what, Capacity::Vertices | Capacity::Triangles)
+                    && *available == <u16 as Index>::COUNT
+                    && *needed > *available
+                {
+                    f.write_str(" (u16 links number at most 65535: use u32 links)")?;
+                }
+                Ok(())
+            }
             Error::IndexOutOfRange { triangle, index } => {
                 write!(f, "triangle {triangle} refers to missing vertex {index}")
             }
             Error::NonFinitePosition { vertex } => {
                 write!(f, "vertex {vertex} has a non-finite coordinate")
             }
-            Error::InvalidConfig { field } => {
-                write!(f, "configuration field {field:?} is out of range")
-            }
+            Error::InvalidConfig { field } => match field {
+                ConfigField::MaxError => write!(
+                    f,
+                    "configuration field MaxError is out of range (non-negative; a finite bound \
+                     needs bound::Controls)"
+                ),
+                ConfigField::Schedule => write!(
+                    f,
+                    "configuration field Schedule: stored quadrics run the greedy schedule only"
+                ),
+                ConfigField::Placement => write!(
+                    f,
+                    "configuration field Placement: optimal placement needs writable positions \
+                     and no error bound"
+                ),
+                ConfigField::Cost => write!(
+                    f,
+                    "configuration field Cost names another cost than the one given"
+                ),
+                _ => write!(f, "configuration field {field:?} is out of range"),
+            },
             Error::OriginalMismatch { triangle } => {
                 write!(f, "original triangle {triangle} is not the one to simplify")
             }

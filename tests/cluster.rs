@@ -458,7 +458,7 @@ fn cluster_then_collapse_fits_a_small_workspace() {
     let (cr, r) = cluster_then_collapse(
         &mut table,
         None,
-        &mut ws,
+        ws.as_storage(),
         &mut src,
         &ClusterConfig::target(usize::MAX),
         &Config::new().with_target_triangles(600),

@@ -122,9 +122,6 @@ pub fn cluster(
     ))
 }
 
-/// The workspace of `--then-collapse` (as large as `host-sim simplify`'s, in `.bss`).
-static WS: Mutex<crate::simplify::HostWorkspace> = Mutex::new(tinydecimate::Workspace::new());
-
 /// `cluster_then_collapse` with the harness's buffers.
 fn then_collapse(
     mesh: &MeshData,
@@ -134,8 +131,8 @@ fn then_collapse(
 ) -> Result<(MeshData, ClusterReport, Report, Duration)> {
     let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
     let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
-    let mut ws = WS.lock().unwrap_or_else(|p| p.into_inner());
     let n = mesh.triangles.len().max(1);
+    let mut ws = crate::simplify::HostWorkspace::new(n, n);
     let mut out = vec![[0u32; 3]; n];
     let mut vertices = vec![0u32; n];
     let mut positions = vec![[0.0f32; 3]; n];
@@ -145,7 +142,7 @@ fn then_collapse(
     let (cr, r) = cluster_then_collapse(
         &mut table,
         q,
-        &mut ws,
+        ws.storage(),
         &mut src,
         config,
         &Config::new().with_target_triangles(target),
