@@ -17,7 +17,7 @@ use cortex_m_rt::entry;
 use tinydecimate::bound::{control_len, Bound};
 use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
-    Quadrics, SliceSource, Source, ThenCollapseError, KEY_LANES,
+    Quadrics, Scratch, SliceSource, Source, ThenCollapseError, KEY_LANES,
 };
 use tinydecimate::cost::{
     error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
@@ -493,7 +493,15 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
     } else {
         None
     };
-    match table.cluster(&mut src, q, &config, &mut out) {
+    match table.cluster(
+        &mut src,
+        &config,
+        &mut out,
+        Scratch {
+            quadrics: q,
+            ..Scratch::new()
+        },
+    ) {
         Ok(r) => {
             black_box(r);
         }
@@ -509,7 +517,16 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         } else {
             None
         };
-        match table.cluster_with_seen(&mut src, q, &config, &mut out, b) {
+        match table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                seen: b,
+                ..Scratch::new()
+            },
+        ) {
             Ok(r) => {
                 black_box(r);
             }
@@ -520,7 +537,16 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         } else {
             None
         };
-        match table.cluster_with_cache(&mut src, q, &config, &mut out, c) {
+        match table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                cache: c,
+                ..Scratch::new()
+            },
+        ) {
             Ok(r) => {
                 black_box(r);
             }
@@ -535,7 +561,17 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
             } else {
                 None
             };
-            match table.cluster_with_keys(&mut src, q, &config, &mut out, c, k) {
+            match table.cluster(
+                &mut src,
+                &config,
+                &mut out,
+                Scratch {
+                    quadrics: q,
+                    cache: c,
+                    keys: k,
+                    ..Scratch::new()
+                },
+            ) {
                 Ok(r) => {
                     black_box(r);
                 }
@@ -551,7 +587,7 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         return;
     };
     let mut s = SliceSource::new(p, t);
-    match table.cluster(&mut s, None, &config, &mut out) {
+    match table.cluster(&mut s, &config, &mut out, Scratch::new()) {
         Ok(r) => {
             black_box(r);
         }
@@ -594,16 +630,19 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
     let mut vertices = [0u32; 48];
     let mut pos = [[0.0f32; 3]; 48];
     let ccfg = opaque_config();
+    let scratch = Scratch {
+        vertices: &mut vertices,
+        positions: &mut pos,
+        ..Scratch::new()
+    };
     match cluster_then_collapse(
         &mut table,
-        None,
-        ws.as_storage(),
         &mut src,
         &config,
         &ccfg,
         &mut out,
-        &mut vertices,
-        &mut pos,
+        ws.as_storage(),
+        scratch,
     ) {
         Ok((c, r)) => {
             black_box(c);
