@@ -41,7 +41,7 @@
 //! every Cortex-M core.
 //!
 //! ```
-//! use tinydecimate::cluster::{ClusterConfig, Clusterer, SliceSource};
+//! use tinydecimate::cluster::{ClusterConfig, Clusterer, Scratch, SliceSource};
 //!
 //! // A 16x16 grid of quads on z = 0: 512 triangles.
 //! let n = 17;
@@ -62,7 +62,9 @@
 //! let mut table = Clusterer::<256>::new();
 //! let mut out = [[0u16; 3]; 160];
 //! let mut source = SliceSource::new(&positions, &triangles);
-//! let report = table.cluster(&mut source, None, &ClusterConfig::target(100), &mut out)?;
+//! // No optional buffers (`Scratch` holds the quadric table and the per-vertex memories).
+//! let config = ClusterConfig::target(100);
+//! let report = table.cluster(&mut source, &config, &mut out, Scratch::new())?;
 //! assert!(report.triangles_out <= 100 && report.triangles_out > 0);
 //! # Ok::<(), tinydecimate::cluster::ClusterError>(())
 //! ```

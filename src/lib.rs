@@ -54,10 +54,29 @@
 //! let config = Config::new().with_ratio(0.25).with_schedule(Schedule::Greedy);
 //! // An error is a typed value and the buffer is untouched: firmware hands it on (`?`) or
 //! // logs it; it never needs to panic.
+//! let grid = triangles;
 //! let report = ws.simplify(&positions, &mut triangles, &config)?;
 //! let simplified = &triangles[..report.triangles_out];
 //! assert!(report.triangles_out < 32);
 //! assert_eq!(simplified.len(), report.triangles_out);
+//!
+//! // Any other choice goes through `start`, with the cost (and its placement) and the error
+//! // bound as values, each on the caller's storage and checked when the run starts: here
+//! // stored quadrics under a guaranteed bound of 0.05 (`run` to the end, or `step`).
+//! use tinydecimate::{bound, Controls, Placement, Positions, StoredQuadric};
+//! let (original, mut triangles) = (grid, grid);
+//! let mut quadrics = [[0.0f32; 10]; 25];
+//! let mut links = [0u16; bound::control_len(32, 25)];
+//! let report = ws
+//!     .start(
+//!         Positions::Read(&positions),
+//!         &mut triangles,
+//!         &Config::stored().with_ratio(0.25).with_max_error(0.05),
+//!         StoredQuadric::new(&mut quadrics, Placement::Subset),
+//!         Controls::new(&original, &mut links),
+//!     )?
+//!     .run();
+//! assert!(report.max_error.unwrap() <= 0.05);
 //! # Ok::<(), tinydecimate::Error>(())
 //! ```
 #![cfg_attr(not(test), no_std)]
