@@ -423,16 +423,33 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     bounded: bool,
     quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    use tinydecimate::{NoBound, Placement, Positions, StoredQuadric};
     if bounded {
         return run_bounded(ws, positions, triangles, config, quadrics);
     }
-    let (p, cost) = match placement {
-        None => return ws.simplify(positions, triangles, config),
-        Some(Placement::Subset) => (Positions::Read(positions), Placement::Subset),
-        Some(Placement::Optimal) => (Positions::Write(positions), Placement::Optimal),
+    match placement {
+        None => ws.simplify(positions, triangles, config),
+        Some(placement) => run_stored(ws, positions, triangles, config, placement, quadrics),
+    }
+}
+
+/// A stored-quadric case (`StoredQuadric`). Never inlined, for the same reason as
+/// [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_stored<I: tinydecimate::Index>(
+    ws: &mut board::Workspace,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+    placement: tinydecimate::Placement,
+    quadrics: &mut [[f32; 10]],
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    use tinydecimate::{NoBound, Placement, Positions, StoredQuadric};
+    let p = match placement {
+        Placement::Subset => Positions::Read(positions),
+        Placement::Optimal => Positions::Write(positions),
     };
-    let cost = StoredQuadric::new(quadrics, cost);
+    let cost = StoredQuadric::new(quadrics, placement);
     Ok(ws.start(p, triangles, config, cost, NoBound)?.run())
 }
 
