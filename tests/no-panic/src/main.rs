@@ -25,7 +25,7 @@ use tinydecimate::cost::{
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, Error, FeatureMode, Index, NoBound, Operator, Positions, Progressive, Report,
+    Config, CostKind, FeatureMode, Index, NoBound, Operator, Positions, Progressive, Report,
     Schedule, Simplifier, Workspace,
 };
 
