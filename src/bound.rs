@@ -157,9 +157,20 @@ pub trait Bound<'a, I: Index>: sealed::Sealed + 'a {
     /// The control points, if any.
     #[doc(hidden)]
     fn controls_mut(&mut self) -> Option<&mut Controls<'a, I, Self::K>>;
+    /// Checks the bound's storage and configuration when the run starts, before anything is
+    /// written: `triangles` are the ones to simplify, `vertices` the number of positions.
+    #[doc(hidden)]
+    fn prepare(
+        &mut self,
+        triangles: &[[I; 3]],
+        vertices: usize,
+        config: &crate::Config,
+    ) -> Result<(), crate::Error>;
 }
 
-/// No error bound (the default engine).
+/// No error bound (the default engine): [`Config::max_error`](crate::Config::max_error) must
+/// be infinite, else [`Error::InvalidConfig`](crate::Error::InvalidConfig) for
+/// [`ConfigField::MaxError`](crate::ConfigField::MaxError) (a bound needs [`Controls`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct NoBound;
 
@@ -174,6 +185,19 @@ impl<'a, I: Index> Bound<'a, I> for NoBound {
     fn controls_mut(&mut self) -> Option<&mut Controls<'a, I, u32>> {
         None
     }
+    fn prepare(
+        &mut self,
+        _: &[[I; 3]],
+        _: usize,
+        config: &crate::Config,
+    ) -> Result<(), crate::Error> {
+        if config.max_error < f32::INFINITY {
+            return Err(crate::Error::InvalidConfig {
+                field: crate::ConfigField::MaxError,
+            });
+        }
+        Ok(())
+    }
 }
 
 impl<'a, I: Index, K: Index> Bound<'a, I> for Controls<'a, I, K> {
@@ -187,11 +211,55 @@ impl<'a, I: Index, K: Index> Bound<'a, I> for Controls<'a, I, K> {
     fn controls_mut(&mut self) -> Option<&mut Controls<'a, I, K>> {
         Some(self)
     }
+    fn prepare(
+        &mut self,
+        triangles: &[[I; 3]],
+        vertices: usize,
+        config: &crate::Config,
+    ) -> Result<(), crate::Error> {
+        use crate::{Capacity, Error};
+        let original = self.original;
+        if original.len() != triangles.len() {
+            return Err(Error::OriginalMismatch {
+                triangle: original.len().min(triangles.len()),
+            });
+        }
+        if let Some(t) = original.iter().zip(triangles).position(|(a, b)| a != b) {
+            return Err(Error::OriginalMismatch { triangle: t });
+        }
+        let need = control_len(triangles.len(), vertices);
+        let available = if need > K::COUNT {
+            K::COUNT
+        } else {
+            self.links.len()
+        };
+        if need > available {
+            return Err(Error::Capacity {
+                what: Capacity::Controls,
+                needed: need,
+                available,
+            });
+        }
+        let links = core::mem::take(&mut self.links);
+        self.links = links.get_mut(..need).unwrap_or(&mut []);
+        self.cos_feature = math::cos_deg(config.control_angle_deg);
+        Ok(())
+    }
 }
 
-/// The control points of a bounded run (see the module documentation): the original
-/// triangles (read only) and the caller's link slice. Built by
-/// [`Workspace::start_bounded`](crate::Workspace::start_bounded).
+/// The guaranteed error bound [`Config::max_error`](crate::Config::max_error) of a run (see the
+/// module documentation), given to [`Storage::start`](crate::Storage::start): the original
+/// triangles (read only, they may stay in flash) and the caller's link slice.
+///
+/// Checked when the run starts: `original` must equal the triangles to simplify
+/// ([`Error::OriginalMismatch`](crate::Error::OriginalMismatch)); `links` must hold at least
+/// [`control_len`]`(triangles, positions)` links of any [`Index`] type (`2·T + V`: 5 bytes
+/// per triangle with `u16` and `V ≈ T/2`), all numbered below its `NIL`, else
+/// [`Error::Capacity`](crate::Error::Capacity) for
+/// [`Capacity::Controls`](crate::Capacity::Controls). The links are meaningless after
+/// [`Simplifier::finish`](crate::Simplifier::finish) (the triangles are compacted). Positions
+/// are only read (subset placement). An infinite `max_error` runs unbounded but still reports
+/// E_max and E_mean.
 pub struct Controls<'a, I: Index, K: Index> {
     original: &'a [[I; 3]],
     /// `[0, nt)`: first control point of each triangle slot; `[nt, 2·nt + nv)`: the next
@@ -205,15 +273,15 @@ pub struct Controls<'a, I: Index, K: Index> {
 }
 
 impl<'a, I: Index, K: Index> Controls<'a, I, K> {
-    /// Checked by the caller: `links` holds `control_len(original.len(), nv)` links, all
-    /// numbered below `K::NIL`.
-    pub(crate) fn new(original: &'a [[I; 3]], links: &'a mut [K], cos_feature: f32) -> Self {
+    /// Control points over the `original` triangles, linked in `links` (contents on entry do
+    /// not matter); both are checked when the run starts.
+    pub fn new(original: &'a [[I; 3]], links: &'a mut [K]) -> Self {
         Controls {
             original,
             nt: original.len(),
             links,
             limit2: f32::INFINITY,
-            cos_feature,
+            cos_feature: 1.0,
         }
     }
 

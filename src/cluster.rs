@@ -41,7 +41,7 @@
 //! every Cortex-M core.
 //!
 //! ```
-//! use tinydecimate::cluster::{ClusterConfig, Clusterer, SliceSource};
+//! use tinydecimate::cluster::{ClusterConfig, Clusterer, Scratch, SliceSource};
 //!
 //! // A 16x16 grid of quads on z = 0: 512 triangles.
 //! let n = 17;
@@ -62,7 +62,9 @@
 //! let mut table = Clusterer::<256>::new();
 //! let mut out = [[0u16; 3]; 160];
 //! let mut source = SliceSource::new(&positions, &triangles);
-//! let report = table.cluster(&mut source, None, &ClusterConfig::target(100), &mut out)?;
+//! // No optional buffers (`Scratch` holds the quadric table and the per-vertex memories).
+//! let config = ClusterConfig::target(100);
+//! let report = table.cluster(&mut source, &config, &mut out, Scratch::new())?;
 //! assert!(report.triangles_out <= 100 && report.triangles_out > 0);
 //! # Ok::<(), tinydecimate::cluster::ClusterError>(())
 //! ```
@@ -543,6 +545,67 @@ impl<const CELLS: usize> Default for Quadrics<CELLS> {
     }
 }
 
+/// The optional buffers of [`Clusterer::cluster`] and [`cluster_then_collapse`], all empty by
+/// default (the table and the output only). Contents on entry do not matter.
+///
+/// * `quadrics`: the quadric representative (two passes) instead of the nearest to the cell's
+///   centre.
+/// * `seen`: a bit per input vertex (vertex `v` is bit `v % 32` of word `v / 32`): the quadric
+///   representative's second pass scores each vertex once instead of once per corner (about
+///   6 times), most of that pass's time. `vertices / 8` bytes (4.5 KB for the bunny's 35 947
+///   vertices).
+/// * `cache`: 8 bytes per input vertex: each position is read and quantised once for the grid
+///   search and the first pass instead of once per corner and pass, and the second pass
+///   scores each vertex once (as `seen`). 288 KB for the bunny: a host's or a large device's
+///   option.
+/// * `keys`: a further 32 bytes per input vertex: each counting pass of the target search
+///   computes a vertex's cells at all its probed resolutions once, and counts a triangle with
+///   one comparison of its corners' keys (with `cache`, 1.4 MB for the bunny).
+/// * `vertices`, `positions`: [`cluster_then_collapse`]'s compacted mesh (4 and 12 bytes per
+///   vertex it keeps); unused by [`Clusterer::cluster`].
+///
+/// Vertices beyond any buffer take the path without it.
+pub struct Scratch<'a, const CELLS: usize> {
+    /// See the type.
+    pub quadrics: Option<&'a mut Quadrics<CELLS>>,
+    /// See the type.
+    pub seen: &'a mut [u32],
+    /// See the type.
+    pub cache: &'a mut [u64],
+    /// See the type.
+    pub keys: &'a mut [[u32; KEY_LANES]],
+    /// See the type.
+    pub vertices: &'a mut [u32],
+    /// See the type.
+    pub positions: &'a mut [[f32; 3]],
+}
+
+impl<'a, const CELLS: usize> Scratch<'a, CELLS> {
+    /// No buffers.
+    pub fn new() -> Self {
+        Scratch {
+            quadrics: None,
+            seen: &mut [],
+            cache: &mut [],
+            keys: &mut [],
+            vertices: &mut [],
+            positions: &mut [],
+        }
+    }
+
+    /// With the quadric representative.
+    pub fn with_quadrics(mut self, quadrics: &'a mut Quadrics<CELLS>) -> Self {
+        self.quadrics = Some(quadrics);
+        self
+    }
+}
+
+impl<const CELLS: usize> Default for Scratch<'_, CELLS> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 /// The cell table: a fixed-capacity open-addressing hash table from occupied cells to their
 /// representative vertex. 12 bytes per cell ([`Clusterer::BYTES_PER_CELL`]); keep it about
 /// 1.3x the occupied cells for short probes (it works up to completely full).
@@ -586,10 +649,10 @@ struct Pass<'a, I: Index> {
     out_missed: usize,
     slivers: usize,
     flipped: usize,
-    /// The caller's per-vertex cache of quantised coordinates ([`Clusterer::cluster_with_cache`]);
+    /// The caller's per-vertex cache of quantised coordinates ([`Scratch::cache`]);
     /// empty without.
     cache: &'a mut [u64],
-    /// The caller's key entries ([`Clusterer::cluster_with_keys`]): lane 6 holds the vertex's
+    /// The caller's key entries ([`Scratch::keys`]): lane 6 holds the vertex's
     /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`], and lane 0 the cell's slot
     /// + 1 once it is known (0 before); empty without.
     keys: &'a mut [[u32; KEY_LANES]],
@@ -1271,91 +1334,32 @@ impl<const CELLS: usize> Clusterer<CELLS> {
 
     /// Clusters a re-readable `source` into `out`, in passes: the bounding box (unless given),
     /// the grid search (for a target count), then one pass (nearest representative) or two
-    /// (`quadrics`: accumulate, then choose). On success the first `triangles_out` entries of
-    /// `out` hold the result, in input vertex numbers.
+    /// (`scratch.quadrics`: accumulate, then choose). On success the first `triangles_out`
+    /// entries of `out` hold the result, in input vertex numbers. The optional buffers of
+    /// `scratch` only make it faster (see [`Scratch`]); the output is the same.
     pub fn cluster<S: Source, I: Index>(
         &mut self,
         source: &mut S,
-        quadrics: Option<&mut Quadrics<CELLS>>,
         config: &ClusterConfig,
         out: &mut [[I; 3]],
+        scratch: Scratch<'_, CELLS>,
     ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(
-            source,
+        let Scratch {
             quadrics,
-            config,
-            out,
-            None,
-            &mut [],
-            &mut [],
-            &mut [],
-        )
-        .map(|(r, _)| r)
-    }
-
-    /// Like [`Clusterer::cluster`], with a caller's bit per input vertex (`seen`: vertex `v` is
-    /// bit `v % 32` of word `v / 32`; contents on entry do not matter). The quadric
-    /// representative's second pass then scores each vertex once instead of once per
-    /// triangle corner (about 6 times), which is most of that pass's time: the same output,
-    /// faster. Vertices beyond the bits are scored at every corner, as without them; with
-    /// the nearest representative the bits are unused. Costs `vertices / 8` bytes (4.5 KB for
-    /// the bunny's 35 947 vertices).
-    pub fn cluster_with_seen<S: Source, I: Index>(
-        &mut self,
-        source: &mut S,
-        quadrics: Option<&mut Quadrics<CELLS>>,
-        config: &ClusterConfig,
-        out: &mut [[I; 3]],
-        seen: &mut [u32],
-    ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, seen, &mut [], &mut [])
-            .map(|(r, _)| r)
-    }
-
-    /// Like [`Clusterer::cluster`], with a caller's cache of 8 bytes per input vertex (`cache[v]`
-    /// for vertex `v`; contents on entry do not matter): each vertex's position is read and
-    /// quantised once for the grid search and the first pass instead of once per corner and
-    /// pass, and the quadric representative's second pass scores each vertex once (as
-    /// [`Clusterer::cluster_with_seen`]). The same output, faster; vertices beyond the cache
-    /// take the path without it. 288 KB for the bunny's 35 947 vertices: a host's or a large
-    /// device's option, not the micro:bit's.
-    pub fn cluster_with_cache<S: Source, I: Index>(
-        &mut self,
-        source: &mut S,
-        quadrics: Option<&mut Quadrics<CELLS>>,
-        config: &ClusterConfig,
-        out: &mut [[I; 3]],
-        cache: &mut [u64],
-    ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, &mut [], cache, &mut [])
-            .map(|(r, _)| r)
-    }
-
-    /// Like [`Clusterer::cluster_with_cache`], with a further 32 bytes per input vertex
-    /// (`keys[v]` for vertex `v`; contents on entry do not matter): each counting pass of the
-    /// target search computes a vertex's cells at all its probed resolutions once, per
-    /// vertex, instead of at every corner, and counts a triangle with one comparison of its
-    /// corners' keys. The same output, faster (the counting passes are half the time with the
-    /// cache alone); vertices beyond either memory take the per-corner path. 40 bytes per
-    /// vertex in all: 1.4 MB for the bunny's 35 947 vertices, a host's option.
-    pub fn cluster_with_keys<S: Source, I: Index>(
-        &mut self,
-        source: &mut S,
-        quadrics: Option<&mut Quadrics<CELLS>>,
-        config: &ClusterConfig,
-        out: &mut [[I; 3]],
-        cache: &mut [u64],
-        keys: &mut [[u32; KEY_LANES]],
-    ) -> Result<ClusterReport, ClusterError> {
-        self.cluster_into(source, quadrics, config, out, None, &mut [], cache, keys)
+            seen,
+            cache,
+            keys,
+            ..
+        } = scratch;
+        self.cluster_into(source, quadrics, config, out, None, seen, cache, keys)
             .map(|(r, _)| r)
     }
 
     /// Like [`Clusterer::cluster`], but the output triangles use new vertex numbers 0, 1, ...
     /// (in order of first use) and `vertices[i]` receives the input number of new vertex `i`:
-    /// a compact mesh for [`Workspace`](crate::Workspace). Returns the report and the number
-    /// of vertices. [`ClusterError::VerticesFull`] if `vertices` is too short.
-    pub fn cluster_compact<S: Source, I: Index>(
+    /// a compact mesh for the collapse engine. Returns the report and the number of vertices.
+    /// [`ClusterError::VerticesFull`] if `vertices` is too short.
+    fn cluster_compact<S: Source, I: Index>(
         &mut self,
         source: &mut S,
         quadrics: Option<&mut Quadrics<CELLS>>,
@@ -1581,7 +1585,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
 /// Resolutions probed per counting pass of the target search.
 pub const PROBES: usize = 6;
 
-/// Lanes of a per-vertex key entry of [`Clusterer::cluster_with_keys`]: the cells of the
+/// Lanes of a per-vertex key entry of [`Scratch::keys`]: the cells of the
 /// [`PROBES`] resolutions of a counting pass, padded to 8 (32 bytes, two SIMD registers).
 pub const KEY_LANES: usize = 8;
 /// The lane of a key entry that holds the number of the counting pass it was computed for.
@@ -1852,41 +1856,38 @@ impl core::fmt::Display for ThenCollapseError {
     }
 }
 
-/// Cluster, then collapse: clusters `source` down to what fits `workspace` (at most its
-/// triangle capacity, `out.len()` and twice `vertices.len()` triangles; the grid is searched
-/// as for [`GridChoice::TargetTriangles`] unless `cluster_config` fixes it), copies the
-/// surviving vertices' positions into `positions` (RAM: 12 bytes per vertex), then runs the
+/// Cluster, then collapse: clusters `source` down to what fits `storage` (at most its
+/// triangle capacity, `out.len()` and twice `scratch.vertices.len()` and
+/// `scratch.positions.len()` triangles; the grid is searched as for
+/// [`GridChoice::TargetTriangles`] unless `cluster_config` fixes it), copies the surviving
+/// vertices' positions into `scratch.positions` (RAM: 12 bytes per vertex), then runs the
 /// collapse engine with `config` (give it an absolute target with
 /// [`Config::with_target_triangles`](crate::Config::with_target_triangles)). On success the
 /// first `collapse.triangles_out` entries of `out` hold the result **in input vertex
-/// numbers**; `vertices` and `positions` are scratch. A small device thus gets collapse
-/// quality from a mesh it could never hold.
-#[allow(clippy::too_many_arguments)]
-pub fn cluster_then_collapse<
-    S: Source,
-    I: Index,
-    L: Index,
-    const CELLS: usize,
-    const V: usize,
-    const T: usize,
->(
+/// numbers**. A small device thus gets collapse quality from a mesh it could never hold.
+pub fn cluster_then_collapse<S: Source, I: Index, L: Index, const CELLS: usize>(
     table: &mut Clusterer<CELLS>,
-    quadrics: Option<&mut Quadrics<CELLS>>,
-    workspace: &mut crate::Workspace<L, V, T>,
     source: &mut S,
     cluster_config: &ClusterConfig,
     config: &crate::Config,
     out: &mut [[I; 3]],
-    vertices: &mut [u32],
-    positions: &mut [[f32; 3]],
+    mut storage: crate::Storage<'_, L>,
+    scratch: Scratch<'_, CELLS>,
 ) -> Result<(ClusterReport, crate::Report), ThenCollapseError> {
+    let Scratch {
+        quadrics,
+        vertices,
+        positions,
+        ..
+    } = scratch;
     let mut cc = *cluster_config;
+    let (cap_v, cap_t) = storage.capacity();
     if let GridChoice::TargetTriangles(t) = cc.grid {
-        let fit = T
+        let fit = cap_t
             .min(out.len())
             .min(vertices.len().saturating_mul(2))
             .min(positions.len().saturating_mul(2))
-            .min(V.saturating_mul(2));
+            .min(cap_v.saturating_mul(2));
         cc.grid = GridChoice::TargetTriangles(t.min(fit));
     }
     let nv_cap = vertices.len().min(positions.len());
@@ -1911,7 +1912,7 @@ pub fn cluster_then_collapse<
                 index: v as usize,
             }))?;
     }
-    let report = workspace
+    let report = storage
         .simplify(ps, tris, config)
         .map_err(ThenCollapseError::Collapse)?;
     let done = tris.get_mut(..report.triangles_out).unwrap_or(&mut []);

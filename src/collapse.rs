@@ -87,14 +87,14 @@ enum Phase {
     Done(Stop),
 }
 
-/// A simplification in progress; see [`Workspace::start`](crate::Workspace::start).
+/// A simplification in progress; see [`Storage::start`](crate::Storage::start).
 ///
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
 /// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
 ///
-/// `B` is the error bound: [`NoBound`] (none, the default) or the control points of
-/// [`Workspace::start_bounded`](crate::Workspace::start_bounded).
+/// `B` is the error bound: [`NoBound`] (none, the default) or
+/// [`Controls`](crate::bound::Controls).
 pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
@@ -134,6 +134,7 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound
 }
 
 impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    #[inline(always)]
     pub(crate) fn new(
         mesh: Mesh<'a, L, I>,
         heap: Heap<'a, L>,
@@ -153,7 +154,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             locked += mesh.has(v, flag::LOCKED) as usize;
             used_in += mesh.has(v, flag::USED) as usize;
         }
-        Simplifier {
+        let mut s = Simplifier {
             mesh,
             heap,
             rules: Rules::new(&config),
@@ -181,11 +182,15 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             logged: 0,
             initialised: false,
             bound,
+        };
+        if B::ON {
+            s.enrol();
         }
+        s
     }
 
     /// Enrols the control points of a bounded run (nothing without a bound).
-    pub(crate) fn enrol(&mut self) {
+    fn enrol(&mut self) {
         let d = self.config.max_error;
         if let Some(c) = self.bound.controls_mut() {
             c.enrol(&self.mesh, d);
@@ -225,6 +230,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             ops += 1;
         }
         matches!(self.phase, Phase::Done(_))
+    }
+
+    /// Runs to the end and [finishes](Simplifier::finish): the one-shot run.
+    pub fn run(mut self) -> Report {
+        while !self.step(u32::MAX) {}
+        self.finish()
     }
 
     /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
@@ -1254,7 +1265,7 @@ fn less(a: (f32, usize), b: (f32, usize)) -> bool {
 mod tests {
     use super::*;
     use crate::cost::{Placement, StoredQuadric, VertexQuadric};
-    use crate::Workspace;
+    use crate::{Positions, Workspace};
 
     impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
         /// The queue's promise: every queued key is at most its vertex's cheapest price now,
@@ -1327,8 +1338,8 @@ mod tests {
         let mut q = [[0.0f32; 10]; 121] as [VertexQuadric; 121];
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
-        let cost = StoredQuadric::new(&mut q, 1.0, Placement::Subset);
-        audit(ws.start_with_cost(&p, &mut t, &config, cost)?);
+        let cost = StoredQuadric::new(&mut q, Placement::Subset);
+        audit(ws.start(Positions::Read(&p), &mut t, &config, cost, NoBound)?);
         Ok(())
     }
 
@@ -1342,8 +1353,8 @@ mod tests {
         let mut q = [[0.0f32; 10]; 121] as [VertexQuadric; 121];
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
-        let cost = StoredQuadric::new(&mut q, 1.0, Placement::Optimal);
-        audit(ws.start_moving(&mut p, &mut t, &config, cost)?);
+        let cost = StoredQuadric::new(&mut q, Placement::Optimal);
+        audit(ws.start(Positions::Write(&mut p), &mut t, &config, cost, NoBound)?);
         Ok(())
     }
 

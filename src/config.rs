@@ -51,13 +51,17 @@ pub enum FeatureMode {
 }
 
 /// Simplification settings. Build with [`Config::new`] and the `with_*` methods; the engine
-/// checks them in [`Workspace::start`](crate::Workspace::start).
+/// checks them in [`Storage::start`](crate::Storage::start), and each policy given there
+/// (cost, bound) checks the fields it depends on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Collapse order.
     pub schedule: Schedule,
-    /// What a collapse costs.
+    /// What a collapse costs: the built-in cost of [`Storage::simplify`](crate::Storage::simplify)
+    /// and [`Builtin`](crate::cost::Builtin); a cost given to
+    /// [`Storage::start`](crate::Storage::start) must agree with it (stored quadrics are a
+    /// [`CostKind::Quadric`]).
     pub cost: CostKind,
     /// Stop at or below this many triangles (`0`: use [`Config::target_ratio`] only).
     pub target_triangles: usize,
@@ -90,9 +94,9 @@ pub struct Config {
     pub boundary_weight: f32,
     /// The guaranteed error bound `d_hold` (seed 001 §2-§3), in the input's units: no control
     /// point (original triangle centroid or feature-edge vertex) ends farther than this from
-    /// the result. Infinite (the default): no bound. A finite value needs the control points
-    /// of [`Workspace::start_bounded`](crate::Workspace::start_bounded); the other entry
-    /// points refuse it with [`Capacity::Controls`](crate::Capacity::Controls). Non-negative.
+    /// the result. Infinite (the default): no bound. A finite value needs
+    /// [`Controls`](crate::bound::Controls); with [`NoBound`](crate::bound::NoBound) it is
+    /// [`Error::InvalidConfig`](crate::Error::InvalidConfig) for `MaxError`. Non-negative.
     pub max_error: f32,
     /// With an error bound: an original edge is a feature edge (its vertices are control
     /// points of the second kind, seed 001 §2 fig. 2) when its two triangles' normals differ
@@ -140,16 +144,14 @@ impl Config {
         c
     }
 
-    /// The defaults for stored quadrics ([`Workspace::simplify_stored`],
-    /// [`Workspace::simplify_optimal`](crate::Workspace::simplify_optimal)): [`Config::new`]
+    /// The defaults for stored quadrics ([`StoredQuadric`](crate::cost::StoredQuadric), either
+    /// placement): [`Config::new`]
     /// without seed 004's feature rule. The stored quadrics keep creases themselves; without
     /// the rule the Metro mean error is lower on 27 (subset) and 28 (optimal placement) of the
     /// 30 runs over the shared meshes at 50/25/10 % (the maximum is mixed: lower on 10 and
     /// 15, higher on 13 and 12), and with
     /// subset placement the engine then re-keys a collapse's neighbours with one price each
     /// (README, "Stored quadrics").
-    ///
-    /// [`Workspace::simplify_stored`]: crate::Workspace::simplify_stored
     pub const fn stored() -> Self {
         let mut c = Self::new();
         c.features = false;
@@ -214,6 +216,42 @@ impl Config {
     /// [`Config::max_error`]).
     pub const fn with_max_error(mut self, distance: f32) -> Self {
         self.max_error = distance;
+        self
+    }
+
+    /// Detects and keeps feature vertices, or not.
+    pub const fn with_features(mut self, features: bool) -> Self {
+        self.features = features;
+        self
+    }
+
+    /// Lets feature vertices be the kept endpoint of a collapse, or not.
+    pub const fn with_feature_targets(mut self, targets: bool) -> Self {
+        self.feature_targets = targets;
+        self
+    }
+
+    /// Sets the normal-turn limit in degrees.
+    pub const fn with_max_normal_turn(mut self, degrees: f32) -> Self {
+        self.max_normal_turn_deg = degrees;
+        self
+    }
+
+    /// Sets the triangle-quality floor.
+    pub const fn with_min_quality(mut self, quality: f32) -> Self {
+        self.min_quality = quality;
+        self
+    }
+
+    /// Sets the weight of the boundary terms (every cost's, given once here).
+    pub const fn with_boundary_weight(mut self, weight: f32) -> Self {
+        self.boundary_weight = weight;
+        self
+    }
+
+    /// Sets the feature-edge angle of an error bound's control points, in degrees.
+    pub const fn with_control_angle(mut self, degrees: f32) -> Self {
+        self.control_angle_deg = degrees;
         self
     }
 

@@ -6,14 +6,21 @@
 //! [`Cost::price`] in O(1). A cost that needs every surviving triangle's *new* normal (the
 //! paper's W) says so with [`Cost::needs_turn`]; the engine then walks the fan once more per
 //! candidate and passes the summed normal change. A new cost is one more implementation of this
-//! trait, passed to [`Workspace::start_with_cost`](crate::Workspace::start_with_cost); the
-//! engine does not change.
+//! trait, passed to [`Storage::start`](crate::Storage::start); the engine does not change.
+//!
+//! The built-in costs take their settings (boundary weight, schedule) from the [`Config`] when
+//! the run starts ([`Cost::configure`]), so each setting is given once.
 //!
 //! All lengths are in the engine's normalised units (the input's bounding box mapped to about
 //! `[-1, 1]³`), so costs do not depend on the scale of the input.
 
 use crate::math::{self, V3};
-use crate::CostKind;
+use crate::{Config, ConfigField, CostKind, Error};
+
+/// `Error::InvalidConfig` for `field`.
+fn bad(field: ConfigField) -> Result<(), Error> {
+    Err(Error::InvalidConfig { field })
+}
 
 /// One candidate collapse `from -> to`, as a cost sees it.
 #[derive(Clone, Copy, Debug)]
@@ -42,6 +49,18 @@ pub struct Move {
 /// A collapse cost. Lower is better; the engine never performs a collapse whose price is not
 /// finite.
 pub trait Cost {
+    /// Called once when the run starts, after the configuration was validated, with the
+    /// number of positions: takes the settings the cost needs from `config` and checks its
+    /// own storage and the configuration it can run with ([`Error::Capacity`],
+    /// [`Error::InvalidConfig`]). Accepts anything by default.
+    fn configure(&mut self, _config: &Config, _vertices: usize) -> Result<(), Error> {
+        Ok(())
+    }
+    /// Where the kept vertex goes ([`Placement::Optimal`] needs
+    /// [`Positions::Write`](crate::Positions::Write) and no error bound). Subset by default.
+    fn placement(&self) -> Placement {
+        Placement::Subset
+    }
     /// What the cost keeps of one fan while the engine walks it.
     type Fan: Copy;
     /// The summary of an empty fan.
@@ -113,12 +132,31 @@ pub trait Cost {
 /// first (Hausdorff 5.1 % of the diagonal at 10 %); dividing by the fan's area alone (a mean
 /// squared distance) keeps them but raises the mean error by 10-30 % on every shared mesh.
 /// Measured on the shared meshes with `host-sim bench`; see the README.
+///
+/// Needs [`Config::cost`] = [`CostKind::Quadric`]; the boundary weight is
+/// [`Config::boundary_weight`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Quadric {
-    /// Weight of the boundary retreat.
-    pub boundary_weight: f32,
+    /// Weight of the boundary retreat (set when the run starts).
+    boundary_weight: f32,
     /// Twice the mean triangle area of the current mesh (set each round by the engine).
-    pub reference: f32,
+    reference: f32,
+}
+
+impl Quadric {
+    /// The memoryless quadric (its settings come from the configuration).
+    pub const fn new() -> Self {
+        Quadric {
+            boundary_weight: 1.0,
+            reference: 0.0,
+        }
+    }
+}
+
+impl Default for Quadric {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// The fan summary of [`Quadric`]: `Q` (upper triangle, row by row) and twice the area.
@@ -130,6 +168,14 @@ pub struct QuadricFan {
 
 impl Cost for Quadric {
     type Fan = QuadricFan;
+
+    fn configure(&mut self, config: &Config, _vertices: usize) -> Result<(), Error> {
+        if config.cost != CostKind::Quadric {
+            return bad(ConfigField::Cost);
+        }
+        self.boundary_weight = config.boundary_weight;
+        Ok(())
+    }
 
     fn empty(&self) -> QuadricFan {
         QuadricFan::default()
@@ -179,41 +225,57 @@ pub type PlaneDistance = Quadric;
 /// The paper's normal variation W (seed 004 §2, eq. 1-2, Algorithm 1): the sum over the moving
 /// vertex's surviving triangles of ‖N_new − N_old‖², with no trigonometry.
 ///
-/// * `length_weighted`: multiply by the squared edge length (greedy). W measures how far
+/// Needs [`Config::cost`] = [`CostKind::NormalVariation`]; both settings come from the
+/// configuration when the run starts:
+///
+/// * `length_weighted`: multiply by the squared edge length (the greedy schedule). W measures how far
 ///   normals turn, not how far the surface moves; as a *global* priority alone it prefers long
 ///   collapses across flat regions. Displacement is about length × normal change, so W·ℓ²
 ///   ranks collapses by a squared distance.
-/// * `boundary_weight`: a boundary vertex moving along its boundary adds
+/// * `boundary_weight` ([`Config::boundary_weight`]): a boundary vertex moving along its boundary adds
 ///   `boundary_weight · retreat² / ℓ²` (scale-free like W; with W·ℓ², `boundary_weight ·
 ///   retreat²`), so open meshes keep their rims.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NormalVariation {
     /// Multiply by the squared edge length (greedy schedule).
-    pub length_weighted: bool,
+    length_weighted: bool,
     /// Weight of the boundary retreat.
-    pub boundary_weight: f32,
+    boundary_weight: f32,
 }
 
 impl NormalVariation {
-    /// W as in the paper, plus the boundary term: the cost of `Config::paper()`.
-    pub const fn paper(boundary_weight: f32) -> Self {
+    /// The normal variation (its settings come from the configuration).
+    pub const fn new() -> Self {
         NormalVariation {
             length_weighted: false,
-            boundary_weight,
+            boundary_weight: 1.0,
         }
     }
 
-    /// W·ℓ² plus the boundary term: greedy with `CostKind::NormalVariation`.
-    pub const fn greedy(boundary_weight: f32) -> Self {
+    const fn of(config: &Config) -> Self {
         NormalVariation {
-            length_weighted: true,
-            boundary_weight,
+            length_weighted: matches!(config.schedule, crate::Schedule::Greedy),
+            boundary_weight: config.boundary_weight,
         }
+    }
+}
+
+impl Default for NormalVariation {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
 impl Cost for NormalVariation {
     type Fan = ();
+
+    fn configure(&mut self, config: &Config, _vertices: usize) -> Result<(), Error> {
+        if config.cost != CostKind::NormalVariation {
+            return bad(ConfigField::Cost);
+        }
+        *self = Self::of(config);
+        Ok(())
+    }
 
     fn empty(&self) {}
 
@@ -241,7 +303,8 @@ impl Cost for NormalVariation {
     }
 }
 
-/// The built-in costs, chosen at run time by [`Config::cost`](crate::Config::cost).
+/// The built-in costs, chosen at run time by [`Config::cost`] when the run starts (what
+/// [`Storage::simplify`](crate::Storage::simplify) uses): one engine for both.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Builtin {
     /// [`Quadric`].
@@ -251,24 +314,36 @@ pub enum Builtin {
 }
 
 impl Builtin {
+    /// The cost the configuration names when the run starts.
+    pub const fn new() -> Self {
+        Builtin::Quadric(Quadric::new())
+    }
+
     /// The cost a configuration names (W is length-weighted under the greedy schedule).
-    pub fn of(config: &crate::Config) -> Self {
-        let boundary_weight = config.boundary_weight;
+    fn of(config: &Config) -> Self {
         match config.cost {
             CostKind::Quadric => Builtin::Quadric(Quadric {
-                boundary_weight,
+                boundary_weight: config.boundary_weight,
                 reference: 0.0,
             }),
-            CostKind::NormalVariation => Builtin::NormalVariation(NormalVariation {
-                length_weighted: config.schedule == crate::Schedule::Greedy,
-                boundary_weight,
-            }),
+            CostKind::NormalVariation => Builtin::NormalVariation(NormalVariation::of(config)),
         }
+    }
+}
+
+impl Default for Builtin {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
 impl Cost for Builtin {
     type Fan = QuadricFan;
+
+    fn configure(&mut self, config: &Config, _vertices: usize) -> Result<(), Error> {
+        *self = Self::of(config);
+        Ok(())
+    }
 
     fn empty(&self) -> QuadricFan {
         QuadricFan::default()
@@ -328,7 +403,12 @@ pub enum Placement {
 /// §3.3), weighted by `boundary_weight` times the squared edge length.
 ///
 /// The matrices live in a caller-provided slice, one [`VertexQuadric`] (40 bytes) per vertex, at
-/// least as long as the positions. All in the engine's normalised units, and each vertex's
+/// least as long as the positions (else [`Error::Capacity`] for
+/// [`Capacity::Quadrics`](crate::Capacity::Quadrics) when the run starts). Needs the greedy
+/// schedule (else [`Error::InvalidConfig`] for [`ConfigField::Schedule`]) and [`Config::cost`]
+/// = [`CostKind::Quadric`]; the boundary weight is [`Config::boundary_weight`].
+/// [`Config::stored`] is the recommended configuration (no feature rule: lower mean error,
+/// and the faster re-keying). All in the engine's normalised units, and each vertex's
 /// matrix in a frame centred on that vertex (moved to the kept vertex's new position on a
 /// collapse): in `f32`, `vᵀQv` with a global origin loses the small errors of early collapses
 /// to cancellation between terms of order one.
@@ -339,18 +419,12 @@ pub struct StoredQuadric<'q> {
 }
 
 impl<'q> StoredQuadric<'q> {
-    /// A stored quadric over `storage` (zeroed here; the engine fills it).
-    pub fn new(
-        storage: &'q mut [VertexQuadric],
-        boundary_weight: f32,
-        placement: Placement,
-    ) -> Self {
-        for q in storage.iter_mut() {
-            *q = [0.0; 10];
-        }
+    /// A stored quadric over `storage` (contents on entry do not matter: zeroed when the run
+    /// starts; the engine fills it), leaving kept vertices where `placement` says.
+    pub fn new(storage: &'q mut [VertexQuadric], placement: Placement) -> Self {
         StoredQuadric {
             q: storage,
-            boundary_weight,
+            boundary_weight: 1.0,
             placement,
         }
     }
@@ -513,6 +587,31 @@ fn solve(q: &VertexQuadric) -> Option<V3> {
 impl Cost for StoredQuadric<'_> {
     type Fan = ();
     const PLACES: bool = true;
+
+    fn configure(&mut self, config: &Config, vertices: usize) -> Result<(), Error> {
+        if self.q.len() < vertices {
+            return Err(Error::Capacity {
+                what: crate::Capacity::Quadrics,
+                needed: vertices,
+                available: self.q.len(),
+            });
+        }
+        if config.schedule != crate::Schedule::Greedy {
+            return bad(ConfigField::Schedule);
+        }
+        if config.cost != CostKind::Quadric {
+            return bad(ConfigField::Cost);
+        }
+        self.boundary_weight = config.boundary_weight;
+        for q in self.q.iter_mut() {
+            *q = [0.0; 10];
+        }
+        Ok(())
+    }
+
+    fn placement(&self) -> Placement {
+        self.placement
+    }
 
     fn empty(&self) {}
 

@@ -16,7 +16,7 @@
 //! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
 //! A guaranteed error bound (Zhu, Wang and Meng 2007, seed 001 §2-§4) is a policy of the same
-//! engine: [`Config::with_max_error`] with [`Workspace::start_bounded`] checks control points
+//! engine: [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control points
 //! (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
 //! seed's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
 //!
@@ -54,10 +54,29 @@
 //! let config = Config::new().with_ratio(0.25).with_schedule(Schedule::Greedy);
 //! // An error is a typed value and the buffer is untouched: firmware hands it on (`?`) or
 //! // logs it; it never needs to panic.
+//! let grid = triangles;
 //! let report = ws.simplify(&positions, &mut triangles, &config)?;
 //! let simplified = &triangles[..report.triangles_out];
 //! assert!(report.triangles_out < 32);
 //! assert_eq!(simplified.len(), report.triangles_out);
+//!
+//! // Any other choice goes through `start`, with the cost (and its placement) and the error
+//! // bound as values, each on the caller's storage and checked when the run starts: here
+//! // stored quadrics under a guaranteed bound of 0.05 (`run` to the end, or `step`).
+//! use tinydecimate::{bound, Controls, Placement, Positions, StoredQuadric};
+//! let (original, mut triangles) = (grid, grid);
+//! let mut quadrics = [[0.0f32; 10]; 25];
+//! let mut links = [0u16; bound::control_len(32, 25)];
+//! let report = ws
+//!     .start(
+//!         Positions::Read(&positions),
+//!         &mut triangles,
+//!         &Config::stored().with_ratio(0.25).with_max_error(0.05),
+//!         StoredQuadric::new(&mut quadrics, Placement::Subset),
+//!         Controls::new(&original, &mut links),
+//!     )?
+//!     .run();
+//! assert!(report.max_error.unwrap() <= 0.05);
 //! # Ok::<(), tinydecimate::Error>(())
 //! ```
 #![cfg_attr(not(test), no_std)]
@@ -84,11 +103,12 @@ mod workspace;
 pub use bound::{Controls, NoBound};
 pub use collapse::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
+pub use cost::{Builtin, Placement, StoredQuadric};
 pub use index::Index;
 pub use legality::{Reject, RULES};
 pub use progressive::Progressive;
 pub use report::{Rejections, Report, Stop, PASS_LOG};
-pub use workspace::Workspace;
+pub use workspace::{Positions, Storage, Workspace};
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]
@@ -99,16 +119,26 @@ pub struct ReadmeDoctests;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Capacity {
-    /// More positions than the workspace (or its link type) can number.
+    /// More positions than the [`Storage`] (or its link type) can number.
     Vertices,
-    /// More triangles than the workspace (or its link type) can number.
+    /// More triangles than the [`Storage`] (or its link type) can number.
     Triangles,
-    /// Fewer stored quadrics than positions ([`Workspace::simplify_stored`]).
+    /// Fewer stored quadrics than positions ([`StoredQuadric`]).
     Quadrics,
-    /// Fewer control links than [`bound::control_len`], more control points than the link
-    /// type numbers, or a finite [`Config::max_error`] on an entry point without control
-    /// points ([`Workspace::start_bounded`]).
+    /// Fewer control links than [`bound::control_len`], or more control points than the
+    /// link type numbers ([`Controls`]).
     Controls,
+}
+
+impl core::fmt::Display for Capacity {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Capacity::Vertices => "vertices",
+            Capacity::Triangles => "triangles",
+            Capacity::Quadrics => "stored quadrics",
+            Capacity::Controls => "control links",
+        })
+    }
 }
 
 /// Which configuration field is out of range.
@@ -126,6 +156,13 @@ pub enum ConfigField {
     MaxError,
     ControlAngle,
     Operator,
+    /// The schedule cannot run this cost ([`StoredQuadric`]: greedy only).
+    Schedule,
+    /// Optimal placement without [`Positions::Write`], or with an error bound (its control
+    /// points are read at the positions placement would move).
+    Placement,
+    /// [`Config::cost`] names another cost than the one given to [`Storage::start`].
+    Cost,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
@@ -174,19 +211,48 @@ impl core::fmt::Display for Error {
                 what,
                 needed,
                 available,
-            } => write!(
-                f,
-                "mesh has {needed} {what:?} but the workspace holds {available}"
-            ),
+            } => {
+                let holds = match what {
+                    Capacity::Vertices | Capacity::Triangles => "the workspace holds",
+                    Capacity::Quadrics => "there are",
+                    Capacity::Controls => "there are",
+                };
+                write!(f, "mesh needs {needed} {what} but {holds} {available}")?;
+                if matches!(what, Capacity::Vertices | Capacity::Triangles)
+                    && *available == <u16 as Index>::COUNT
+                    && *needed > *available
+                {
+                    f.write_str(" (u16 links number at most 65535: use u32 links)")?;
+                }
+                Ok(())
+            }
             Error::IndexOutOfRange { triangle, index } => {
                 write!(f, "triangle {triangle} refers to missing vertex {index}")
             }
             Error::NonFinitePosition { vertex } => {
                 write!(f, "vertex {vertex} has a non-finite coordinate")
             }
-            Error::InvalidConfig { field } => {
-                write!(f, "configuration field {field:?} is out of range")
-            }
+            Error::InvalidConfig { field } => match field {
+                ConfigField::MaxError => write!(
+                    f,
+                    "configuration field MaxError is out of range (non-negative; a finite bound \
+                     needs bound::Controls)"
+                ),
+                ConfigField::Schedule => write!(
+                    f,
+                    "configuration field Schedule: stored quadrics run the greedy schedule only"
+                ),
+                ConfigField::Placement => write!(
+                    f,
+                    "configuration field Placement: optimal placement needs writable positions \
+                     and no error bound"
+                ),
+                ConfigField::Cost => write!(
+                    f,
+                    "configuration field Cost names another cost than the one given"
+                ),
+                _ => write!(f, "configuration field {field:?} is out of range"),
+            },
             Error::OriginalMismatch { triangle } => {
                 write!(f, "original triangle {triangle} is not the one to simplify")
             }

@@ -85,17 +85,32 @@ pub(crate) const NIL: usize = usize::MAX;
 
 /// Where the positions live: the caller's read-only slice (subset placement: flash is fine),
 /// or a mutable one that a placement may write (optimal placement of stored quadrics).
-pub(crate) enum Positions<'a> {
+pub enum Positions<'a> {
+    /// Only read.
     Read(&'a [[f32; 3]]),
+    /// Read, and written by optimal placement (the kept vertex of each collapse, in the
+    /// input's units). Positions of vertices that no longer have triangles keep their last
+    /// value.
     Write(&'a mut [[f32; 3]]),
 }
 
 impl Positions<'_> {
-    pub(crate) fn len(&self) -> usize {
+    /// How many positions.
+    pub fn len(&self) -> usize {
         match self {
             Positions::Read(p) => p.len(),
             Positions::Write(p) => p.len(),
         }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether they may be written ([`Positions::Write`]).
+    pub fn is_write(&self) -> bool {
+        matches!(self, Positions::Write(_))
     }
 
     #[inline]

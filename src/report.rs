@@ -101,7 +101,7 @@ pub struct Report {
     pub pass_triangles: heapless::Vec<u32, PASS_LOG>,
     /// Refused candidate collapses by reason.
     pub rejected: Rejections,
-    /// With an error bound ([`Workspace::start_bounded`](crate::Workspace::start_bounded)):
+    /// With an error bound ([`Controls`](crate::bound::Controls)):
     /// E_max of seed 001 eq. 4, the largest distance of a control point (original centroid
     /// or feature-edge vertex) to its controlled triangle, in the input's units. Never more
     /// than [`Config::max_error`](crate::Config::max_error). `None` without a bound.

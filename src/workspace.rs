@@ -1,300 +1,218 @@
-//! The fixed-capacity working memory, sized at compile time.
+//! The working memory: caller slices of run-time length ([`Storage`]), and a fixed-capacity
+//! [`Workspace`] sized at compile time that lends them.
+//!
+//! Both have the same two entry points: [`Storage::simplify`] for the common case (read-only
+//! positions, the built-in cost [`Config::cost`] names, no error bound) and [`Storage::start`]
+//! for everything else, with the cost (and its placement) and the error bound as values:
+//!
+//! ```text
+//! ws.simplify(&positions, &mut triangles, &config)                                  // common case
+//! ws.start(Positions::Read(&p), &mut t, &config, Builtin::new(), NoBound)?.run()  // = the line above
+//! ws.start(Positions::Read(&p), &mut t, &config, StoredQuadric::new(&mut q, Placement::Subset),
+//!          Controls::new(&original, &mut links))?.run()                             // stored + bound
+//! ws.start(Positions::Write(&mut p), &mut t, &config, StoredQuadric::new(&mut q, Placement::Optimal),
+//!          NoBound)?                                                                // a stepping Simplifier
+//! ```
+//!
+//! Each policy checks its own storage and configuration when the run starts, before anything
+//! is written: [`StoredQuadric`] one quadric per position and the greedy schedule,
+//! [`Controls`] its links and original triangles, [`NoBound`] that [`Config::max_error`] is
+//! infinite; optimal placement needs [`Positions::Write`] and no bound (the bound's control
+//! points are read at the positions placement would move). A refusal names the field
+//! ([`Error::InvalidConfig`]) or the storage ([`Error::Capacity`]).
+//!
+//! [`StoredQuadric`]: crate::cost::StoredQuadric
+//! [`Controls`]: crate::bound::Controls
 
-use crate::bound::{control_len, Bound, Controls, NoBound};
+use crate::bound::{Bound, NoBound};
 use crate::collapse::Simplifier;
-use crate::cost::{Builtin, Cost, Placement, StoredQuadric, VertexQuadric};
+use crate::cost::{Builtin, Cost, Placement};
 use crate::index::Index;
-use crate::mesh::{Mesh, Positions};
-use crate::{Config, Error, Report};
+use crate::mesh::Mesh;
+use crate::{Capacity, Config, ConfigField, Error, Report};
 
-/// All working state of the simplifier, with capacity fixed by const generics.
+pub use crate::mesh::Positions;
+
+/// The simplifier's working memory as caller slices of run-time length (sized to the mesh on
+/// a host, or lent by a [`Workspace`] with [`Workspace::as_storage`]).
 ///
-/// * `L`: link type (`u16` or `u32`) for vertex and corner numbers inside the workspace. With
-///   `u16` a mesh may have at most 65 535 vertices and 65 535 triangles (the largest value is
-///   reserved as "none").
-/// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
-///
-/// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a
-/// heap slot, a 4-byte key and a flag byte; per triangle three corner links. With `u16` links
-/// and the usual `V ≈ T/2` that is 11.5 bytes per triangle. [`Workspace::new`] is a `const fn`,
-/// so a workspace can be a `static` in `.bss` instead of living on the stack.
-///
-/// The positions are never copied: they stay wherever the caller keeps them (flash included).
-pub struct Workspace<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> {
-    /// Triangle of the first corner of each vertex's corner list (NIL: none).
-    pub(crate) head: [L; MAX_VERTICES],
-    /// For corner `3t + k`, the triangle of the next corner around the same vertex.
-    pub(crate) next: [[L; 3]; MAX_TRIANGLES],
-    /// Per-vertex flags, see `mesh::flag`.
-    pub(crate) flags: [u8; MAX_VERTICES],
-    /// Greedy schedule: binary heap of vertices ...
-    pub(crate) heap: [L; MAX_VERTICES],
-    /// ... each vertex's slot in it (NIL: not queued) ...
-    pub(crate) heap_pos: [L; MAX_VERTICES],
-    /// ... and its key, the cost of its cheapest legal collapse.
-    pub(crate) key: [f32; MAX_VERTICES],
+/// Per vertex: three links (corner-list head, heap slot, heap position), a 4-byte key and a
+/// flag byte; per triangle: three corner links. [`Storage::bytes`] gives the total. With `u16`
+/// links a mesh may have at most 65 535 vertices and 65 535 triangles (the largest value is
+/// reserved as "none"); `u32` links take any mesh that fits in memory.
+pub struct Storage<'a, L: Index> {
+    head: &'a mut [L],
+    heap: &'a mut [L],
+    heap_pos: &'a mut [L],
+    next: &'a mut [[L; 3]],
+    keys: &'a mut [f32],
+    flags: &'a mut [u8],
 }
 
-impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
-    Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
-{
-    /// Size of the workspace in bytes: all of the simplifier's RAM apart from the caller's
-    /// triangle buffer, positions and a bounded stack frame.
-    pub const BYTES: usize = core::mem::size_of::<Self>();
+impl<'a, L: Index> Storage<'a, L> {
+    /// Bytes of storage per vertex.
+    pub const VERTEX_BYTES: usize = 3 * core::mem::size_of::<L>() + 5;
+    /// Bytes of storage per triangle.
+    pub const TRIANGLE_BYTES: usize = 3 * core::mem::size_of::<L>();
 
-    /// An empty workspace. `const`, so it can initialise a `static`; and all zero bits, so
-    /// such a `static` goes to `.bss` (zeroed at boot) instead of taking its size again in
-    /// flash as `.data`. Nothing here is read before [`Workspace::start`] writes it.
-    pub const fn new() -> Self {
-        Workspace {
-            head: [L::ZERO; MAX_VERTICES],
-            next: [[L::ZERO; 3]; MAX_TRIANGLES],
-            flags: [0; MAX_VERTICES],
-            heap: [L::ZERO; MAX_VERTICES],
-            heap_pos: [L::ZERO; MAX_VERTICES],
-            key: [0.0; MAX_VERTICES],
+    /// Bytes of storage for a mesh of `vertices` positions and `triangles` triangles.
+    pub const fn bytes(vertices: usize, triangles: usize) -> usize {
+        vertices * Self::VERTEX_BYTES + triangles * Self::TRIANGLE_BYTES
+    }
+
+    /// Storage for `keys.len()` vertices and `corners.len()` triangles: `links` holds three
+    /// links per vertex and `flags` one byte per vertex (contents on entry do not matter).
+    /// Slices that disagree are [`Error::Capacity`] for [`Capacity::Vertices`] (`needed`: the
+    /// keys' length, `available`: what the shorter slice holds).
+    pub fn new(
+        links: &'a mut [L],
+        corners: &'a mut [[L; 3]],
+        keys: &'a mut [f32],
+        flags: &'a mut [u8],
+    ) -> Result<Self, Error> {
+        let nv = keys.len();
+        let short = Error::Capacity {
+            what: Capacity::Vertices,
+            needed: nv,
+            available: (links.len() / 3).min(flags.len()),
+        };
+        if flags.len() != nv || links.len() != nv.saturating_mul(3) {
+            return Err(short);
+        }
+        let (head, rest) = links.split_at_mut_checked(nv).ok_or(short)?;
+        let (heap, heap_pos) = rest.split_at_mut_checked(nv).ok_or(short)?;
+        Ok(Storage {
+            head,
+            heap,
+            heap_pos,
+            next: corners,
+            keys,
+            flags,
+        })
+    }
+
+    /// The largest mesh it takes: `(vertices, triangles)`, the link type's limit included.
+    pub fn capacity(&self) -> (usize, usize) {
+        (self.keys.len().min(L::COUNT), self.next.len().min(L::COUNT))
+    }
+
+    /// A shorter-lived copy of the same storage (to run again after a [`Storage::start`]).
+    pub fn reborrow(&mut self) -> Storage<'_, L> {
+        Storage {
+            head: &mut *self.head,
+            heap: &mut *self.heap,
+            heap_pos: &mut *self.heap_pos,
+            next: &mut *self.next,
+            keys: &mut *self.keys,
+            flags: &mut *self.flags,
         }
     }
 
-    /// Simplifies `triangles` in place, in one call.
+    /// Simplifies `triangles` in place, in one call: read-only `positions`, the built-in cost
+    /// [`Config::cost`] names, no error bound.
     ///
-    /// `positions` are only read. On success the first `report.triangles_out` entries of
-    /// `triangles` hold the result, referring to the original vertex indices; the rest of the
-    /// buffer is left over and meaningless. On error nothing has been written.
+    /// On success the first `report.triangles_out` entries of `triangles` hold the result,
+    /// referring to the original vertex indices; the rest of the buffer is left over and
+    /// meaningless. On error nothing has been written. Errors as [`Storage::start`].
     pub fn simplify<I: Index>(
         &mut self,
         positions: &[[f32; 3]],
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
-        // One engine for every configuration (the schedule and the built-in cost are chosen
-        // at run time, so a configuration received at run time costs no extra flash). For
-        // the least flash with one known cost, drive `start_with_cost` with that cost.
-        let mut s = self.start(positions, triangles, config)?;
-        while !s.step(u32::MAX) {}
-        Ok(s.finish())
-    }
-
-    /// Validates the input, builds adjacency and returns a [`Simplifier`] to drive step by step
-    /// (for watchdogs and frame deadlines). Steps of any size give exactly the result of
-    /// [`Workspace::simplify`].
-    ///
-    /// Errors, all returned before the triangle buffer is touched:
-    /// [`Error::Capacity`], [`Error::IndexOutOfRange`], [`Error::NonFinitePosition`],
-    /// [`Error::InvalidConfig`].
-    pub fn start<'a, I: Index>(
-        &'a mut self,
-        positions: &'a [[f32; 3]],
-        triangles: &'a mut [[I; 3]],
-        config: &Config,
-    ) -> Result<Simplifier<'a, L, I, Builtin>, Error> {
-        self.start_with_cost(positions, triangles, config, Builtin::of(config))
-    }
-
-    /// Like [`Workspace::start`], with another [`Cost`].
-    pub fn start_with_cost<'a, I: Index, C: Cost>(
-        &'a mut self,
-        positions: &'a [[f32; 3]],
-        triangles: &'a mut [[I; 3]],
-        config: &Config,
-        cost: C,
-    ) -> Result<Simplifier<'a, L, I, C>, Error> {
-        self.start_on(Positions::Read(positions), triangles, config, cost, NoBound)
-    }
-
-    /// Like [`Workspace::start_with_cost`], on positions that a placing cost may move
-    /// ([`Cost::place`]; [`StoredQuadric`] with [`Placement::Optimal`]): the kept vertex of each
-    /// collapse is written there, in the input's units. Positions of vertices that no longer
-    /// have triangles keep their last value.
-    pub fn start_moving<'a, I: Index, C: Cost>(
-        &'a mut self,
-        positions: &'a mut [[f32; 3]],
-        triangles: &'a mut [[I; 3]],
-        config: &Config,
-        cost: C,
-    ) -> Result<Simplifier<'a, L, I, C>, Error> {
-        self.start_on(
-            Positions::Write(positions),
+        // One engine for every built-in configuration (the schedule and the built-in cost are
+        // chosen at run time, so a configuration received at run time costs no extra flash).
+        // For the least flash with one known cost, `start` with that cost.
+        let mut s = self.reborrow().start(
+            Positions::Read(positions),
             triangles,
             config,
-            cost,
+            Builtin::new(),
             NoBound,
-        )
+        )?;
+        while !s.step(u32::MAX) {}
+        Ok(s.finish())
     }
 
-    /// Like [`Workspace::start_with_cost`], with the guaranteed error bound
-    /// [`Config::max_error`] (Zhu, Wang and Meng 2007, seed 001 §2-§4; see [`crate::bound`]):
-    /// no collapse is made that would leave a control point (a centroid of an `original`
-    /// triangle, or a vertex of an original feature edge) farther than the bound from the
-    /// result, whatever the cost. The report gives E_max and E_mean (eq. 4-5).
+    /// Validates the input, builds adjacency and returns a [`Simplifier`] to drive step by
+    /// step ([`Simplifier::step`], for watchdogs and frame deadlines) or to the end
+    /// ([`Simplifier::run`]). Steps of any size give exactly the result of one run.
     ///
-    /// * `original`: the triangles as handed in, read only (they may stay in flash): a copy of
-    ///   `triangles` before the call, else [`Error::OriginalMismatch`].
-    /// * `controls`: at least [`control_len`]`(triangles.len(), positions.len())` links of
-    ///   any [`Index`] type (`2·T + V`: 5 bytes per triangle with `u16` and `V ≈ T/2`), all
-    ///   numbered below its `NIL`; else [`Error::Capacity`] with
-    ///   [`Capacity::Controls`](crate::Capacity::Controls). Meaningless after
-    ///   [`Simplifier::finish`] (the triangles are compacted).
+    /// * `positions`: [`Positions::Read`] (flash is fine), or [`Positions::Write`] for a cost
+    ///   with [`Placement::Optimal`], which writes each kept vertex there.
+    /// * `cost`: [`Builtin::new`]`()` (the cost [`Config::cost`] names: what [`Storage::simplify`] uses), any other
+    ///   [`Cost`], e.g. [`StoredQuadric`](crate::cost::StoredQuadric).
+    /// * `bound`: [`NoBound`], or the guaranteed error bound [`Config::max_error`] with
+    ///   [`Controls`](crate::bound::Controls) (Zhu, Wang and Meng 2007; see [`crate::bound`]).
     ///
-    /// Positions are only read (subset placement). An infinite `max_error` runs unbounded but
-    /// still reports E_max and E_mean.
-    #[allow(clippy::too_many_arguments)]
-    pub fn start_bounded<'a, I: Index, C: Cost, K: Index>(
-        &'a mut self,
-        positions: &'a [[f32; 3]],
-        original: &'a [[I; 3]],
-        triangles: &'a mut [[I; 3]],
-        controls: &'a mut [K],
-        config: &Config,
-        cost: C,
-    ) -> Result<Simplifier<'a, L, I, C, Controls<'a, I, K>>, Error> {
-        if original.len() != triangles.len() {
-            return Err(Error::OriginalMismatch {
-                triangle: original.len().min(triangles.len()),
-            });
-        }
-        if let Some(t) = original
-            .iter()
-            .zip(triangles.iter())
-            .position(|(a, b)| a != b)
-        {
-            return Err(Error::OriginalMismatch { triangle: t });
-        }
-        let need = control_len(triangles.len(), positions.len());
-        if need > K::COUNT {
-            return Err(Error::Capacity {
-                what: crate::Capacity::Controls,
-                needed: need,
-                available: K::COUNT,
-            });
-        }
-        let available = controls.len();
-        let Some(links) = controls.get_mut(..need) else {
-            return Err(Error::Capacity {
-                what: crate::Capacity::Controls,
-                needed: need,
-                available,
-            });
-        };
-        config.validate()?;
-        let bound = Controls::new(
-            original,
-            links,
-            crate::math::cos_deg(config.control_angle_deg),
-        );
-        let mut s = self.start_on(Positions::Read(positions), triangles, config, cost, bound)?;
-        s.enrol();
-        Ok(s)
-    }
-
-    /// [`Workspace::start_bounded`] with the configuration's built-in cost, in one call.
-    pub fn simplify_bounded<I: Index, K: Index>(
-        &mut self,
-        positions: &[[f32; 3]],
-        original: &[[I; 3]],
-        triangles: &mut [[I; 3]],
-        controls: &mut [K],
-        config: &Config,
-    ) -> Result<Report, Error> {
-        let cost = Builtin::of(config);
-        let mut s = self.start_bounded(positions, original, triangles, controls, config, cost)?;
-        while !s.step(u32::MAX) {}
-        Ok(s.finish())
-    }
-
-    /// Simplifies with stored quadrics ([`StoredQuadric`], seed 000 §2.3-2.5 and §3.3) and
-    /// subset placement: positions are only read. `quadrics` holds one [`VertexQuadric`] (40
-    /// bytes) per position; too short a slice is [`Error::Capacity`] with
-    /// [`Capacity::Quadrics`](crate::Capacity::Quadrics). Boundary planes are weighted by
-    /// [`Config::boundary_weight`]. [`Config::stored`] is the recommended configuration (no
-    /// feature rule: lower mean error, and the faster re-keying).
-    pub fn simplify_stored<I: Index>(
-        &mut self,
-        positions: &[[f32; 3]],
-        triangles: &mut [[I; 3]],
-        config: &Config,
-        quadrics: &mut [VertexQuadric],
-    ) -> Result<Report, Error> {
-        quadrics_fit(positions.len(), quadrics.len())?;
-        let cost = StoredQuadric::new(quadrics, config.boundary_weight, Placement::Subset);
-        let mut s = self.start_with_cost(positions, triangles, config, cost)?;
-        while !s.step(u32::MAX) {}
-        Ok(s.finish())
-    }
-
-    /// Like [`Workspace::simplify_stored`] with optimal placement: each kept vertex moves to the
-    /// minimiser of its summed quadric (or the best of the endpoints and the midpoint), written
-    /// into `positions`. On error nothing has been written.
-    pub fn simplify_optimal<I: Index>(
-        &mut self,
-        positions: &mut [[f32; 3]],
-        triangles: &mut [[I; 3]],
-        config: &Config,
-        quadrics: &mut [VertexQuadric],
-    ) -> Result<Report, Error> {
-        quadrics_fit(positions.len(), quadrics.len())?;
-        let cost = StoredQuadric::new(quadrics, config.boundary_weight, Placement::Optimal);
-        let mut s = self.start_moving(positions, triangles, config, cost)?;
-        while !s.step(u32::MAX) {}
-        Ok(s.finish())
-    }
-
-    fn start_on<'a, I: Index, C: Cost, B: Bound<'a, I>>(
-        &'a mut self,
+    /// Errors, all returned before the triangle buffer (or the positions) is touched:
+    /// [`Error::InvalidConfig`] (a field out of range, or a policy that cannot run with it),
+    /// [`Error::OriginalMismatch`], [`Error::Capacity`], [`Error::IndexOutOfRange`],
+    /// [`Error::NonFinitePosition`].
+    #[inline(always)]
+    pub fn start<I: Index, C: Cost, B: Bound<'a, I>>(
+        self,
         positions: Positions<'a>,
         triangles: &'a mut [[I; 3]],
         config: &Config,
-        cost: C,
-        bound: B,
+        mut cost: C,
+        mut bound: B,
     ) -> Result<Simplifier<'a, L, I, C, B>, Error> {
+        let nv = positions.len();
+        let nt = triangles.len();
+        if B::ON {
+            // A bound's own storage first: its original triangles and its links.
+            bound.prepare(triangles, nv, config)?;
+        }
         config.validate()?;
-        if !B::ON && config.max_error < f32::INFINITY {
-            return Err(Error::Capacity {
-                what: crate::Capacity::Controls,
-                needed: control_len(triangles.len(), positions.len()),
-                available: 0,
+        if !B::ON {
+            bound.prepare(triangles, nv, config)?;
+        }
+        cost.configure(config, nv)?;
+        if cost.placement() == Placement::Optimal && (B::ON || !positions.is_write()) {
+            // The bound reads control points at the positions placement would move.
+            return Err(Error::InvalidConfig {
+                field: ConfigField::Placement,
             });
         }
-        if positions.len() > MAX_VERTICES || positions.len() > L::COUNT {
+        let (cv, ct) = self.capacity();
+        if nv > cv {
             return Err(Error::Capacity {
-                what: crate::Capacity::Vertices,
-                needed: positions.len(),
-                available: if MAX_VERTICES < L::COUNT {
-                    MAX_VERTICES
-                } else {
-                    L::COUNT
-                },
+                what: Capacity::Vertices,
+                needed: nv,
+                available: cv,
             });
         }
         // Links number triangles (not corners), so the link type caps triangles at its COUNT.
-        let corner_cap = L::COUNT;
-        if triangles.len() > MAX_TRIANGLES || triangles.len() > corner_cap {
+        if nt > ct {
             return Err(Error::Capacity {
-                what: crate::Capacity::Triangles,
-                needed: triangles.len(),
-                available: if MAX_TRIANGLES < corner_cap {
-                    MAX_TRIANGLES
-                } else {
-                    corner_cap
-                },
+                what: Capacity::Triangles,
+                needed: nt,
+                available: ct,
             });
         }
-        let nv = positions.len();
-        let nt = triangles.len();
+        let Storage {
+            head,
+            heap,
+            heap_pos,
+            next,
+            keys,
+            flags,
+        } = self;
         // `get_mut` with lengths just checked against the capacities: cannot fail, but costs
         // nothing and keeps every path panic-free.
         let (Some(head), Some(next), Some(flags), Some(heap), Some(heap_pos), Some(key)) = (
-            self.head.get_mut(..nv),
-            self.next.get_mut(..nt),
-            self.flags.get_mut(..nv),
-            self.heap.get_mut(..nv),
-            self.heap_pos.get_mut(..nv),
-            self.key.get_mut(..nv),
+            head.get_mut(..nv),
+            next.get_mut(..nt),
+            flags.get_mut(..nv),
+            heap.get_mut(..nv),
+            heap_pos.get_mut(..nv),
+            keys.get_mut(..nv),
         ) else {
             return Err(Error::Capacity {
-                what: crate::Capacity::Vertices,
+                what: Capacity::Vertices,
                 needed: nv,
-                available: MAX_VERTICES,
+                available: cv,
             });
         };
         let mesh = Mesh::build(
@@ -315,16 +233,85 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
     }
 }
 
-/// `Error::Capacity` unless there is a quadric per position.
-fn quadrics_fit(positions: usize, quadrics: usize) -> Result<(), Error> {
-    if quadrics < positions {
-        return Err(Error::Capacity {
-            what: crate::Capacity::Quadrics,
-            needed: positions,
-            available: quadrics,
-        });
+/// A fixed-capacity [`Storage`], sized by const generics, that can be a `static`.
+///
+/// * `L`: link type (`u16` or `u32`) for vertex and corner numbers inside the workspace. With
+///   `u16` a mesh may have at most 65 535 vertices and 65 535 triangles (the largest value is
+///   reserved as "none").
+/// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
+///
+/// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a
+/// heap slot, a 4-byte key and a flag byte; per triangle three corner links. With `u16` links
+/// and the usual `V ≈ T/2` that is 11.5 bytes per triangle. [`Workspace::new`] is a `const fn`,
+/// so a workspace can be a `static` in `.bss` instead of living on the stack.
+///
+/// The positions are never copied: they stay wherever the caller keeps them (flash included).
+pub struct Workspace<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> {
+    /// Per vertex: the triangle of the first corner of its corner list (NIL: none), its heap
+    /// slot and its slot's vertex (the greedy schedule's binary heap).
+    links: [[L; MAX_VERTICES]; 3],
+    /// For corner `3t + k`, the triangle of the next corner around the same vertex.
+    next: [[L; 3]; MAX_TRIANGLES],
+    /// Per-vertex flags, see `mesh::flag`.
+    flags: [u8; MAX_VERTICES],
+    /// Each vertex's key, the cost of its cheapest legal collapse.
+    key: [f32; MAX_VERTICES],
+}
+
+impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
+    Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
+{
+    /// Size of the workspace in bytes: all of the simplifier's RAM apart from the caller's
+    /// triangle buffer, positions and a bounded stack frame.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// An empty workspace. `const`, so it can initialise a `static`; and all zero bits, so
+    /// such a `static` goes to `.bss` (zeroed at boot) instead of taking its size again in
+    /// flash as `.data`. Nothing here is read before [`Storage::start`] writes it.
+    pub const fn new() -> Self {
+        Workspace {
+            links: [[L::ZERO; MAX_VERTICES]; 3],
+            next: [[L::ZERO; 3]; MAX_TRIANGLES],
+            flags: [0; MAX_VERTICES],
+            key: [0.0; MAX_VERTICES],
+        }
     }
-    Ok(())
+
+    /// The workspace as [`Storage`] of `MAX_VERTICES` vertices and `MAX_TRIANGLES` triangles.
+    pub fn as_storage(&mut self) -> Storage<'_, L> {
+        let [head, heap, heap_pos] = &mut self.links;
+        Storage {
+            head,
+            heap,
+            heap_pos,
+            next: &mut self.next,
+            keys: &mut self.key,
+            flags: &mut self.flags,
+        }
+    }
+
+    /// [`Storage::simplify`] on this workspace.
+    pub fn simplify<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        self.as_storage().simplify(positions, triangles, config)
+    }
+
+    /// [`Storage::start`] on this workspace.
+    pub fn start<'a, I: Index, C: Cost, B: Bound<'a, I>>(
+        &'a mut self,
+        positions: Positions<'a>,
+        triangles: &'a mut [[I; 3]],
+        config: &Config,
+        cost: C,
+        bound: B,
+    ) -> Result<Simplifier<'a, L, I, C, B>, Error> {
+        self.as_storage()
+            .start(positions, triangles, config, cost, bound)
+    }
 }
 
 impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize> Default

@@ -23,7 +23,10 @@ mod common;
 use common::{cube, fin_and_pinch, grid, icosphere, jitter, MeshData, Tri};
 use std::collections::HashMap;
 use tinydecimate::bound::control_len;
-use tinydecimate::{Capacity, Config, ConfigField, Error, Reject, Report};
+use tinydecimate::{
+    Builtin, Capacity, Config, ConfigField, Controls, Error, Placement, Positions, Reject, Report,
+    StoredQuadric,
+};
 
 type P = [f64; 3];
 
@@ -40,9 +43,12 @@ fn bounded(m: &MeshData, config: &Config) -> (MeshData, Report) {
     let mut tris = m.triangles.clone();
     let mut links = vec![0u32; control_len(tris.len(), m.positions.len())];
     let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let bound = Controls::new(&m.triangles, &mut links);
+    let p = Positions::Read(&m.positions);
     let r = ws
-        .simplify_bounded(&m.positions, &m.triangles, &mut tris, &mut links, config)
-        .expect("simplify_bounded");
+        .start(p, &mut tris, config, Builtin::new(), bound)
+        .expect("start")
+        .run();
     tris.truncate(r.triangles_out);
     (
         MeshData {
@@ -335,16 +341,10 @@ fn stepping_gives_the_one_shot_bytes() {
     let mut tris = m.triangles.clone();
     let mut links = vec![0u16; control_len(tris.len(), m.positions.len())];
     let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
-    let cost = tinydecimate::cost::Builtin::of(&config);
+    let bound = Controls::new(&m.triangles, &mut links);
+    let p = Positions::Read(&m.positions);
     let mut s = ws
-        .start_bounded(
-            &m.positions,
-            &m.triangles,
-            &mut tris,
-            &mut links,
-            &config,
-            cost,
-        )
+        .start(p, &mut tris, &config, Builtin::new(), bound)
         .expect("start");
     while !s.step(7) {}
     let r2 = s.finish();
@@ -373,20 +373,46 @@ fn bad_input_is_refused() {
     let need = control_len(m.triangles.len(), m.positions.len());
     assert_eq!(need, 2 * 80 + 42);
     let config = Config::new().with_max_error(0.1);
-    // A bound without control points.
+    // A bound without control points: a configuration error, not a capacity one.
     let mut tris = m.triangles.clone();
     assert_eq!(
         ws.simplify(&m.positions, &mut tris, &config),
-        Err(Error::Capacity {
-            what: Capacity::Controls,
-            needed: need,
-            available: 0
+        Err(Error::InvalidConfig {
+            field: ConfigField::MaxError
         })
     );
+    // A bound with optimal placement: refused (control points are read at the positions
+    // placement would move).
+    let mut q = vec![[0.0f32; 10]; m.positions.len()];
+    let mut pos = m.positions.clone();
+    let mut links = vec![0u32; need];
+    let r = ws
+        .start(
+            Positions::Write(&mut pos),
+            &mut tris,
+            &Config::stored().with_max_error(0.1),
+            StoredQuadric::new(&mut q, Placement::Optimal),
+            Controls::new(&m.triangles, &mut links),
+        )
+        .map(|s| s.run());
+    assert_eq!(
+        r,
+        Err(Error::InvalidConfig {
+            field: ConfigField::Placement
+        })
+    );
+    assert_eq!(pos, m.positions);
     // Too few links.
     let mut links = vec![0u32; need - 1];
     assert_eq!(
-        ws.simplify_bounded(&m.positions, &m.triangles, &mut tris, &mut links, &config),
+        run_bounded(
+            &mut ws,
+            &m.positions,
+            &m.triangles,
+            &mut tris,
+            &mut links,
+            &config
+        ),
         Err(Error::Capacity {
             what: Capacity::Controls,
             needed: need,
@@ -398,11 +424,19 @@ fn bad_input_is_refused() {
     let mut other = m.triangles.clone();
     other[5] = [0, 1, 2];
     assert_eq!(
-        ws.simplify_bounded(&m.positions, &other, &mut tris, &mut links, &config),
+        run_bounded(
+            &mut ws,
+            &m.positions,
+            &other,
+            &mut tris,
+            &mut links,
+            &config
+        ),
         Err(Error::OriginalMismatch { triangle: 5 })
     );
     assert_eq!(
-        ws.simplify_bounded(
+        run_bounded(
+            &mut ws,
             &m.positions,
             &m.triangles[..70],
             &mut tris,
@@ -414,7 +448,8 @@ fn bad_input_is_refused() {
     // Bad bounds.
     for d in [-1.0, f32::NAN] {
         assert_eq!(
-            ws.simplify_bounded(
+            run_bounded(
+                &mut ws,
                 &m.positions,
                 &m.triangles,
                 &mut tris,
@@ -525,16 +560,10 @@ fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
         let mut tris = m.triangles.clone();
         let mut links = vec![0u32; control_len(tris.len(), m.positions.len())];
         let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
-        let cost = tinydecimate::cost::Builtin::of(&config);
+        let bound = Controls::new(&m.triangles, &mut links);
+        let p = Positions::Read(&m.positions);
         let mut s = ws
-            .start_bounded(
-                &m.positions,
-                &m.triangles,
-                &mut tris,
-                &mut links,
-                &config,
-                cost,
-            )
+            .start(p, &mut tris, &config, Builtin::new(), bound)
             .expect("start");
         let mut ops = 0u64;
         while !s.step(1) {
@@ -608,4 +637,18 @@ fn triangle_collapse_needs_its_feature() {
             field: ConfigField::Operator
         })
     );
+}
+
+/// One bounded run on `ws` with the built-in cost.
+fn run_bounded(
+    ws: &mut tinydecimate::Workspace<u32, 65_536, 131_072>,
+    positions: &[[f32; 3]],
+    original: &[[u32; 3]],
+    triangles: &mut [[u32; 3]],
+    links: &mut [u32],
+    config: &Config,
+) -> Result<Report, Error> {
+    let bound = Controls::new(original, links);
+    let p = Positions::Read(positions);
+    Ok(ws.start(p, triangles, config, Builtin::new(), bound)?.run())
 }

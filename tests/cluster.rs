@@ -12,7 +12,7 @@ use std::sync::Mutex;
 use proptest::prelude::*;
 use tinydecimate::cluster::{
     ClusterConfig, ClusterError, ClusterReport, Clusterer, Grid, GridChoice, PositionFn, Quadrics,
-    SliceSource, KEY_LANES,
+    Scratch, SliceSource, KEY_LANES,
 };
 
 const CELLS: usize = 65_535;
@@ -39,7 +39,15 @@ fn cluster(m: &MeshData, config: &ClusterConfig, quadric: bool) -> (Vec<Tri>, Cl
     let mut src = SliceSource::new(&m.positions, &m.triangles);
     let q = if quadric { Some(&mut *quads) } else { None };
     let r = table
-        .cluster(&mut src, q, config, &mut out)
+        .cluster(
+            &mut src,
+            config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                ..Scratch::new()
+            },
+        )
         .expect("cluster");
     out.truncate(r.triangles_out);
     (out, r)
@@ -160,7 +168,16 @@ fn vertex_memory_changes_nothing_but_time() {
                 let mut cache = vec![7u64; n];
                 let mut src = SliceSource::new(&m.positions, &m.triangles);
                 let r = table
-                    .cluster_with_cache(&mut src, Some(&mut *quads), &config, &mut out, &mut cache)
+                    .cluster(
+                        &mut src,
+                        &config,
+                        &mut out,
+                        Scratch {
+                            quadrics: Some(&mut *quads),
+                            cache: &mut cache,
+                            ..Scratch::new()
+                        },
+                    )
                     .expect("cluster_with_cache");
                 out.truncate(r.triangles_out);
                 assert_eq!(r, wr, "{name} config {frac}, cache {n}: report");
@@ -175,13 +192,16 @@ fn vertex_memory_changes_nothing_but_time() {
                 let mut keys = vec![[u32::MAX; KEY_LANES]; nk];
                 let mut src = SliceSource::new(&m.positions, &m.triangles);
                 let r = table
-                    .cluster_with_keys(
+                    .cluster(
                         &mut src,
-                        Some(&mut *quads),
                         &config,
                         &mut out,
-                        &mut cache,
-                        &mut keys,
+                        Scratch {
+                            quadrics: Some(&mut *quads),
+                            cache: &mut cache,
+                            keys: &mut keys,
+                            ..Scratch::new()
+                        },
                     )
                     .expect("cluster_with_keys");
                 out.truncate(r.triangles_out);
@@ -198,7 +218,16 @@ fn vertex_memory_changes_nothing_but_time() {
                 let mut bits = vec![u32::MAX; n];
                 let mut src = SliceSource::new(&m.positions, &m.triangles);
                 let r = table
-                    .cluster_with_seen(&mut src, Some(&mut *quads), &config, &mut out, &mut bits)
+                    .cluster(
+                        &mut src,
+                        &config,
+                        &mut out,
+                        Scratch {
+                            quadrics: Some(&mut *quads),
+                            seen: &mut bits,
+                            ..Scratch::new()
+                        },
+                    )
                     .expect("cluster_with_seen");
                 out.truncate(r.triangles_out);
                 assert_eq!(r, wr, "{name} {frac}% {n} words: report");
@@ -267,7 +296,12 @@ fn nan_position_is_a_typed_error() {
     let mut table = Clusterer::<512>::new();
     let mut out = [[0u16; 3]; 400];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
-    let e = table.cluster(&mut src, None, &ClusterConfig::target(100), &mut out);
+    let e = table.cluster(
+        &mut src,
+        &ClusterConfig::target(100),
+        &mut out,
+        Scratch::new(),
+    );
     assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
     // The same first error with per-vertex memory, with and without a given box.
     let (lo, hi) = ([-2.0; 3], [2.0; 3]);
@@ -277,22 +311,51 @@ fn nan_position_is_a_typed_error() {
     ] {
         let mut cache = vec![0u64; m.positions.len()];
         let mut bits = vec![0u32; m.positions.len() / 32 + 1];
-        let e = table.cluster_with_cache(&mut src, None, &config, &mut out, &mut cache);
-        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
-        let mut quads = Quadrics::<512>::new();
-        let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
-        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
-        let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
-        let e = table.cluster_with_keys(
+        let e = table.cluster(
             &mut src,
-            Some(&mut quads),
             &config,
             &mut out,
-            &mut cache,
-            &mut keys,
+            Scratch {
+                cache: &mut cache,
+                ..Scratch::new()
+            },
         );
         assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
-        let e = table.cluster_with_seen(&mut src, Some(&mut quads), &config, &mut out, &mut bits);
+        let mut quads = Quadrics::<512>::new();
+        let e = table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: Some(&mut quads),
+                cache: &mut cache,
+                ..Scratch::new()
+            },
+        );
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+        let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
+        let e = table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: Some(&mut quads),
+                cache: &mut cache,
+                keys: &mut keys,
+                ..Scratch::new()
+            },
+        );
+        assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
+        let e = table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: Some(&mut quads),
+                seen: &mut bits,
+                ..Scratch::new()
+            },
+        );
         assert_eq!(e, Err(ClusterError::NonFinitePosition { vertex: 7 }));
     }
 }
@@ -304,7 +367,12 @@ fn index_out_of_range_is_a_typed_error() {
     let mut table = Clusterer::<512>::new();
     let mut out = [[0u16; 3]; 400];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
-    let e = table.cluster(&mut src, None, &ClusterConfig::cell_size(0.3), &mut out);
+    let e = table.cluster(
+        &mut src,
+        &ClusterConfig::cell_size(0.3),
+        &mut out,
+        Scratch::new(),
+    );
     assert_eq!(
         e,
         Err(ClusterError::IndexOutOfRange {
@@ -315,7 +383,16 @@ fn index_out_of_range_is_a_typed_error() {
     let mut cache = vec![0u64; m.positions.len()];
     let mut quads = Quadrics::<512>::new();
     for config in [ClusterConfig::cell_size(0.3), ClusterConfig::target(100)] {
-        let e = table.cluster_with_cache(&mut src, Some(&mut quads), &config, &mut out, &mut cache);
+        let e = table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: Some(&mut quads),
+                cache: &mut cache,
+                ..Scratch::new()
+            },
+        );
         assert_eq!(
             e,
             Err(ClusterError::IndexOutOfRange {
@@ -324,13 +401,16 @@ fn index_out_of_range_is_a_typed_error() {
             })
         );
         let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
-        let e = table.cluster_with_keys(
+        let e = table.cluster(
             &mut src,
-            Some(&mut quads),
             &config,
             &mut out,
-            &mut cache,
-            &mut keys,
+            Scratch {
+                quadrics: Some(&mut quads),
+                cache: &mut cache,
+                keys: &mut keys,
+                ..Scratch::new()
+            },
         );
         assert_eq!(
             e,
@@ -350,7 +430,12 @@ fn full_table_says_how_big_it_must_be() {
     let mut table = Clusterer::<256>::new();
     let mut out = vec![[0u32; 3]; m.triangles.len()];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
-    let e = table.cluster(&mut src, None, &ClusterConfig::cell_size(0.3), &mut out);
+    let e = table.cluster(
+        &mut src,
+        &ClusterConfig::cell_size(0.3),
+        &mut out,
+        Scratch::new(),
+    );
     let Err(ClusterError::TableFull {
         capacity,
         needed_at_least,
@@ -368,7 +453,12 @@ fn full_table_says_how_big_it_must_be() {
     assert!(estimate <= 4096);
     let mut src = SliceSource::new(&m.positions, &m.triangles);
     let r2 = big
-        .cluster(&mut src, None, &ClusterConfig::cell_size(0.3), &mut out)
+        .cluster(
+            &mut src,
+            &ClusterConfig::cell_size(0.3),
+            &mut out,
+            Scratch::new(),
+        )
         .unwrap();
     assert_eq!(r2.cells, needed);
 }
@@ -379,7 +469,12 @@ fn full_output_says_how_big_it_must_be() {
     let mut table = Clusterer::<2048>::new();
     let mut out = [[0u16; 3]; 50];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
-    let e = table.cluster(&mut src, None, &ClusterConfig::cell_size(0.2), &mut out);
+    let e = table.cluster(
+        &mut src,
+        &ClusterConfig::cell_size(0.2),
+        &mut out,
+        Scratch::new(),
+    );
     assert!(
         matches!(e, Err(ClusterError::OutputFull { capacity: 50, needed_at_least: 51, estimate }) if estimate > 51),
         "{e:?}"
@@ -392,7 +487,12 @@ fn a_table_too_wide_for_u16_is_refused() {
     let mut table = Clusterer::<70_000>::new();
     let mut out = [[0u16; 3]; 80];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
-    let e = table.cluster(&mut src, None, &ClusterConfig::cell_size(0.5), &mut out);
+    let e = table.cluster(
+        &mut src,
+        &ClusterConfig::cell_size(0.5),
+        &mut out,
+        Scratch::new(),
+    );
     assert!(matches!(e, Err(ClusterError::TableTooWide { .. })), "{e:?}");
 }
 
@@ -455,16 +555,19 @@ fn cluster_then_collapse_fits_a_small_workspace() {
     let mut vertices = vec![0u32; 2048];
     let mut positions = vec![[0.0f32; 3]; 2048];
     let mut src = SliceSource::new(&m.positions, &m.triangles);
+    let scratch = Scratch {
+        vertices: &mut vertices,
+        positions: &mut positions,
+        ..Scratch::new()
+    };
     let (cr, r) = cluster_then_collapse(
         &mut table,
-        None,
-        &mut ws,
         &mut src,
         &ClusterConfig::target(usize::MAX),
         &Config::new().with_target_triangles(600),
         &mut out,
-        &mut vertices,
-        &mut positions,
+        ws.as_storage(),
+        scratch,
     )
     .unwrap();
     eprintln!(
@@ -603,7 +706,15 @@ fn a_full_table_fails_the_same_with_key_entries() {
         let mut quads = QUADS.lock().unwrap_or_else(|e| e.into_inner());
         let mut out = vec![[0u32; 3]; m.triangles.len()];
         let mut src = SliceSource::new(&m.positions, &m.triangles);
-        let want = table.cluster(&mut src, Some(&mut *quads), &config, &mut out);
+        let want = table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: Some(&mut *quads),
+                ..Scratch::new()
+            },
+        );
         assert!(
             matches!(want, Err(ClusterError::TableFull { capacity, .. }) if capacity == cells),
             "{cells} cells: {want:?}"
@@ -611,13 +722,16 @@ fn a_full_table_fails_the_same_with_key_entries() {
         let mut cache = vec![0u64; m.positions.len()];
         let mut keys = vec![[0u32; KEY_LANES]; m.positions.len()];
         let mut src = SliceSource::new(&m.positions, &m.triangles);
-        let got = table.cluster_with_keys(
+        let got = table.cluster(
             &mut src,
-            Some(&mut *quads),
             &config,
             &mut out,
-            &mut cache,
-            &mut keys,
+            Scratch {
+                quadrics: Some(&mut *quads),
+                cache: &mut cache,
+                keys: &mut keys,
+                ..Scratch::new()
+            },
         );
         assert_eq!(got, want, "{cells} cells");
     }

@@ -40,7 +40,13 @@ fn simplify_logged(m: &MeshData, config: &Config) -> (Vec<[u32; 2]>, Vec<Tri>, S
     let mut log = vec![[0u32; 2]; m.positions.len()];
     let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
     let mut s = ws
-        .start(&m.positions, &mut tris, config)
+        .start(
+            tinydecimate::Positions::Read(&m.positions),
+            &mut tris,
+            config,
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+        )
         .unwrap()
         .record_into(&mut log);
     while !s.step(u32::MAX) {}
@@ -194,7 +200,13 @@ fn a_full_log_stops_the_run_with_a_valid_mesh() {
     let mut log = vec![[0u32; 2]; 100];
     let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
     let mut s = ws
-        .start(&m.positions, &mut tris, &Config::new().with_ratio(0.1))
+        .start(
+            tinydecimate::Positions::Read(&m.positions),
+            &mut tris,
+            &Config::new().with_ratio(0.1),
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+        )
         .unwrap()
         .record_into(&mut log);
     while !s.step(u32::MAX) {}

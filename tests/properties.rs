@@ -114,7 +114,7 @@ proptest! {
         let input = build(&kind, jitter);
         let mut tris = input.triangles.clone();
         let mut ws = Workspace::<u16, 2048, 2048>::new();
-        let mut s = ws.start(&input.positions, &mut tris, &config).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut tris, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
         let mut guard = 0;
         loop {
             let before: Vec<[u32; 3]> = s.buffer().to_vec();
@@ -151,7 +151,7 @@ proptest! {
         let mut ws = Workspace::<u32, 2048, 2048>::new();
         let r1 = ws.simplify(&input.positions, &mut one, &config).unwrap();
         let mut stepped = input.triangles.clone();
-        let mut s = ws.start(&input.positions, &mut stepped, &config).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut stepped, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
         let mut i = 0;
         while !s.step(budgets[i % budgets.len()]) {
             i += 1;

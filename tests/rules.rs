@@ -47,7 +47,15 @@ struct Steps {
 fn step_by_step(m: &MeshData, config: &Config) -> (MeshData, Report, Steps) {
     let mut tris = m.triangles.clone();
     let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
-    let mut s = ws.start(&m.positions, &mut tris, config).expect("start");
+    let mut s = ws
+        .start(
+            tinydecimate::Positions::Read(&m.positions),
+            &mut tris,
+            config,
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+        )
+        .expect("start");
     let mut steps = Steps::default();
     let nv = m.positions.len();
     let limit = config.max_normal_turn_deg as f64 + 0.5;

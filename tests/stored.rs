@@ -1,5 +1,5 @@
-//! Stored quadrics (issue 15): `Workspace::simplify_stored` (subset placement) and
-//! `Workspace::simplify_optimal` (optimal placement on mutable positions).
+//! Stored quadrics (issue 15): `StoredQuadric` with `Placement::Subset` (subset placement) and
+//! `StoredQuadric` with `Placement::Optimal` (optimal placement on mutable positions).
 //!
 //! Properties: valid output (the shared checker, moved positions allowed for optimal), optimal
 //! placement lowers the error against the input below subset placement, exact determinism
@@ -31,8 +31,24 @@ fn stored(m: &MeshData, config: &Config, placement: Placement) -> (MeshData, Rep
     let mut pos = m.positions.clone();
     let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len()];
     let r = match placement {
-        Placement::Subset => ws.simplify_stored(&pos, &mut tris, config, &mut q),
-        Placement::Optimal => ws.simplify_optimal(&mut pos, &mut tris, config, &mut q),
+        Placement::Subset => ws
+            .start(
+                tinydecimate::Positions::Read(&pos),
+                &mut tris,
+                config,
+                tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Subset),
+                tinydecimate::NoBound,
+            )
+            .map(|s| s.run()),
+        Placement::Optimal => ws
+            .start(
+                tinydecimate::Positions::Write(&mut pos),
+                &mut tris,
+                config,
+                tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
+                tinydecimate::NoBound,
+            )
+            .map(|s| s.run()),
     }
     .expect("simplify");
     tris.truncate(r.triangles_out);
@@ -226,15 +242,31 @@ fn runs_are_exactly_repeatable_and_stepping_gives_the_same_bytes() {
         let mut tris = m.triangles.clone();
         let mut pos = m.positions.clone();
         let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len()];
-        let cost = StoredQuadric::new(&mut q, config.boundary_weight, placement);
+        let cost = StoredQuadric::new(&mut q, placement);
         let r = match placement {
             Placement::Subset => {
-                let mut s = ws.start_with_cost(&pos, &mut tris, &config, cost).unwrap();
+                let mut s = ws
+                    .start(
+                        tinydecimate::Positions::Read(&pos),
+                        &mut tris,
+                        &config,
+                        cost,
+                        tinydecimate::NoBound,
+                    )
+                    .unwrap();
                 while !s.step(7) {}
                 s.finish()
             }
             Placement::Optimal => {
-                let mut s = ws.start_moving(&mut pos, &mut tris, &config, cost).unwrap();
+                let mut s = ws
+                    .start(
+                        tinydecimate::Positions::Write(&mut pos),
+                        &mut tris,
+                        &config,
+                        cost,
+                        tinydecimate::NoBound,
+                    )
+                    .unwrap();
                 while !s.step(7) {}
                 s.finish()
             }
@@ -256,9 +288,23 @@ fn bad_input_is_refused_before_anything_is_written() {
     let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len() - 1];
     for optimal in [false, true] {
         let r = if optimal {
-            ws.simplify_optimal(&mut pos, &mut tris, &config, &mut q)
+            ws.start(
+                tinydecimate::Positions::Write(&mut pos),
+                &mut tris,
+                &config,
+                tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
+                tinydecimate::NoBound,
+            )
+            .map(|s| s.run())
         } else {
-            ws.simplify_stored(&pos, &mut tris, &config, &mut q)
+            ws.start(
+                tinydecimate::Positions::Read(&pos),
+                &mut tris,
+                &config,
+                tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Subset),
+                tinydecimate::NoBound,
+            )
+            .map(|s| s.run())
         };
         assert_eq!(
             r,
@@ -274,13 +320,29 @@ fn bad_input_is_refused_before_anything_is_written() {
     // A NaN position and an index out of range: typed errors, positions and triangles untouched.
     let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len()];
     pos[3][1] = f32::NAN;
-    let r = ws.simplify_optimal(&mut pos, &mut tris, &config, &mut q);
+    let r = ws
+        .start(
+            tinydecimate::Positions::Write(&mut pos),
+            &mut tris,
+            &config,
+            tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
+            tinydecimate::NoBound,
+        )
+        .map(|s| s.run());
     assert_eq!(r, Err(Error::NonFinitePosition { vertex: 3 }));
     assert!(pos[3][1].is_nan());
     pos[3][1] = m.positions[3][1];
     assert_eq!(tris, m.triangles);
     tris[5][2] = 10_000;
-    let r = ws.simplify_optimal(&mut pos, &mut tris, &config, &mut q);
+    let r = ws
+        .start(
+            tinydecimate::Positions::Write(&mut pos),
+            &mut tris,
+            &config,
+            tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
+            tinydecimate::NoBound,
+        )
+        .map(|s| s.run());
     assert_eq!(
         r,
         Err(Error::IndexOutOfRange {
@@ -291,7 +353,15 @@ fn bad_input_is_refused_before_anything_is_written() {
     assert_eq!(pos, m.positions);
     // A bad configuration.
     tris[5] = m.triangles[5];
-    let r = ws.simplify_optimal(&mut pos, &mut tris, &config.with_ratio(2.0), &mut q);
+    let r = ws
+        .start(
+            tinydecimate::Positions::Write(&mut pos),
+            &mut tris,
+            &config.with_ratio(2.0),
+            tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
+            tinydecimate::NoBound,
+        )
+        .map(|s| s.run());
     assert!(matches!(r, Err(Error::InvalidConfig { .. })));
     assert_eq!((tris, pos), (m.triangles.clone(), m.positions.clone()));
 }
@@ -306,8 +376,16 @@ fn feature_vertices_are_never_removed_nor_moved_while_they_are_features() {
         let mut tris = m.triangles.clone();
         let mut pos = m.positions.clone();
         let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len()];
-        let cost = StoredQuadric::new(&mut q, config.boundary_weight, Placement::Optimal);
-        let mut s = ws.start_moving(&mut pos, &mut tris, &config, cost).unwrap();
+        let cost = StoredQuadric::new(&mut q, Placement::Optimal);
+        let mut s = ws
+            .start(
+                tinydecimate::Positions::Write(&mut pos),
+                &mut tris,
+                &config,
+                cost,
+                tinydecimate::NoBound,
+            )
+            .unwrap();
         let (mut checked, mut moved) = (0usize, 0usize);
         loop {
             let before: Vec<(usize, [f32; 3])> = (0..m.positions.len())

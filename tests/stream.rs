@@ -41,7 +41,13 @@ fn collapse_log(m: &MeshData, ratio: f32) -> Vec<[u32; 2]> {
     let n = {
         let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
         let mut s = ws
-            .start(&m.positions, &mut tris, &Config::new().with_ratio(ratio))
+            .start(
+                tinydecimate::Positions::Read(&m.positions),
+                &mut tris,
+                &Config::new().with_ratio(ratio),
+                tinydecimate::Builtin::new(),
+                tinydecimate::NoBound,
+            )
             .unwrap()
             .record_into(&mut log);
         while !s.step(u32::MAX) {}

@@ -16,7 +16,15 @@ use tinydecimate::{Config, Schedule, Workspace};
 fn operations(m: &MeshData, config: &Config) -> (u64, usize, u32) {
     let mut tris = m.triangles.clone();
     let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
-    let mut s = ws.start(&m.positions, &mut tris, config).unwrap();
+    let mut s = ws
+        .start(
+            tinydecimate::Positions::Read(&m.positions),
+            &mut tris,
+            config,
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+        )
+        .unwrap();
     let mut ops = 0u64;
     while !s.step(1) {
         ops += 1;
@@ -104,11 +112,23 @@ fn stored_operations_are_bounded_by_the_mesh_size() {
             let mut tris = m.triangles.clone();
             let mut pos = m.positions.clone();
             let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; pos.len()];
-            let cost = StoredQuadric::new(&mut q, config.boundary_weight, placement);
+            let cost = StoredQuadric::new(&mut q, placement);
             let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
             let mut s = match placement {
-                Placement::Subset => ws.start_with_cost(&m.positions, &mut tris, &config, cost),
-                Placement::Optimal => ws.start_moving(&mut pos, &mut tris, &config, cost),
+                Placement::Subset => ws.start(
+                    tinydecimate::Positions::Read(&m.positions),
+                    &mut tris,
+                    &config,
+                    cost,
+                    tinydecimate::NoBound,
+                ),
+                Placement::Optimal => ws.start(
+                    tinydecimate::Positions::Write(&mut pos),
+                    &mut tris,
+                    &config,
+                    cost,
+                    tinydecimate::NoBound,
+                ),
             }
             .unwrap();
             let mut ops = 0u64;

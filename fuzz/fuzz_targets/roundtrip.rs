@@ -31,7 +31,13 @@ fuzz_target!(|data: &[u8]| {
     let mut ws: Box<Ws> = Box::new(Workspace::new());
     let mut tris = input.clone();
     let mut log = vec![[0u32; 2]; nv];
-    let Ok(s) = ws.start(positions, &mut tris, &case.config) else {
+    let Ok(s) = ws.start(
+        tinydecimate::Positions::Read(positions),
+        &mut tris,
+        &case.config,
+        tinydecimate::Builtin::new(),
+        tinydecimate::NoBound,
+    ) else {
         return;
     };
     let mut s = s.record_into(&mut log);

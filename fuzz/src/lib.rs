@@ -5,8 +5,9 @@
 use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
-use tinydecimate::cost::{NormalVariation, PlaneDistance};
+use tinydecimate::cost::{NormalVariation, Quadric};
 use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Stop, Workspace};
+use tinydecimate::{NoBound, Positions};
 
 /// The caller's index type: `u16` or `u32`, converted from the generator's `u32` by truncation
 /// (so out-of-range and NIL-valued indices reach the library as they are).
@@ -35,13 +36,12 @@ impl Idx for u32 {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CostKind {
-    /// `Workspace::start` / `simplify`: the schedule's own normal variation.
+    /// `simplify` / `start` with `Builtin`: the cost `config.cost` names.
     Default,
-    Plane(f32),
-    Normal {
-        length_weighted: bool,
-        boundary_weight: f32,
-    },
+    /// `start` with `Quadric` (`config.cost` set to match).
+    Plane,
+    /// `start` with `NormalVariation` (`config.cost` set to match).
+    Normal,
 }
 
 /// One generated run.
@@ -414,14 +414,22 @@ impl Case {
     pub fn generate(u: &mut Unstructured) -> Result<Case> {
         let workspace = u.int_in_range(0..=2u8)?;
         let wide = u.arbitrary()?;
-        let config = config(u)?;
+        let mut config = config(u)?;
+        // The same bytes as before the costs took their settings from the configuration
+        // (the corpus stays meaningful); the explicit costs' settings go into it.
         let cost = match u.int_in_range(0..=5u8)? {
             0..=3 => CostKind::Default,
-            4 => CostKind::Plane(float(u, 0.0, 10.0)?),
-            _ => CostKind::Normal {
-                length_weighted: u.arbitrary()?,
-                boundary_weight: float(u, 0.0, 10.0)?,
-            },
+            4 => {
+                config.cost = tinydecimate::CostKind::Quadric;
+                config.boundary_weight = float(u, 0.0, 10.0)?;
+                CostKind::Plane
+            }
+            _ => {
+                let _length_weighted: bool = u.arbitrary()?;
+                config.cost = tinydecimate::CostKind::NormalVariation;
+                config.boundary_weight = float(u, 0.0, 10.0)?;
+                CostKind::Normal
+            }
         };
         let nb = u.int_in_range(1..=8usize)?;
         let mut budgets = Vec::with_capacity(nb);
@@ -539,7 +547,7 @@ fn with_dirty<L: Index + 'static, const V: usize, const T: usize, R>(
     out.unwrap_or_else(|| (f.take().unwrap())(&mut Workspace::new()))
 }
 
-/// Drives `start`/`start_with_cost` to the end with the given budgets, checking the state
+/// Drives `start` (with the case's cost) to the end with the given budgets, checking the state
 /// between steps; `stop_after`: finish early after that many `step` calls.
 fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
     ws: &mut Workspace<L, V, T>,
@@ -616,27 +624,26 @@ fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
         }};
     }
     match case.cost {
-        CostKind::Default => drive!(ws.start(&case.positions, tris, &case.config)),
-        CostKind::Plane(w) => drive!(ws.start_with_cost(
-            &case.positions,
+        CostKind::Default => drive!(ws.start(
+            Positions::Read(&case.positions),
             tris,
             &case.config,
-            PlaneDistance {
-                boundary_weight: w,
-                reference: 0.0,
-            }
+            tinydecimate::Builtin::new(),
+            NoBound
         )),
-        CostKind::Normal {
-            length_weighted,
-            boundary_weight,
-        } => drive!(ws.start_with_cost(
-            &case.positions,
+        CostKind::Plane => drive!(ws.start(
+            Positions::Read(&case.positions),
             tris,
             &case.config,
-            NormalVariation {
-                length_weighted,
-                boundary_weight
-            }
+            Quadric::new(),
+            NoBound
+        )),
+        CostKind::Normal => drive!(ws.start(
+            Positions::Read(&case.positions),
+            tris,
+            &case.config,
+            NormalVariation::new(),
+            NoBound
         )),
     }
 }

@@ -184,9 +184,9 @@ pub enum Method {
     Paper,
     /// meshoptimizer's `meshopt_simplify`.
     Meshopt,
-    /// tinydecimate, stored quadrics with subset placement (`Workspace::simplify_stored`).
+    /// tinydecimate, stored quadrics with subset placement (`StoredQuadric`, `Placement::Subset`).
     Stored,
-    /// tinydecimate, stored quadrics with optimal placement (`Workspace::simplify_optimal`).
+    /// tinydecimate, stored quadrics with optimal placement (`StoredQuadric`, `Placement::Optimal`).
     StoredOptimal,
     /// meshoptimizer's `meshopt_simplifyWithUpdate` (positions moved, no attributes).
     MeshoptUpdate,
@@ -250,8 +250,8 @@ impl Method {
             Method::GreedyW => "`Config::new().with_cost(CostKind::NormalVariation)`",
             Method::Paper => "`Config::paper()`",
             Method::Meshopt => "`meshopt::simplify`",
-            Method::Stored => "`Workspace::simplify_stored` with `Config::stored()`",
-            Method::StoredOptimal => "`Workspace::simplify_optimal` with `Config::stored()`",
+            Method::Stored => "`StoredQuadric` (subset placement) with `Config::stored()`",
+            Method::StoredOptimal => "`StoredQuadric` (optimal placement) with `Config::stored()`",
             Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
         }
     }
@@ -751,10 +751,11 @@ fn run_method(
     for _ in 0..reps {
         let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
             (Some(config), Some(placement)) => {
-                let (out, report, elapsed) = crate::simplify::simplify_stored(
+                let (out, report, elapsed) = crate::simplify::simplify_with(
                     mesh,
                     &config.with_ratio(ratio),
-                    placement,
+                    Some(placement),
+                    false,
                     false,
                 )?;
                 let bytes = workspace_bytes(v, t).0 + v * crate::simplify::QUADRIC_BYTES;

@@ -116,7 +116,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             .with_ratio(0.0)
             .with_relative_max_error(f, &mesh.positions);
         let start = Instant::now();
-        let (ours, r, _) = crate::simplify::simplify_bounded(&mesh, &config, false, false)?;
+        let (ours, r, _) = crate::simplify::simplify_with(&mesh, &config, None, true, false)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let m = metro(&mesh, &ours, &opts);
         let emax = f64::from(r.max_error.unwrap_or(f32::NAN));
@@ -132,7 +132,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         );
         if args.triangle {
             let tc = config.with_operator(Operator::Triangle);
-            let (tri, rt, _) = crate::simplify::simplify_bounded(&mesh, &tc, false, false)?;
+            let (tri, rt, _) = crate::simplify::simplify_with(&mesh, &tc, None, true, false)?;
             let mt = metro(&mesh, &tri, &opts);
             let e = f64::from(rt.max_error.unwrap_or(f32::NAN));
             ok &= e <= f64::from(config.max_error);

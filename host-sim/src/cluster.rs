@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 use tinydecimate::cluster::{
-    cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, GridChoice, Quadrics,
+    cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, GridChoice, Quadrics, Scratch,
     SliceSource, KEY_LANES,
 };
 use tinydecimate::{Config, Report};
@@ -102,12 +102,46 @@ pub fn cluster(
     let start = Instant::now();
     let q = if quadric { Some(&mut *quads) } else { None };
     let r = match mem {
-        VertexMemory::None => table.cluster(&mut src, q, config, &mut out),
-        VertexMemory::Bit => table.cluster_with_seen(&mut src, q, config, &mut out, &mut bits),
-        VertexMemory::Cache => table.cluster_with_cache(&mut src, q, config, &mut out, &mut cache),
-        VertexMemory::Keys => {
-            table.cluster_with_keys(&mut src, q, config, &mut out, &mut cache, &mut keys)
-        }
+        VertexMemory::None => table.cluster(
+            &mut src,
+            config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                ..Scratch::new()
+            },
+        ),
+        VertexMemory::Bit => table.cluster(
+            &mut src,
+            config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                seen: &mut bits,
+                ..Scratch::new()
+            },
+        ),
+        VertexMemory::Cache => table.cluster(
+            &mut src,
+            config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                cache: &mut cache,
+                ..Scratch::new()
+            },
+        ),
+        VertexMemory::Keys => table.cluster(
+            &mut src,
+            config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                cache: &mut cache,
+                keys: &mut keys,
+                ..Scratch::new()
+            },
+        ),
     }
     .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
     let dt = start.elapsed();
@@ -122,9 +156,6 @@ pub fn cluster(
     ))
 }
 
-/// The workspace of `--then-collapse` (as large as `host-sim simplify`'s, in `.bss`).
-static WS: Mutex<crate::simplify::HostWorkspace> = Mutex::new(tinydecimate::Workspace::new());
-
 /// `cluster_then_collapse` with the harness's buffers.
 fn then_collapse(
     mesh: &MeshData,
@@ -134,24 +165,28 @@ fn then_collapse(
 ) -> Result<(MeshData, ClusterReport, Report, Duration)> {
     let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
     let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
-    let mut ws = WS.lock().unwrap_or_else(|p| p.into_inner());
     let n = mesh.triangles.len().max(1);
+    let mut ws = crate::simplify::HostWorkspace::new(n, n);
     let mut out = vec![[0u32; 3]; n];
     let mut vertices = vec![0u32; n];
     let mut positions = vec![[0.0f32; 3]; n];
     let mut src = SliceSource::new(&mesh.positions, &mesh.triangles);
     let start = Instant::now();
     let q = if quadric { Some(&mut *quads) } else { None };
+    let scratch = Scratch {
+        quadrics: q,
+        vertices: &mut vertices,
+        positions: &mut positions,
+        ..Scratch::new()
+    };
     let (cr, r) = cluster_then_collapse(
         &mut table,
-        q,
-        &mut ws,
         &mut src,
         config,
         &Config::new().with_target_triangles(target),
         &mut out,
-        &mut vertices,
-        &mut positions,
+        ws.storage(),
+        scratch,
     )
     .map_err(|e| anyhow!("tinydecimate::cluster_then_collapse: {e}"))?;
     let dt = start.elapsed();

@@ -285,10 +285,11 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     row(
         "workspace RAM",
         format!(
-            "{} B ({} V / {} T capacity)",
-            thousands(golden::HostWorkspace::BYTES as u64),
-            golden::HOST_MAX_VERTICES,
-            golden::HOST_MAX_TRIANGLES
+            "{} B (u32 links, sized to the mesh)",
+            thousands(tinydecimate::Storage::<u32>::bytes(
+                case.positions.len(),
+                case.triangles.len()
+            ) as u64),
         ),
         format!(
             "{} B ({} V / {} T capacity)",

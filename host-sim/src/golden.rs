@@ -28,7 +28,12 @@ use meshfmt::file::{decode_result, encode_case, encode_result};
 use meshfmt::{Board, CostCode, ErrorKind, IndexType, ResultHeader, Status};
 use serde::Deserialize;
 use sha2::{Digest, Sha256};
-use tinydecimate::{Config, FeatureMode, Schedule, Workspace};
+use tinydecimate::bound::Controls;
+use tinydecimate::{
+    Builtin, Config, FeatureMode, NoBound, Placement, Positions, Schedule, StoredQuadric,
+};
+
+use crate::simplify::HostWorkspace;
 
 /// The case list inside the golden directory.
 pub const MANIFEST: &str = "cases.toml";
@@ -177,9 +182,9 @@ pub enum Features {
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 pub enum QuadricName {
-    /// `Workspace::simplify_stored`.
+    /// `StoredQuadric` with `Placement::Subset`.
     StoredSubset,
-    /// `Workspace::simplify_optimal`.
+    /// `StoredQuadric` with `Placement::Optimal`.
     StoredOptimal,
 }
 
@@ -235,7 +240,7 @@ pub struct CaseSpec {
     #[serde(default)]
     pub quadric: Option<QuadricName>,
     /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
-    /// `Workspace::simplify_bounded`) as a fraction of the bounding-box diagonal; the case file
+    /// `Controls`) as a fraction of the bounding-box diagonal; the case file
     /// carries it in input units.
     #[serde(default)]
     pub max_error: Option<f32>,
@@ -470,28 +475,12 @@ impl Outcome {
     }
 }
 
-/// Workspace capacity of the host reference run. Larger than any board's.
-pub const HOST_MAX_VERTICES: usize = 1 << 18;
-/// See [`HOST_MAX_VERTICES`].
-pub const HOST_MAX_TRIANGLES: usize = 1 << 19;
-/// The host reference run's workspace.
-pub type HostWorkspace = Workspace<u32, HOST_MAX_VERTICES, HOST_MAX_TRIANGLES>;
-
-/// Runs the case through the library on the host, exactly as the firmware does
-/// (`Workspace::simplify` with the case's index type and the configuration as the case file
-/// carries it).
+/// Runs the case through the library on the host, exactly as the firmware does (the same
+/// policies, the case's index type and the configuration as the case file carries it), on
+/// `u32`-link storage sized to the case.
 pub fn reference(case: &Case) -> Result<Outcome> {
-    let case = case.clone();
-    // The workspace is ~11 MB; build it on a thread with room for it even in debug builds,
-    // where `Box::new` may construct it on the stack first.
-    std::thread::Builder::new()
-        .stack_size(64 << 20)
-        .spawn(move || {
-            let mut ws: Box<HostWorkspace> = Box::new(Workspace::new());
-            reference_with(&mut ws, &case)
-        })?
-        .join()
-        .map_err(|_| anyhow!("reference run panicked"))?
+    let mut ws = HostWorkspace::new(case.positions.len(), case.triangles.len());
+    reference_with(&mut ws, case)
 }
 
 fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
@@ -523,7 +512,7 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
         }
     };
     let mut header = meshfmt::lib::result_header(case.index_type, &outcome, Board::Host);
-    if placement == Some(tinydecimate::cost::Placement::Optimal) {
+    if placement == Some(Placement::Optimal) {
         header.positions_hash = meshfmt::positions_hash(&positions);
     }
     Ok(Outcome {
@@ -538,25 +527,40 @@ fn run_reference<I: tinydecimate::Index>(
     positions: &mut [[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &Config,
-    placement: Option<tinydecimate::cost::Placement>,
+    placement: Option<Placement>,
     bounded: bool,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    use tinydecimate::cost::Placement;
+    let storage = ws.storage();
     if bounded {
         // The firmware lends its quadric storage to these two (`board::BOUND_BYTES`).
         let original = triangles.to_vec();
-        let mut controls =
+        let mut links =
             vec![0u32; tinydecimate::bound::control_len(triangles.len(), positions.len())];
-        return ws.simplify_bounded(positions, &original, triangles, &mut controls, config);
+        let bound = Controls::new(&original, &mut links);
+        let p = Positions::Read(positions);
+        return Ok(storage
+            .start(p, triangles, config, Builtin::new(), bound)?
+            .run());
     }
     let mut quadrics = vec![[0.0f32; 10]; positions.len()];
-    match placement {
-        None => ws.simplify(positions, triangles, config),
-        Some(Placement::Subset) => ws.simplify_stored(positions, triangles, config, &mut quadrics),
-        Some(Placement::Optimal) => {
-            ws.simplify_optimal(positions, triangles, config, &mut quadrics)
-        }
-    }
+    let s = match placement {
+        None => return ws.storage().simplify(positions, triangles, config),
+        Some(Placement::Subset) => storage.start(
+            Positions::Read(positions),
+            triangles,
+            config,
+            StoredQuadric::new(&mut quadrics, Placement::Subset),
+            NoBound,
+        )?,
+        Some(Placement::Optimal) => storage.start(
+            Positions::Write(positions),
+            triangles,
+            config,
+            StoredQuadric::new(&mut quadrics, Placement::Optimal),
+            NoBound,
+        )?,
+    };
+    Ok(s.run())
 }
 
 // ---------------------------------------------------------------------------------------------

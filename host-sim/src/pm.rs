@@ -15,7 +15,7 @@ use tinydecimate::{Config, Progressive};
 
 use crate::io::{self, MeshData};
 use crate::metro::{metro, MetroOptions};
-use crate::simplify::WS;
+use crate::simplify::HostWorkspace;
 
 /// `host-sim pm …`
 #[derive(Clone, Debug, clap::Args)]
@@ -149,11 +149,19 @@ impl Store {
 
 /// Simplifies `mesh` with `config` and a collapse log; returns the log.
 pub fn collapse_log(mesh: &MeshData, config: &Config) -> Result<Vec<[u32; 2]>> {
-    let mut ws = WS.lock().unwrap_or_else(|e| e.into_inner());
+    let mut ws = HostWorkspace::for_mesh(mesh);
     let mut tris = mesh.triangles.clone();
     let mut log = vec![[0u32; 2]; mesh.positions.len()];
+    let p = tinydecimate::Positions::Read(&mesh.positions);
     let mut s = ws
-        .start(&mesh.positions, &mut tris, config)
+        .storage()
+        .start(
+            p,
+            &mut tris,
+            config,
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+        )
         .map_err(|e| anyhow!("tinydecimate: {e}"))?
         .record_into(&mut log);
     while !s.step(u32::MAX) {}

@@ -21,7 +21,7 @@ use meshfmt::cluster::{
 };
 use meshfmt::{Board as BoardId, IndexType, Status};
 use serde::Deserialize;
-use tinydecimate::cluster::{ClusterReport, Clusterer, Quadrics, SliceSource};
+use tinydecimate::cluster::{ClusterReport, Clusterer, Quadrics, Scratch, SliceSource};
 
 use crate::golden::{self, Backend};
 use crate::qemu::{self, Board};
@@ -171,7 +171,15 @@ pub fn reference(case: &Case) -> Result<(ClusterResult, Vec<u8>)> {
     let (outcome, bytes): (Result<ClusterReport, _>, Vec<u8>) = match h.index_type {
         IndexType::U16 => {
             let mut out = vec![[0u16; 3]; n];
-            let r = table.cluster(&mut src, q, &config, &mut out);
+            let r = table.cluster(
+                &mut src,
+                &config,
+                &mut out,
+                Scratch {
+                    quadrics: q,
+                    ..Scratch::new()
+                },
+            );
             let k = r.as_ref().map_or(0, |r| r.triangles_out);
             let b = out[..k]
                 .iter()
@@ -182,7 +190,15 @@ pub fn reference(case: &Case) -> Result<(ClusterResult, Vec<u8>)> {
         }
         IndexType::U32 => {
             let mut out = vec![[0u32; 3]; n];
-            let r = table.cluster(&mut src, q, &config, &mut out);
+            let r = table.cluster(
+                &mut src,
+                &config,
+                &mut out,
+                Scratch {
+                    quadrics: q,
+                    ..Scratch::new()
+                },
+            );
             let k = r.as_ref().map_or(0, |r| r.triangles_out);
             let b = out[..k]
                 .iter()

@@ -9,24 +9,60 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
+use tinydecimate::bound::Controls;
 use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
-use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Workspace};
+use tinydecimate::{
+    Builtin, Config, CostKind, FeatureMode, NoBound, Positions, Report, Schedule, Storage,
+    Workspace,
+};
 
 use crate::io::{Format, MeshData};
 
-/// Largest mesh the harness takes: vertices.
-pub const MAX_VERTICES: usize = 262_144;
-/// Largest mesh the harness takes: triangles.
-pub const MAX_TRIANGLES: usize = 524_288;
-/// The harness's workspace type.
-pub type HostWorkspace = Workspace<u32, MAX_VERTICES, MAX_TRIANGLES>;
+/// The harness's working memory: the library's [`Storage`] with `u32` links, sized to the mesh
+/// (any mesh that fits in the PC's memory).
+pub struct HostWorkspace {
+    links: Vec<u32>,
+    corners: Vec<[u32; 3]>,
+    keys: Vec<f32>,
+    flags: Vec<u8>,
+}
 
-/// One big workspace in `.bss` (about 12 MB: too large for a thread's stack).
-pub static WS: Mutex<HostWorkspace> = Mutex::new(Workspace::new());
+impl HostWorkspace {
+    /// Room for `vertices` positions and `triangles` triangles.
+    pub fn new(vertices: usize, triangles: usize) -> Self {
+        HostWorkspace {
+            links: vec![0; 3 * vertices],
+            corners: vec![[0; 3]; triangles],
+            keys: vec![0.0; vertices],
+            flags: vec![0; vertices],
+        }
+    }
+
+    /// Room for `mesh`.
+    pub fn for_mesh(mesh: &MeshData) -> Self {
+        Self::new(mesh.positions.len(), mesh.triangles.len())
+    }
+
+    /// The library's view of it.
+    pub fn storage(&mut self) -> Storage<'_, u32> {
+        // The lengths agree by construction.
+        Storage::new(
+            &mut self.links,
+            &mut self.corners,
+            &mut self.keys,
+            &mut self.flags,
+        )
+        .expect("HostWorkspace slices agree")
+    }
+
+    /// Its size in bytes.
+    pub fn bytes(&self) -> usize {
+        Storage::<u32>::bytes(self.keys.len(), self.corners.len())
+    }
+}
 
 /// Bytes of `tinydecimate::Workspace` per vertex and per triangle for link type `L`, read
 /// off the library's own `BYTES` (differences, so no fixed part or padding leaks in).
@@ -397,9 +433,10 @@ impl Args {
 /// The cost is `config.cost`; the wall time is that of `Workspace::simplify` alone.
 pub fn simplify(mesh: &MeshData, config: &Config) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
-    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let mut ws = HostWorkspace::for_mesh(mesh);
     let start = Instant::now();
     let report = ws
+        .storage()
         .simplify(&mesh.positions, &mut tris, config)
         .map_err(|e| anyhow!("tinydecimate: {e}"))?;
     let elapsed = start.elapsed();
@@ -411,20 +448,49 @@ pub fn simplify(mesh: &MeshData, config: &Config) -> Result<(MeshData, Report, D
     Ok((out, report, elapsed))
 }
 
-/// Runs the library with stored quadrics on `mesh` (`Workspace::start_with_cost`, or
-/// `start_moving` for optimal placement), stepping with a progress bar when `progress`. The
-/// result carries the positions as the library left them (moved by optimal placement). The
-/// wall time is that of the library alone (the quadric storage is allocated before).
-pub fn simplify_stored(
+/// The library's error, with the command-line options that name the refused field.
+pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
+    use tinydecimate::{ConfigField, Error};
+    let hint = match e {
+        Error::InvalidConfig {
+            field: ConfigField::Placement,
+        } => " (with --max-error use --placement subset with --quadric stored)",
+        Error::InvalidConfig {
+            field: ConfigField::Schedule,
+        } => " (drop --schedule passes with --quadric stored)",
+        _ => "",
+    };
+    anyhow!("tinydecimate: {e}{hint}")
+}
+
+/// Runs the library on `mesh` with any policies: stored quadrics (`placement`, else the
+/// configuration's built-in cost) and the error bound (`bounded`: control points in a `u32`
+/// link slice; the bound itself is `config.max_error`), stepping with a progress bar when
+/// `progress`. The library refuses combinations it cannot run. The result carries the
+/// positions as the library left them (moved by optimal placement). The wall time is that of
+/// the library alone (storage is allocated before).
+pub fn simplify_with(
     mesh: &MeshData,
     config: &Config,
-    placement: Placement,
+    placement: Option<Placement>,
+    bounded: bool,
     progress: bool,
 ) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
     let mut positions = mesh.positions.clone();
-    let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; positions.len()];
-    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let n = if placement.is_some() {
+        positions.len()
+    } else {
+        0
+    };
+    let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; n];
+    let n = if bounded {
+        tinydecimate::bound::control_len(tris.len(), positions.len())
+    } else {
+        0
+    };
+    let mut links = vec![0u32; n];
+    let mut ws = HostWorkspace::for_mesh(mesh);
     let bar = progress.then(|| {
         crate::progress::Progress::new(
             "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
@@ -432,12 +498,15 @@ pub fn simplify_stored(
         )
     });
     let start = Instant::now();
-    let cost = StoredQuadric::new(&mut quadrics, config.boundary_weight, placement);
+    let budget = if bounded { 1 << 12 } else { 1 << 14 };
     macro_rules! drive {
-        ($s:expr) => {{
-            let mut s = $s.map_err(|e| anyhow!("tinydecimate: {e}"))?;
+        ($p:expr, $cost:expr, $bound:expr) => {{
+            let mut s = ws
+                .storage()
+                .start($p, &mut tris, config, $cost, $bound)
+                .map_err(library_error)?;
             let n0 = s.live_triangles();
-            while !s.step(1 << 14) {
+            while !s.step(budget) {
                 if let Some(b) = &bar {
                     b.set((n0 - s.live_triangles().min(n0)) as u64);
                 }
@@ -445,9 +514,35 @@ pub fn simplify_stored(
             s.finish()
         }};
     }
-    let report = match placement {
-        Placement::Subset => drive!(ws.start_with_cost(&positions, &mut tris, config, cost)),
-        Placement::Optimal => drive!(ws.start_moving(&mut positions, &mut tris, config, cost)),
+    let original = &mesh.triangles;
+    // Optimal placement writes the positions; every other run only reads them.
+    let report = match (placement, bounded) {
+        (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
+        (None, true) => drive!(
+            Positions::Read(&positions),
+            Builtin::new(),
+            Controls::new(original, &mut links)
+        ),
+        (Some(Placement::Subset), false) => drive!(
+            Positions::Read(&positions),
+            StoredQuadric::new(&mut quadrics, Placement::Subset),
+            NoBound
+        ),
+        (Some(Placement::Subset), true) => drive!(
+            Positions::Read(&positions),
+            StoredQuadric::new(&mut quadrics, Placement::Subset),
+            Controls::new(original, &mut links)
+        ),
+        (Some(Placement::Optimal), false) => drive!(
+            Positions::Write(&mut positions),
+            StoredQuadric::new(&mut quadrics, Placement::Optimal),
+            NoBound
+        ),
+        (Some(Placement::Optimal), true) => drive!(
+            Positions::Write(&mut positions),
+            StoredQuadric::new(&mut quadrics, Placement::Optimal),
+            Controls::new(original, &mut links)
+        ),
     };
     let elapsed = start.elapsed();
     if let Some(b) = bar {
@@ -457,65 +552,6 @@ pub fn simplify_stored(
     Ok((
         MeshData {
             positions,
-            triangles: tris,
-        },
-        report,
-        elapsed,
-    ))
-}
-
-/// Runs the library with the error bound (`Workspace::start_bounded`, control points in a
-/// `u32` link slice), with the configuration's cost or stored quadrics with subset placement,
-/// stepping with a progress bar when `progress`. The wall time is that of the library alone.
-pub fn simplify_bounded(
-    mesh: &MeshData,
-    config: &Config,
-    stored: bool,
-    progress: bool,
-) -> Result<(MeshData, Report, Duration)> {
-    let mut tris = mesh.triangles.clone();
-    let mut links = vec![0u32; tinydecimate::bound::control_len(tris.len(), mesh.positions.len())];
-    let mut quadrics: Vec<VertexQuadric> = if stored {
-        vec![[0.0; 10]; mesh.positions.len()]
-    } else {
-        Vec::new()
-    };
-    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let bar = progress.then(|| {
-        crate::progress::Progress::new(
-            "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
-            mesh.triangles.len() as u64,
-        )
-    });
-    let start = Instant::now();
-    macro_rules! drive {
-        ($s:expr) => {{
-            let mut s = $s.map_err(|e| anyhow!("tinydecimate: {e}"))?;
-            let n0 = s.live_triangles();
-            while !s.step(1 << 12) {
-                if let Some(b) = &bar {
-                    b.set((n0 - s.live_triangles().min(n0)) as u64);
-                }
-            }
-            s.finish()
-        }};
-    }
-    let (p, o) = (&mesh.positions, &mesh.triangles);
-    let report = if stored {
-        let cost = StoredQuadric::new(&mut quadrics, config.boundary_weight, Placement::Subset);
-        drive!(ws.start_bounded(p, o, &mut tris, &mut links, config, cost))
-    } else {
-        let cost = tinydecimate::cost::Builtin::of(config);
-        drive!(ws.start_bounded(p, o, &mut tris, &mut links, config, cost))
-    };
-    let elapsed = start.elapsed();
-    if let Some(b) = bar {
-        b.finish();
-    }
-    tris.truncate(report.triangles_out);
-    Ok((
-        MeshData {
-            positions: mesh.positions.clone(),
             triangles: tris,
         },
         report,
@@ -576,36 +612,12 @@ pub fn format_report(r: &Report) -> String {
 
 /// [`simplify`] driven step by step, with a progress bar on stderr when it is a terminal and
 /// the run takes over a second. Same result as [`simplify`] (steps of any size give the result
-/// of `Workspace::simplify`).
+/// of `Storage::simplify`).
 pub fn simplify_with_progress(
     mesh: &MeshData,
     config: &Config,
 ) -> Result<(MeshData, Report, Duration)> {
-    let mut tris = mesh.triangles.clone();
-    let mut ws = WS.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-    let start = Instant::now();
-    let progress = crate::progress::Progress::new(
-        "simplify {bar:40} {pos}/{len} triangles removed ({elapsed})",
-        mesh.triangles.len() as u64,
-    );
-    let report = {
-        let mut s = ws
-            .start(&mesh.positions, &mut tris, config)
-            .map_err(|e| anyhow!("tinydecimate: {e}"))?;
-        let n0 = s.live_triangles();
-        while !s.step(1 << 14) {
-            progress.set((n0 - s.live_triangles().min(n0)) as u64);
-        }
-        s.finish()
-    };
-    progress.finish();
-    let elapsed = start.elapsed();
-    tris.truncate(report.triangles_out);
-    let out = MeshData {
-        positions: mesh.positions.clone(),
-        triangles: tris,
-    };
-    Ok((out, report, elapsed))
+    simplify_with(mesh, config, None, false, true)
 }
 
 /// The report as JSON: every field of `Report`.
@@ -661,9 +673,6 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         .validate()
         .map_err(|e| anyhow!("configuration: {e}"))?;
     let stored = args.quadric == QuadricArg::Stored;
-    if stored && config.schedule != Schedule::Greedy {
-        bail!("--quadric stored runs the greedy schedule only (drop --schedule passes)");
-    }
     // Optimal placement moves vertices: only their numbering says which input vertex each
     // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
     let moved = stored && args.placement == PlacementArg::Optimal;
@@ -675,18 +684,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     }
     let keep_numbering = args.keep_numbering || moved;
     let bounded = args.max_error.is_some();
-    if bounded && stored && args.placement == PlacementArg::Optimal {
-        bail!(
-            "--max-error keeps positions read only: use --placement subset with --quadric stored"
-        );
-    }
-    let (out, report, elapsed) = if bounded {
-        simplify_bounded(&mesh, &config, stored, true)?
-    } else if stored {
-        simplify_stored(&mesh, &config, args.placement.into(), true)?
-    } else {
-        simplify_with_progress(&mesh, &config)?
-    };
+    // The library refuses what it cannot run (stored quadrics with the passes schedule,
+    // optimal placement with a bound) before any work, naming the option.
+    let placement = stored.then(|| args.placement.into());
+    let (out, report, elapsed) = simplify_with(&mesh, &config, placement, bounded, true)?;
     let written = if keep_numbering {
         out.clone()
     } else {
@@ -739,12 +740,12 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     );
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let per_tri = |b: usize| b as f64 / t.max(1) as f64;
+    let host = Storage::<u32>::bytes(v, t);
     let _ = writeln!(
         text,
-        "  workspace (static)     {} bytes = Workspace<u32, {MAX_VERTICES}, {MAX_TRIANGLES}> \
-         ({:.1} bytes per input triangle, misleading for a fixed big static)",
-        HostWorkspace::BYTES,
-        per_tri(HostWorkspace::BYTES)
+        "  workspace (this run)   {host} bytes: Storage<u32> sized to the mesh ({:.1} bytes per \
+         input triangle)",
+        per_tri(host)
     );
     let (need, link) = workspace_bytes(v, t);
     let _ = writeln!(
@@ -883,6 +884,72 @@ pub fn run(args: &Args) -> Result<ExitCode> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A `n` x `n` quad grid on a gentle wave (two triangles per quad), built in memory.
+    fn wave_grid(n: usize) -> MeshData {
+        let w = n + 1;
+        let positions = (0..w * w)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                [x, y, (x * 0.05).sin() * (y * 0.03).cos() * 4.0]
+            })
+            .collect();
+        let mut triangles = Vec::with_capacity(2 * n * n);
+        for y in 0..n {
+            for x in 0..n {
+                let a = (y * w + x) as u32;
+                let (b, c, d) = (a + 1, a + w as u32, a + w as u32 + 1);
+                triangles.push([a, b, d]);
+                triangles.push([a, d, c]);
+            }
+        }
+        MeshData {
+            positions,
+            triangles,
+        }
+    }
+
+    /// Storage sized to the mesh: a 2 M-triangle grid (far beyond u16 links and the former
+    /// fixed 262 144-vertex workspace) simplifies through the harness's path.
+    #[test]
+    fn two_million_triangles_simplify() {
+        let mesh = wave_grid(1000);
+        assert_eq!(mesh.triangles.len(), 2_000_000);
+        let config = Config::new().with_ratio(0.9);
+        let (out, report, _) = simplify(&mesh, &config).expect("simplify");
+        assert!(report.target_reached, "{report:?}");
+        assert!(report.triangles_out <= 1_800_000 && report.triangles_out > 1_700_000);
+        assert_eq!(out.triangles.len(), report.triangles_out);
+        assert!(out
+            .triangles
+            .iter()
+            .all(|t| t.iter().all(|&i| (i as usize) < mesh.positions.len())));
+    }
+
+    /// A mesh too big for a storage says so in words, and names the way out for u16 links.
+    #[test]
+    fn capacity_errors_read_well() {
+        let mesh = wave_grid(8);
+        let mut tris = mesh.triangles.clone();
+        let mut ws = tinydecimate::Workspace::<u16, 16, 512>::new();
+        let e = ws
+            .simplify(&mesh.positions, &mut tris, &Config::new())
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "mesh needs 81 vertices but the workspace holds 16"
+        );
+        let e = tinydecimate::Error::Capacity {
+            what: tinydecimate::Capacity::Vertices,
+            needed: 313_600,
+            available: 65_535,
+        };
+        assert_eq!(
+            e.to_string(),
+            "mesh needs 313600 vertices but the workspace holds 65535 (u16 links number at \
+             most 65535: use u32 links)"
+        );
+    }
     use clap::Parser;
 
     #[derive(Parser)]

@@ -117,7 +117,7 @@ mod sel {
 
 pub use sel::*;
 
-/// Bytes a bounded case (`Workspace::simplify_bounded`) borrows from the quadric storage, which
+/// Bytes a bounded case (`Controls`) borrows from the quadric storage, which
 /// it does not use: a read-only copy of the input triangles and the control-point links
 /// (`bound::control_len(T, V)` of `Link`).
 pub const BOUND_BYTES: usize = QUADRIC_VERTICES * 40;

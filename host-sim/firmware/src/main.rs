@@ -426,18 +426,37 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     bounded: bool,
     quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    use tinydecimate::cost::Placement;
     if bounded {
         return run_bounded(ws, positions, triangles, config, quadrics);
     }
     match placement {
         None => ws.simplify(positions, triangles, config),
-        Some(Placement::Subset) => ws.simplify_stored(positions, triangles, config, quadrics),
-        Some(Placement::Optimal) => ws.simplify_optimal(positions, triangles, config, quadrics),
+        Some(placement) => run_stored(ws, positions, triangles, config, placement, quadrics),
     }
 }
 
-/// A bounded case (`Workspace::simplify_bounded`). Never inlined: its locals would deepen
+/// A stored-quadric case (`StoredQuadric`). Never inlined, for the same reason as
+/// [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_stored<I: tinydecimate::Index>(
+    ws: &mut board::Workspace,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+    placement: tinydecimate::Placement,
+    quadrics: &mut [[f32; 10]],
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    use tinydecimate::{NoBound, Placement, Positions, StoredQuadric};
+    let p = match placement {
+        Placement::Subset => Positions::Read(positions),
+        Placement::Optimal => Positions::Write(positions),
+    };
+    let cost = StoredQuadric::new(quadrics, placement);
+    Ok(ws.start(p, triangles, config, cost, NoBound)?.run())
+}
+
+/// A bounded case (`Controls`). Never inlined: its locals would deepen
 /// [`run_library`]'s frame for every case, and the micro:bit has no stack to spare.
 #[cfg(feature = "lib")]
 #[inline(never)]
@@ -465,7 +484,12 @@ fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
         return Err(tinydecimate::Error::OriginalMismatch { triangle: 0 });
     }
     orig.copy_from_slice(triangles);
-    ws.simplify_bounded(positions, orig, triangles, controls, config)
+    let (p, bound) = (
+        tinydecimate::Positions::Read(positions),
+        tinydecimate::Controls::new(orig, controls),
+    );
+    let cost = tinydecimate::Builtin::new();
+    Ok(ws.start(p, triangles, config, cost, bound)?.run())
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).

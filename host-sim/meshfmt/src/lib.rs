@@ -141,9 +141,9 @@ pub enum CostCode {
     Quadric = 0,
     /// `CostKind::NormalVariation`.
     NormalVariation = 1,
-    /// Stored quadrics, subset placement (`Workspace::simplify_stored`).
+    /// Stored quadrics, subset placement (`StoredQuadric` with `Placement::Subset`).
     StoredSubset = 2,
-    /// Stored quadrics, optimal placement (`Workspace::simplify_optimal`): positions move.
+    /// Stored quadrics, optimal placement (`StoredQuadric` with `Placement::Optimal`): positions move.
     StoredOptimal = 3,
 }
 
@@ -189,7 +189,7 @@ pub struct CaseHeader {
     pub max_normal_turn_deg: f32,
     pub min_quality: f32,
     pub boundary_weight: f32,
-    /// The error bound in input units (`Workspace::simplify_bounded`); 0 (or anything not
+    /// The error bound in input units (`Controls`); 0 (or anything not
     /// positive and finite): no bound, `Workspace::simplify`.
     pub max_error: f32,
 }
@@ -341,7 +341,7 @@ impl CaseHeader {
         })
     }
 
-    /// Whether the case asks for the guaranteed error bound (`Workspace::simplify_bounded`):
+    /// Whether the case asks for the guaranteed error bound (`Controls`):
     /// a positive, finite `max_error`.
     pub fn bounded(&self) -> bool {
         self.max_error > 0.0 && self.max_error.is_finite()
@@ -670,7 +670,7 @@ pub mod lib {
         c
     }
 
-    /// Whether a case asks for the guaranteed error bound (`Workspace::simplify_bounded`).
+    /// Whether a case asks for the guaranteed error bound (`Controls`).
     pub fn bounded(h: &CaseHeader) -> bool {
         h.bounded()
     }

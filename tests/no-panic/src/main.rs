@@ -14,19 +14,19 @@ use core::fmt::Write;
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
+use tinydecimate::bound::{control_len, Bound};
 use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterError, Clusterer, Grid, GridChoice, PositionFn,
-    Quadrics, SliceSource, Source, ThenCollapseError, KEY_LANES,
+    Quadrics, Scratch, SliceSource, Source, ThenCollapseError, KEY_LANES,
 };
-use tinydecimate::bound::{control_len, Bound};
 use tinydecimate::cost::{
     error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, Error, FeatureMode, Index, Operator, Progressive, Report, Schedule,
-    Simplifier, Workspace,
+    Config, CostKind, FeatureMode, Index, NoBound, Operator, Positions, Progressive, Report,
+    Schedule, Simplifier, Workspace,
 };
 
 #[panic_handler]
@@ -185,28 +185,17 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         Ok(r) => use_report(&r),
         Err(e) => display(&e),
     }
-    match ws_default.start(p, t, &config) {
+    match ws_default.start(Positions::Read(p), t, &config, Builtin::new(), NoBound) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
-    let nv = if input(5) & 1 == 0 {
-        NormalVariation::greedy(opaque_f32(6))
-    } else {
-        NormalVariation::paper(opaque_f32(6))
-    };
-    let nv = NormalVariation {
-        length_weighted: input(7) & 1 == 0 || nv.length_weighted,
-        boundary_weight: nv.boundary_weight,
-    };
-    match ws.start_with_cost(p, t, &config, nv) {
+    let nv = NormalVariation::new();
+    match ws.start(Positions::Read(p), t, &config, nv, NoBound) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
-    let pd = Quadric {
-        boundary_weight: opaque_f32(8),
-        reference: opaque_f32(9),
-    };
-    match ws.start_with_cost(p, t, &config, pd) {
+    let pd = Quadric::new();
+    match ws.start(Positions::Read(p), t, &config, pd, NoBound) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
@@ -215,11 +204,29 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     let mut moving: [[f32; 3]; V] = black_box([[0.0; 3]; V]);
     let nq = input(11) as usize;
     if let (Some(q), Some(mp)) = (quadrics.get_mut(..nq), moving.get_mut(..np)) {
-        match ws.simplify_stored(p, t, &config, q) {
+        match ws
+            .start(
+                Positions::Read(p),
+                t,
+                &config,
+                StoredQuadric::new(q, Placement::Subset),
+                NoBound,
+            )
+            .map(|s| s.run())
+        {
             Ok(r) => use_report(&r),
             Err(e) => display(&e),
         }
-        match ws.simplify_optimal(mp, t, &config, q) {
+        match ws
+            .start(
+                Positions::Write(mp),
+                t,
+                &config,
+                StoredQuadric::new(q, Placement::Optimal),
+                NoBound,
+            )
+            .map(|s| s.run())
+        {
             Ok(r) => use_report(&r),
             Err(e) => display(&e),
         }
@@ -228,9 +235,13 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         } else {
             Placement::Optimal
         };
-        let sq = StoredQuadric::new(q, opaque_f32(13), placement);
-        black_box((sq.boundary_weight(), sq.placement(), sq.quadric(input(14) as usize)));
-        match ws.start_moving(mp, t, &config, sq) {
+        let sq = StoredQuadric::new(q, placement);
+        black_box((
+            sq.boundary_weight(),
+            tinydecimate::cost::Cost::placement(&sq),
+            sq.quadric(input(14) as usize),
+        ));
+        match ws.start(Positions::Write(mp), t, &config, sq, NoBound) {
             Ok(s) => {
                 black_box(s.position(input(15) as usize));
                 drive(s)
@@ -250,13 +261,24 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         links32.get_mut(..nl),
     ) {
         black_box(control_len(input(14) as usize, input(15) as usize));
-        match ws.simplify_bounded(p, o, t, l16, &config) {
-            Ok(r) => use_report(&r),
+        let bound = tinydecimate::Controls::new(o, l16);
+        match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound) {
+            Ok(s) => use_report(&s.run()),
             Err(e) => display(&e),
         }
-        match ws.start_bounded(p, o, t, l32, &config, Builtin::of(&config)) {
+        let bound = tinydecimate::Controls::new(o, l32);
+        match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound) {
             Ok(s) => drive(s),
             Err(e) => display(&e),
+        }
+        // Stored quadrics with a bound.
+        if let Some(q) = quadrics.get_mut(..nq) {
+            let bound = tinydecimate::Controls::new(o, l32);
+            let cost = StoredQuadric::new(q, placement_of(input(16)));
+            match ws.start(Positions::Read(p), t, &config, cost, bound) {
+                Ok(s) => drive(s),
+                Err(e) => display(&e),
+            }
         }
     }
     black_box(&tris);
@@ -274,7 +296,9 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     };
     black_box(error(&[opaque_f32(7); 10], m.p_to));
     let n = [opaque_f32(6), opaque_f32(7), opaque_f32(10)];
-    let mut pd = pd;
+    let (mut pd, mut nv) = (pd, nv);
+    let _ = pd.configure(&config, input(8) as usize);
+    let _ = nv.configure(&config, input(9) as usize);
     pd.round(opaque_f32(11));
     let mut fan = pd.empty();
     pd.add(&mut fan, n, opaque_f32(12));
@@ -282,11 +306,17 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     let mut unit = nv.empty();
     nv.add(&mut unit, n, opaque_f32(12));
     black_box(nv.price(&unit, &m));
-    let mut b = Builtin::of(&config);
+    let mut b = Builtin::new();
+    let _ = b.configure(&config, input(10) as usize);
     b.round(opaque_f32(13));
     let mut bf = b.empty();
     b.add(&mut bf, n, opaque_f32(14));
-    black_box((b.price(&bf, &m), b.needs_turn(), pd.needs_turn(), nv.needs_turn()));
+    black_box((
+        b.price(&bf, &m),
+        b.needs_turn(),
+        pd.needs_turn(),
+        nv.needs_turn(),
+    ));
 
     // Index.
     let i = I::from_usize(input(9) as usize);
@@ -313,7 +343,7 @@ fn progressive<I: Index, const V: usize, const T: usize>() {
         return;
     };
     let config = opaque_config();
-    let logged = match ws.start(p, t, &config) {
+    let logged = match ws.start(Positions::Read(p), t, &config, Builtin::new(), NoBound) {
         Ok(s) => {
             let mut s = s.record_into(l);
             while !s.step(input(0)) {
@@ -463,7 +493,15 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
     } else {
         None
     };
-    match table.cluster(&mut src, q, &config, &mut out) {
+    match table.cluster(
+        &mut src,
+        &config,
+        &mut out,
+        Scratch {
+            quadrics: q,
+            ..Scratch::new()
+        },
+    ) {
         Ok(r) => {
             black_box(r);
         }
@@ -479,7 +517,16 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         } else {
             None
         };
-        match table.cluster_with_seen(&mut src, q, &config, &mut out, b) {
+        match table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                seen: b,
+                ..Scratch::new()
+            },
+        ) {
             Ok(r) => {
                 black_box(r);
             }
@@ -490,7 +537,16 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         } else {
             None
         };
-        match table.cluster_with_cache(&mut src, q, &config, &mut out, c) {
+        match table.cluster(
+            &mut src,
+            &config,
+            &mut out,
+            Scratch {
+                quadrics: q,
+                cache: c,
+                ..Scratch::new()
+            },
+        ) {
             Ok(r) => {
                 black_box(r);
             }
@@ -505,7 +561,17 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
             } else {
                 None
             };
-            match table.cluster_with_keys(&mut src, q, &config, &mut out, c, k) {
+            match table.cluster(
+                &mut src,
+                &config,
+                &mut out,
+                Scratch {
+                    quadrics: q,
+                    cache: c,
+                    keys: k,
+                    ..Scratch::new()
+                },
+            ) {
                 Ok(r) => {
                     black_box(r);
                 }
@@ -521,7 +587,7 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
         return;
     };
     let mut s = SliceSource::new(p, t);
-    match table.cluster(&mut s, None, &config, &mut out) {
+    match table.cluster(&mut s, &config, &mut out, Scratch::new()) {
         Ok(r) => {
             black_box(r);
         }
@@ -564,16 +630,19 @@ fn run_cluster<I: Index, L: Index, const C: usize>() {
     let mut vertices = [0u32; 48];
     let mut pos = [[0.0f32; 3]; 48];
     let ccfg = opaque_config();
+    let scratch = Scratch {
+        vertices: &mut vertices,
+        positions: &mut pos,
+        ..Scratch::new()
+    };
     match cluster_then_collapse(
         &mut table,
-        None,
-        &mut ws,
         &mut src,
         &config,
         &ccfg,
         &mut out,
-        &mut vertices,
-        &mut pos,
+        ws.as_storage(),
+        scratch,
     ) {
         Ok((c, r)) => {
             black_box(c);
@@ -616,5 +685,14 @@ fn main() -> ! {
     run_cluster::<u32, u32, 64>();
     loop {
         black_box(());
+    }
+}
+
+/// A placement from an opaque word.
+fn placement_of(x: u32) -> Placement {
+    if x & 1 == 0 {
+        Placement::Subset
+    } else {
+        Placement::Optimal
     }
 }

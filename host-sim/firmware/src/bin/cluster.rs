@@ -36,7 +36,7 @@ use riscv_rt::entry;
 use semihosting::fs::File;
 use semihosting::io::{Read, Seek, SeekFrom};
 use static_cell::ConstStaticCell;
-use tinydecimate::cluster::{ClusterError, ClusterReport, Clusterer, Quadrics, Source};
+use tinydecimate::cluster::{ClusterError, ClusterReport, Clusterer, Quadrics, Scratch, Source};
 
 use arch::Timer;
 use hostio::IoError;
@@ -359,11 +359,27 @@ fn call<S: Source>(
 ) -> Result<ClusterReport, ClusterError> {
     match it {
         IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(out) {
-            Ok(o) => table.cluster(src, quads, config, o),
+            Ok(o) => table.cluster(
+                src,
+                config,
+                o,
+                Scratch {
+                    quadrics: quads,
+                    ..Scratch::new()
+                },
+            ),
             Err(_) => Err(ClusterError::InvalidGrid),
         },
         IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(out) {
-            Ok(o) => table.cluster(src, quads, config, o),
+            Ok(o) => table.cluster(
+                src,
+                config,
+                o,
+                Scratch {
+                    quadrics: quads,
+                    ..Scratch::new()
+                },
+            ),
             Err(_) => Err(ClusterError::InvalidGrid),
         },
     }
