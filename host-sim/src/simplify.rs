@@ -640,6 +640,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if to_stdout && args.json {
         bail!("--json and an output of `-` would both write standard output: give an output file");
     }
+    // glTF, and OBJ with texture coordinates or normals: attributes carried (textured.rs).
+    if let Some(code) = crate::textured::run_if_attributes(args)? {
+        return Ok(code);
+    }
     let out_format = crate::io::check_writable(&args.output, args.format)?;
     let mesh = crate::io::load_noting(&args.input)?;
     let mut config = args.config();
