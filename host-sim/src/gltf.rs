@@ -184,9 +184,17 @@ fn split_glb(bytes: &[u8]) -> R<(&[u8], Option<&[u8]>)> {
                     bytes.len().saturating_sub(start)
                 )
             })?;
-        Ok((ty, &bytes[start..end], end.next_multiple_of(4)))
+        Ok((ty, &bytes[start..end], end))
     };
-    let (ty, json, next) = chunk(12)?;
+    let (ty, json, end) = chunk(12)?;
+    // Chunks start on 4-byte boundaries; some writers leave the JSON chunk unpadded and put
+    // the BIN chunk right after it (the validator's GLB_CHUNK_LENGTH_UNALIGNED): accept that.
+    let is_bin = |at: usize| word(at + 4).is_ok_and(|t| t == 0x004E_4942);
+    let next = if !is_bin(end.next_multiple_of(4)) && is_bin(end) {
+        end
+    } else {
+        end.next_multiple_of(4)
+    };
     if ty != 0x4E4F_534A {
         return Err("GLB's first chunk is not JSON".into());
     }
@@ -210,10 +218,12 @@ pub fn parse(bytes: &[u8], dir: Option<&Path>) -> R<GltfFile> {
     } else {
         (bytes, None)
     };
+    let mut json: Value =
+        serde_json::from_slice(json_bytes).map_err(|e| format!("not JSON: {e}"))?;
+    check_references(&mut json)?;
     let doc = gltf::Gltf::from_slice(json_bytes)
         .map_err(|e| format!("not a valid glTF 2.0 document: {e}"))?
         .document;
-    let json: Value = serde_json::from_slice(json_bytes).map_err(|e| format!("JSON: {e}"))?;
     for ext in doc.extensions_required() {
         if ext == "KHR_draco_mesh_compression" || ext == "EXT_meshopt_compression" {
             return Err(format!(
@@ -369,6 +379,39 @@ pub fn parse(bytes: &[u8], dir: Option<&Path>) -> R<GltfFile> {
         buffers,
         primitives,
         passed_through,
+    })
+}
+
+/// Every accessor, buffer view and buffer reference is in range. Checked before the `gltf`
+/// crate validates the document: its validation (1.4.1) indexes the POSITION accessor
+/// before checking the index, and panics on one past the end.
+fn check_references(json: &mut Value) -> R<()> {
+    let len = |j: &Value, k: &str| j[k].as_array().map_or(0, Vec::len);
+    let check = |json: &mut Value, what: &str, n: usize, visit: Visitor| -> R<()> {
+        let mut bad = None;
+        visit(json, &mut |v| {
+            if bad.is_none() && v.as_u64().is_none_or(|i| i >= n as u64) {
+                bad = Some(v.to_string());
+            }
+        });
+        match bad {
+            Some(b) => Err(format!("a reference to {what} {b}, but there are {n}")),
+            None => Ok(()),
+        }
+    };
+    let accessors = len(json, "accessors");
+    check(json, "accessor", accessors, visit_accessor_refs)?;
+    let views = len(json, "bufferViews");
+    check(json, "buffer view", views, visit_view_refs)?;
+    let buffers = len(json, "buffers");
+    check(json, "buffer", buffers, |j, f| {
+        if let Some(vs) = j.get_mut("bufferViews").and_then(Value::as_array_mut) {
+            for v in vs {
+                if let Some(b) = v.get_mut("buffer") {
+                    f(b);
+                }
+            }
+        }
     })
 }
 
@@ -593,12 +636,7 @@ fn visit_view_refs(json: &mut Value, f: &mut dyn FnMut(&mut Value)) {
 
 /// Marks which of `count` indices `visit` reaches and renumbers them densely; unreached ones
 /// map to `None`. `keep_all` keeps every index (identity map).
-fn renumber(
-    count: usize,
-    json: &mut Value,
-    keep_all: bool,
-    visit: Visitor,
-) -> Vec<Option<usize>> {
+fn renumber(count: usize, json: &mut Value, keep_all: bool, visit: Visitor) -> Vec<Option<usize>> {
     let mut used = vec![keep_all; count];
     visit(json, &mut |v| {
         if let Some(i) = v.as_u64() {
