@@ -20,7 +20,7 @@ struct Builder {
 
 impl Builder {
     fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
@@ -61,6 +61,7 @@ impl Builder {
 
 /// A grid of `n`x`n` quads split on a UV seam down its middle column: the seam's vertices are
 /// doubled (u jumps by 1 across it), as an exporter splits them.
+#[allow(clippy::needless_range_loop)]
 fn seam_grid(n: usize) -> (Vec<f32>, Vec<f32>, Vec<u32>) {
     let mut pos = Vec::new();
     let mut uv = Vec::new();
@@ -187,11 +188,11 @@ fn document() -> (Value, Vec<u8>) {
 
 fn glb(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut j = serde_json::to_vec(json).unwrap();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let mut out = b"glTF".to_vec();
