@@ -504,6 +504,9 @@ fn read_accessor(doc: &gltf::Document, buffers: &[Vec<u8>], i: usize, name: &str
         })?;
     let bytes = &buffer[view.offset()..view_end];
     let count = acc.count();
+    if count == 0 {
+        return Err(here("count 0 (glTF asks for at least 1)".into()));
+    }
     // The last element's end, checked before anything the size of `count` is allocated.
     let need = count
         .checked_sub(1)
@@ -694,6 +697,12 @@ pub fn write(
     let mut new_accessors: Vec<Value> = Vec::new();
     let mut new_data: Vec<(Vec<u8>, usize, bool)> = Vec::new(); // (bytes, row, is indices)
     for (prim, tris) in file.primitives.iter().zip(results) {
+        if tris.is_empty() {
+            return Err(format!(
+                "{} has no triangle left: glTF has no empty accessors",
+                label(prim)
+            ));
+        }
         let (tris, old) = compact(tris, prim.positions.len())?;
         let pj = &mut json["meshes"][prim.mesh]["primitives"][prim.index];
         // Indices.

@@ -463,11 +463,7 @@ fn malformed_files_get_clear_errors() {
     // A missing accessor.
     let mut j = json.clone();
     j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(99);
-    assert!(
-        err(&j, &bin).contains("accessor 99"),
-        "{}",
-        err(&j, &bin)
-    );
+    assert!(err(&j, &bin).contains("accessor 99"), "{}", err(&j, &bin));
     // An index past the vertices.
     let mut b = bin.clone();
     let ia = json["meshes"][0]["primitives"][0]["indices"]
@@ -733,4 +729,78 @@ fn obj_keeps_texture_coordinates_normals_and_materials() {
     assert!(models
         .iter()
         .all(|m| !m.mesh.texcoords.is_empty() && !m.mesh.normals.is_empty()));
+}
+
+/// What the fuzz target `gltf` checks, on mutations of the test file: no panic; read files
+/// write and read back with the same attribute bytes per corner.
+fn round_trip(data: &[u8]) -> bool {
+    let Ok(file) = parse(data, None) else {
+        return false;
+    };
+    for p in &file.primitives {
+        let n = p.positions.len();
+        assert!(p.triangles.iter().flatten().all(|&i| (i as usize) < n));
+        for s in p.attributes.iter().chain(p.targets.iter().flatten()) {
+            assert_eq!(s.count(), n, "{}", s.semantic);
+        }
+    }
+    let results: Vec<Vec<[u32; 3]>> = file
+        .primitives
+        .iter()
+        .map(|p| p.triangles.clone())
+        .collect();
+    let (out, _) = write(&file, &results, true, "").expect("writes what it read");
+    let again = parse(&out, None).expect("reads what it wrote");
+    assert_eq!(again.primitives.len(), file.primitives.len());
+    for (a, b) in file.primitives.iter().zip(&again.primitives) {
+        assert_eq!(a.triangles.len(), b.triangles.len());
+        for (sa, sb) in a.attributes.iter().zip(&b.attributes) {
+            assert_eq!(sa.semantic, sb.semantic);
+            for (ta, tb) in a.triangles.iter().zip(&b.triangles) {
+                for k in 0..3 {
+                    assert_eq!(sa.element(ta[k] as usize), sb.element(tb[k] as usize));
+                }
+            }
+        }
+    }
+    true
+}
+
+#[test]
+fn mutated_files_never_panic() {
+    use rand::{RngExt, SeedableRng};
+    let (json, bin) = document();
+    let good = glb(&json, &bin);
+    assert!(round_trip(&good));
+    let mut read = 0;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    for _ in 0..3000 {
+        let mut b = good.clone();
+        for _ in 0..rng.random_range(1..8) {
+            let at = rng.random_range(0..b.len());
+            b[at] = rng.random();
+        }
+        read += usize::from(round_trip(&b));
+    }
+    // The JSON text mutated: digits changed in place.
+    let text = serde_json::to_string(&json).unwrap();
+    let digits: Vec<usize> = text
+        .bytes()
+        .enumerate()
+        .filter(|(_, c)| c.is_ascii_digit())
+        .map(|(i, _)| i)
+        .collect();
+    for _ in 0..3000 {
+        let mut t = text.clone().into_bytes();
+        for _ in 0..rng.random_range(1..4) {
+            let at = digits[rng.random_range(0..digits.len())];
+            t[at] = b"0123456789"[rng.random_range(0..10)];
+        }
+        read += usize::from(round_trip(&glb(
+            &serde_json::from_slice(&t).unwrap_or(json!({})),
+            &bin,
+        )));
+    }
+    // Enough mutants were read (and so written and read back) for the test to mean something.
+    assert!(read > 500, "only {read} mutants read");
 }
