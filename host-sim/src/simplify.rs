@@ -238,10 +238,11 @@ fn parse_samples(v: &str) -> std::result::Result<f64, String> {
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
 pub struct Args {
-    /// Input mesh (.obj, .ply, .stl; `-` reads standard input, the format found from the
-    /// bytes). Quads and n-gons are split into triangles (ear clipping). Only positions and
-    /// faces are read: attributes (texture coordinates, normals, colours) are not carried yet,
-    /// and a warning says which were dropped.
+    /// Input mesh (.obj, .ply, .stl, .gltf, .glb; `-` reads standard input, the format found
+    /// from the bytes). Quads and n-gons are split into triangles (ear clipping). glTF keeps
+    /// every vertex attribute and is written as glTF; an OBJ with texture coordinates or
+    /// normals written to OBJ keeps them and its materials. Otherwise only positions and faces
+    /// are read, and a warning says which attributes were dropped.
     pub input: PathBuf,
     /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
     /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no
