@@ -58,6 +58,7 @@ pub mod golden;
 pub mod io;
 pub mod metro;
 pub mod objattr;
+pub mod plyattr;
 pub mod pm;
 pub mod progress;
 pub mod qemu;

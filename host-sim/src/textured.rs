@@ -1,5 +1,6 @@
-//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::gltf`]) and OBJ
-//! with `vt`/`vn` ([`crate::objattr`]).
+//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::gltf`]), OBJ
+//! with `vt`/`vn` ([`crate::objattr`]) and PLY with vertex properties besides x, y, z
+//! ([`crate::plyattr`]).
 //!
 //! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
 //! the same configuration; `--target-triangles N` is shared among the parts in proportion to
@@ -72,7 +73,44 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
             return run_obj(args, &bytes).map(Some);
         }
     }
+    let is_ply = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
+    };
+    if is_ply(i)
+        && is_ply(o)
+        && args.format.is_none_or(|f| f == crate::io::Format::Ply)
+        && !args.keep_numbering
+    {
+        let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
+        let extra = crate::plyattr::extra_properties(&bytes);
+        if !extra.is_empty() {
+            refuse_optimal(args)?;
+            return run_ply(args, &bytes, &extra).map(Some);
+        }
+    }
     Ok(None)
+}
+
+fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
+    let file =
+        crate::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let parts = vec![("vertex element".to_string(), file.mesh.clone())];
+    let done = simplify_parts(args, &parts)?;
+    let out = crate::plyattr::write(&file, &done[0].triangles)
+        .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
+    std::fs::write(&args.output, out)
+        .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
+    let head = format!(
+        "simplify {} -> {} (PLY, vertex properties {} kept per vertex): {} -> {} triangles\n",
+        args.input.display(),
+        args.output.display(),
+        extra.join(", "),
+        file.mesh.triangles.len(),
+        done[0].triangles.len()
+    );
+    finish(args, head, &done)
 }
 
 fn refuse_optimal(args: &Args) -> Result<()> {

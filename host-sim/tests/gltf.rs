@@ -804,3 +804,68 @@ fn mutated_files_never_panic() {
     // Enough mutants were read (and so written and read back) for the test to mean something.
     assert!(read > 500, "only {read} mutants read");
 }
+
+#[test]
+fn ply_keeps_extra_vertex_properties() {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::DefaultElement;
+    let n = 10;
+    let mut s = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty uchar red\nproperty float s\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        (n + 1) * (n + 1),
+        n * n
+    );
+    for y in 0..=n {
+        for x in 0..=n {
+            s += &format!(
+                "{x} {y} {} 0.{x}{y} {} {}.5\n",
+                (x * y) % 3,
+                (x * 11 + y) % 256,
+                x
+            );
+        }
+    }
+    for y in 0..n {
+        for x in 0..n {
+            let v = y * (n + 1) + x;
+            s += &format!("4 {} {} {} {}\n", v, v + 1, v + n + 2, v + n + 1);
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("grid.ply");
+    std::fs::write(&input, &s).unwrap();
+    let output = dir.path().join("out.ply");
+    let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&output)
+        .args(["--ratio", "0.3"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{report}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(report.contains("nx, red, s kept"), "{report}");
+    let read = |bytes: &[u8]| {
+        Parser::<DefaultElement>::new()
+            .read_ply(&mut std::io::Cursor::new(bytes))
+            .unwrap()
+    };
+    let a = read(s.as_bytes());
+    let b = read(&std::fs::read(&output).unwrap());
+    let key = |e: &DefaultElement| format!("{e:?}");
+    let known: HashSet<String> = a.payload["vertex"].iter().map(key).collect();
+    let kept = &b.payload["vertex"];
+    assert!(kept.len() < (n + 1) * (n + 1) / 2);
+    for v in kept {
+        assert_eq!(v.len(), 6);
+        assert!(known.contains(&key(v)), "{v:?} is not an input vertex");
+    }
+    let faces = &b.payload["face"];
+    assert!(faces.len() < 2 * n * n / 2);
+}
