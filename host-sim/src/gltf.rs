@@ -28,7 +28,7 @@
 //!   gets it as a `.bin` file beside it (the output's name with `.bin`).
 //!
 //! Refused with a clear error: a primitive's accessor that is sparse, has no buffer view, or
-//! is a matrix; a POSITION that is not `f32` VEC3; attributes of different counts; an index
+//! is a matrix; a POSITION that is not `f32` VEC3 or not finite; attributes of different counts; an index
 //! past the vertex count; an index count not a multiple of 3; files requiring Draco or
 //! meshopt compression.
 
@@ -309,6 +309,12 @@ pub fn parse(bytes: &[u8], dir: Option<&Path>) -> R<GltfFile> {
                     [f(0), f(4), f(8)]
                 })
                 .collect();
+            if let Some(v) = positions
+                .iter()
+                .position(|p| p.iter().any(|c| !c.is_finite()))
+            {
+                return Err(here(format!("vertex {v} has a non-finite coordinate")));
+            }
             let mut targets = Vec::new();
             if let Some(ts) = pj["targets"].as_array() {
                 for t in ts {

@@ -61,14 +61,18 @@ impl ObjFile {
     }
 }
 
-/// Whether OBJ text has texture coordinates or normals (a `vt` or `vn` line).
+/// Whether an OBJ's faces use texture coordinates or normals (a corner `a/b`, `a//c` or
+/// `a/b/c`); `vt`/`vn` lines no face refers to do not count.
 pub fn has_attributes(bytes: &[u8]) -> bool {
     bytes.split(|&b| b == b'\n').any(|l| {
         let l = l.trim_ascii_start();
-        l.starts_with(b"vt ")
-            || l.starts_with(b"vn ")
-            || l.starts_with(b"vt\t")
-            || l.starts_with(b"vn\t")
+        (l.starts_with(b"f ") || l.starts_with(b"f\t"))
+            && l.split(|c| c.is_ascii_whitespace()).any(|corner| {
+                corner
+                    .iter()
+                    .position(|&c| c == b'/')
+                    .is_some_and(|k| corner[k + 1..].iter().any(u8::is_ascii_digit))
+            })
     })
 }
 

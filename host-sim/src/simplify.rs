@@ -241,8 +241,9 @@ pub struct Args {
     /// Input mesh (.obj, .ply, .stl, .gltf, .glb; `-` reads standard input, the format found
     /// from the bytes). Quads and n-gons are split into triangles (ear clipping). glTF keeps
     /// every vertex attribute and is written as glTF; an OBJ with texture coordinates or
-    /// normals written to OBJ keeps them and its materials. Otherwise only positions and faces
-    /// are read, and a warning says which attributes were dropped.
+    /// normals written to OBJ keeps them and its materials, a PLY written to PLY its vertex
+    /// properties. Otherwise only positions and faces are read: attributes are not carried,
+    /// and a warning says which were dropped.
     pub input: PathBuf,
     /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
     /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no

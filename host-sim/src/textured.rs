@@ -55,6 +55,14 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
             );
         }
         refuse_optimal(args)?;
+        // The output is checked before the long work, as on the plain path.
+        if o.is_dir() {
+            bail!("{}: is a directory, not a file to write", o.display());
+        }
+        if !o.exists() {
+            std::fs::File::create(o).map_err(|e| anyhow!("{}: cannot create: {e}", o.display()))?;
+            let _ = std::fs::remove_file(o);
+        }
         return run_gltf(args).map(Some);
     }
     let is_obj = |p: &Path| {
@@ -64,6 +72,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     };
     if is_obj(i)
         && is_obj(o)
+        && crate::io::check_writable(o, args.format).is_ok()
         && args.format.is_none_or(|f| f == crate::io::Format::Obj)
         && !args.keep_numbering
     {
@@ -80,6 +89,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     };
     if is_ply(i)
         && is_ply(o)
+        && crate::io::check_writable(o, args.format).is_ok()
         && args.format.is_none_or(|f| f == crate::io::Format::Ply)
         && !args.keep_numbering
     {
@@ -155,8 +165,16 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
             triangles: tris.clone(),
         };
         let mut line = format!(
-            "  {label}: {} -> {} triangles (target {}, stop {:?})",
-            report.triangles_in, report.triangles_out, report.target_triangles, report.stop
+            "  {label}: {} -> {} triangles (target {}, stop {:?}){}",
+            report.triangles_in,
+            report.triangles_out,
+            report.target_triangles,
+            report.stop,
+            if parts.len() == 1 {
+                format!("\n{}", crate::simplify::format_report(&report))
+            } else {
+                String::new()
+            }
         );
         let mut valid = true;
         let mut json = serde_json::json!({
@@ -202,13 +220,17 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
 fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
     let valid = parts.iter().all(|p| p.valid);
     if args.json {
-        let j = serde_json::json!({
+        let mut j = serde_json::json!({
             "input": args.input.display().to_string(),
             "output": args.output.display().to_string(),
             "parts": parts.iter().map(|p| p.json.clone()).collect::<Vec<_>>(),
             "triangles_out": parts.iter().map(|p| p.triangles.len()).sum::<usize>(),
             "valid": valid,
         });
+        if let [p] = parts {
+            // One part: its report where the plain path puts it.
+            j["report"] = p.json["report"].clone();
+        }
         crate::outln!("{}", serde_json::to_string_pretty(&j)?);
     } else {
         let mut text = head;

@@ -498,6 +498,10 @@ fn malformed_files_get_clear_errors() {
     let mut j = json.clone();
     j["accessors"][ia]["count"] = json!(json["accessors"][ia]["count"].as_u64().unwrap() - 1);
     assert!(err(&j, &bin).contains("multiple of 3"));
+    // A non-finite position (its min/max could not be written).
+    let mut b = bin.clone();
+    b[4..8].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert!(err(&json, &b).contains("non-finite"), "{}", err(&json, &b));
     // Attributes of different counts.
     let mut j = json.clone();
     let na = json["meshes"][0]["primitives"][0]["attributes"]["NORMAL"]
