@@ -31,6 +31,12 @@
 //!   -> the compacted triangles in the caller's buffer, and a `Report`
 //! ```
 //!
+//! Only positions and triangles are read. Normals, texture coordinates, colours and any other
+//! per-vertex attribute stay in the caller's buffers, indexed like the positions: with subset
+//! placement every vertex of the result is an input vertex, so they are exactly right for the
+//! result as they are. [`remap`] packs them (and the positions) after a run, in place; optimal
+//! placement moves vertices and does not interpolate attributes.
+//!
 //! ```
 //! use tinydecimate::{Config, Schedule, Workspace};
 //!
@@ -95,6 +101,7 @@ pub mod legality;
 mod math;
 mod mesh;
 pub mod progressive;
+pub mod remap;
 mod report;
 pub mod stream;
 pub mod triangle;

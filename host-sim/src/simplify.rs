@@ -288,9 +288,11 @@ fn parse_samples(v: &str) -> std::result::Result<f64, String> {
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
 pub struct Args {
-    /// Input mesh (.obj, .ply, .stl; `-` reads standard input, the format found from the
-    /// bytes). Quads and n-gons are split into triangles (ear clipping). Only positions and
-    /// faces are read: attributes (texture coordinates, normals, colours) are not carried yet,
+    /// Input mesh (.obj, .ply, .stl, .gltf, .glb; `-` reads standard input, the format found
+    /// from the bytes). Quads and n-gons are split into triangles (ear clipping). glTF keeps
+    /// every vertex attribute and is written as glTF; an OBJ with texture coordinates or
+    /// normals written to OBJ keeps them and its materials, a PLY written to PLY its vertex
+    /// properties. Otherwise only positions and faces are read: attributes are not carried,
     /// and a warning says which were dropped.
     pub input: PathBuf,
     /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
@@ -655,6 +657,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     let to_stdout = crate::io::is_std(&args.output);
     if to_stdout && args.json {
         bail!("--json and an output of `-` would both write standard output: give an output file");
+    }
+    // glTF, and OBJ with texture coordinates or normals: attributes carried (textured.rs).
+    if let Some(code) = crate::textured::run_if_attributes(args)? {
+        return Ok(code);
     }
     let out_format = crate::io::check_writable(&args.output, args.format)?;
     if !args.force && crate::io::same_file(&args.input, &args.output) {

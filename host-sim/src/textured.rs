@@ -1,0 +1,325 @@
+//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::gltf`]), OBJ
+//! with `vt`/`vn` ([`crate::objattr`]) and PLY with vertex properties besides x, y, z
+//! ([`crate::plyattr`]).
+//!
+//! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
+//! the same configuration; `--target-triangles N` is shared among the parts in proportion to
+//! their triangles. The validity check and the Metro error run per part, in the part's own
+//! coordinates (node transforms are not applied); the result is valid when every part is.
+//! The attributes of every kept vertex are those of an input vertex, bit for bit, because the
+//! library's subset placement only moves triangles. Optimal placement moves vertices without
+//! interpolating attributes, so `--placement optimal` is refused here.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::{anyhow, bail, Result};
+use tinydecimate::{Config, Report};
+
+use crate::io::MeshData;
+use crate::simplify::{Args, PlacementArg, QuadricArg};
+
+/// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
+/// report.
+fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
+    let stored = args.quadric == QuadricArg::Stored;
+    let (out, report, _) = if args.max_error.is_some() {
+        crate::simplify::simplify_bounded(mesh, config, stored, false)?
+    } else if stored {
+        crate::simplify::simplify_stored(
+            mesh,
+            config,
+            tinydecimate::cost::Placement::Subset,
+            false,
+        )?
+    } else {
+        crate::simplify::simplify(mesh, config)?
+    };
+    Ok((out.triangles, report))
+}
+
+/// Runs `simplify` here when the input or output is glTF, or the input is an OBJ with texture
+/// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
+pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
+    let (i, o) = (&args.input, &args.output);
+    let gi = crate::gltf::is_gltf_path(i);
+    let go = crate::gltf::is_gltf_path(o);
+    if gi || go {
+        if !(gi && go) {
+            bail!(
+                "glTF is read and written only as glTF: give both {} and {} a .gltf or .glb \
+                 extension",
+                i.display(),
+                o.display()
+            );
+        }
+        refuse_optimal(args)?;
+        // The output is checked before the long work, as on the plain path.
+        if o.is_dir() {
+            bail!("{}: is a directory, not a file to write", o.display());
+        }
+        if !o.exists() {
+            std::fs::File::create(o).map_err(|e| anyhow!("{}: cannot create: {e}", o.display()))?;
+            let _ = std::fs::remove_file(o);
+        }
+        return run_gltf(args).map(Some);
+    }
+    let is_obj = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
+    };
+    if is_obj(i)
+        && is_obj(o)
+        && crate::io::check_writable(o, args.format).is_ok()
+        && args.format.is_none_or(|f| f == crate::io::Format::Obj)
+        && !args.keep_numbering
+    {
+        let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
+        if crate::objattr::has_attributes(&bytes) {
+            refuse_optimal(args)?;
+            return run_obj(args, &bytes).map(Some);
+        }
+    }
+    let is_ply = |p: &Path| {
+        p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("ply"))
+    };
+    if is_ply(i)
+        && is_ply(o)
+        && crate::io::check_writable(o, args.format).is_ok()
+        && args.format.is_none_or(|f| f == crate::io::Format::Ply)
+        && !args.keep_numbering
+    {
+        let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
+        let extra = crate::plyattr::extra_properties(&bytes);
+        if !extra.is_empty() {
+            refuse_optimal(args)?;
+            return run_ply(args, &bytes, &extra).map(Some);
+        }
+    }
+    Ok(None)
+}
+
+fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
+    let file =
+        crate::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let parts = vec![("vertex element".to_string(), file.mesh.clone())];
+    let done = simplify_parts(args, &parts)?;
+    let out = crate::plyattr::write(&file, &done[0].triangles)
+        .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
+    std::fs::write(&args.output, out)
+        .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
+    let head = format!(
+        "simplify {} -> {} (PLY, vertex properties {} kept per vertex): {} -> {} triangles\n",
+        args.input.display(),
+        args.output.display(),
+        extra.join(", "),
+        file.mesh.triangles.len(),
+        done[0].triangles.len()
+    );
+    finish(args, head, &done)
+}
+
+fn refuse_optimal(args: &Args) -> Result<()> {
+    if args.quadric == QuadricArg::Stored && args.placement == PlacementArg::Optimal {
+        bail!(
+            "{}: the mesh has vertex attributes (texture coordinates, normals, ...) and optimal \
+             placement moves vertices without interpolating them: use --placement subset",
+            args.input.display()
+        );
+    }
+    Ok(())
+}
+
+/// One part's outcome.
+struct Part {
+    triangles: Vec<[u32; 3]>,
+    line: String,
+    valid: bool,
+    json: serde_json::Value,
+}
+
+/// Simplifies each mesh of `parts` with `args`' configuration.
+fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>> {
+    let total: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let mut out = Vec::new();
+    for (label, mesh) in parts {
+        let mut config = args.config();
+        if let Some(n) = args.target_triangles {
+            let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
+            config = config.with_target_triangles(share as usize);
+        }
+        if let Some(e) = args.max_error {
+            config = config.with_max_error(e.distance(&mesh.positions));
+        }
+        config
+            .validate()
+            .map_err(|e| anyhow!("configuration: {e}"))?;
+        let (tris, report) =
+            run_library(mesh, &config, args).map_err(|e| anyhow!("{label}: {e}"))?;
+        let result = MeshData {
+            positions: mesh.positions.clone(),
+            triangles: tris.clone(),
+        };
+        let mut line = format!(
+            "  {label}: {} -> {} triangles (target {}, stop {:?}){}",
+            report.triangles_in,
+            report.triangles_out,
+            report.target_triangles,
+            report.stop,
+            if parts.len() == 1 {
+                format!("\n{}", crate::simplify::format_report(&report))
+            } else {
+                String::new()
+            }
+        );
+        let mut valid = true;
+        let mut json = serde_json::json!({
+            "part": label,
+            "report": crate::simplify::report_json(&report),
+        });
+        if !args.no_measure {
+            let v = crate::check::compare_with(mesh, &result, false);
+            valid = v.is_valid();
+            let opts = crate::metro::MetroOptions {
+                samples_per_triangle: args.samples_per_triangle,
+                progress: false,
+                ..Default::default()
+            };
+            let m = crate::metro::metro(mesh, &result, &opts);
+            let _ = write!(
+                line,
+                ", {}, Metro max {:.4} % mean {:.4} % of the diagonal",
+                if valid { "valid" } else { "NOT valid" },
+                m.hausdorff_pct,
+                m.symmetric_mean_pct
+            );
+            if !valid {
+                for d in &v.defects {
+                    let _ = write!(line, "\n    {d}");
+                }
+            }
+            json["valid"] = serde_json::Value::Bool(valid);
+            json["defects"] =
+                serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
+            json["metro"] = serde_json::to_value(&m)?;
+        }
+        out.push(Part {
+            triangles: tris,
+            line,
+            valid,
+            json,
+        });
+    }
+    Ok(out)
+}
+
+fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
+    let valid = parts.iter().all(|p| p.valid);
+    if args.json {
+        let mut j = serde_json::json!({
+            "input": args.input.display().to_string(),
+            "output": args.output.display().to_string(),
+            "parts": parts.iter().map(|p| p.json.clone()).collect::<Vec<_>>(),
+            "triangles_out": parts.iter().map(|p| p.triangles.len()).sum::<usize>(),
+            "valid": valid,
+        });
+        if let [p] = parts {
+            // One part: its report where the plain path puts it.
+            j["report"] = p.json["report"].clone();
+        }
+        crate::outln!("{}", serde_json::to_string_pretty(&j)?);
+    } else {
+        let mut text = head;
+        for p in parts {
+            let _ = writeln!(text, "{}", p.line);
+        }
+        crate::out!("{text}");
+    }
+    Ok(if valid {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn run_gltf(args: &Args) -> Result<ExitCode> {
+    let file = crate::gltf::load(&args.input)?;
+    for p in &file.passed_through {
+        eprintln!(
+            "note: {}: {p} is not triangles: passed through unsimplified",
+            args.input.display()
+        );
+    }
+    let parts: Vec<(String, MeshData)> = file
+        .primitives
+        .iter()
+        .map(|p| {
+            (
+                crate::gltf::label(p),
+                MeshData {
+                    positions: p.positions.clone(),
+                    triangles: p.triangles.clone(),
+                },
+            )
+        })
+        .collect();
+    let done = simplify_parts(args, &parts)?;
+    let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
+    crate::gltf::save(&args.output, &file, &results)?;
+    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let tout: usize = results.iter().map(Vec::len).sum();
+    let head = format!(
+        "simplify {} -> {} (glTF, {} triangle primitive(s), attributes {} kept per vertex): \
+         {tin} -> {tout} triangles\n",
+        args.input.display(),
+        args.output.display(),
+        parts.len(),
+        crate::gltf::attribute_summary(&file)
+    );
+    finish(args, head, &done)
+}
+
+fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
+    let file =
+        crate::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let parts: Vec<(String, MeshData)> = (0..file.groups.len())
+        .filter(|&g| !file.groups[g].triangles.is_empty())
+        .map(|g| {
+            let name = file.groups[g]
+                .material
+                .as_deref()
+                .map_or("no material".to_string(), |m| format!("material {m}"));
+            (name, file.mesh(g))
+        })
+        .collect();
+    let done = simplify_parts(args, &parts)?;
+    let mut results = Vec::new();
+    let mut k = 0;
+    for g in &file.groups {
+        if g.triangles.is_empty() {
+            results.push(Vec::new());
+        } else {
+            results.push(done[k].triangles.clone());
+            k += 1;
+        }
+    }
+    let text = crate::objattr::write(&file, &results);
+    std::fs::write(&args.output, text)
+        .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
+    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let tout: usize = results.iter().map(Vec::len).sum();
+    let head = format!(
+        "simplify {} -> {} (OBJ with {} texture coordinates, {} normals kept per vertex, {} \
+         material group(s)): {tin} -> {tout} triangles\n",
+        args.input.display(),
+        args.output.display(),
+        file.vt_text.len(),
+        file.vn_text.len(),
+        parts.len()
+    );
+    finish(args, head, &done)
+}

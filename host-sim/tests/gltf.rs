@@ -1,0 +1,875 @@
+//! glTF and OBJ with attributes through `simplify`: files built here (a grid split on a UV
+//! seam with normals, colours and a texture, a second interleaved primitive, a non-indexed
+//! one, a node transform, extras), simplified, written, and read back by the `gltf` crate and
+//! by a second reader of our own; every kept vertex's attributes must be bit-identical to an
+//! input vertex's. Malformed files must give errors, never panics or huge allocations.
+
+use std::collections::HashSet;
+use std::process::Command;
+
+use host_sim::gltf::{parse, write, GltfFile};
+use serde_json::{json, Value};
+
+/// Accessors, views and one binary buffer, built up in order.
+#[derive(Default)]
+struct Builder {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Builder {
+    fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
+        while !self.bin.len().is_multiple_of(4) {
+            self.bin.push(0);
+        }
+        let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
+        if let Some(s) = stride {
+            v["byteStride"] = json!(s);
+        }
+        self.bin.extend_from_slice(bytes);
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    fn accessor(&mut self, view: usize, offset: usize, ct: u32, ty: &str, count: usize) -> usize {
+        self.accessors.push(json!({
+            "bufferView": view, "byteOffset": offset, "componentType": ct, "count": count, "type": ty
+        }));
+        self.accessors.len() - 1
+    }
+
+    fn floats(&mut self, data: &[f32], ty: &str, n: usize) -> usize {
+        let b: Vec<u8> = data.iter().flat_map(|x| x.to_le_bytes()).collect();
+        let v = self.view(&b, None);
+        let a = self.accessor(v, 0, 5126, ty, data.len() / n);
+        if ty == "VEC3" && n == 3 {
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for p in data.chunks(3) {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            self.accessors[a]["min"] = json!(lo);
+            self.accessors[a]["max"] = json!(hi);
+        }
+        a
+    }
+}
+
+/// A grid of `n`x`n` quads split on a UV seam down its middle column: the seam's vertices are
+/// doubled (u jumps by 1 across it), as an exporter splits them.
+#[allow(clippy::needless_range_loop)]
+fn seam_grid(n: usize) -> (Vec<f32>, Vec<f32>, Vec<u32>) {
+    let mut pos = Vec::new();
+    let mut uv = Vec::new();
+    let mut id = vec![[0u32; 2]; (n + 1) * (n + 1)];
+    let mid = n / 2;
+    for y in 0..=n {
+        for x in 0..=n {
+            let z = ((x * 7 + y * 3) % 5) as f32 * 0.02;
+            let copies = if x == mid { 2 } else { 1 };
+            for c in 0..copies {
+                id[y * (n + 1) + x][c] = (pos.len() / 3) as u32;
+                pos.extend_from_slice(&[x as f32 / n as f32, y as f32 / n as f32, z]);
+                let shift = if x > mid || c == 1 { 1.0 } else { 0.0 };
+                uv.extend_from_slice(&[x as f32 / n as f32 + shift, y as f32 / n as f32]);
+            }
+            if copies == 1 {
+                id[y * (n + 1) + x][1] = id[y * (n + 1) + x][0];
+            }
+        }
+    }
+    let mut idx = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let side = usize::from(x >= mid);
+            let v = |xx: usize, yy: usize| id[yy * (n + 1) + xx][side];
+            idx.extend_from_slice(&[v(x, y), v(x + 1, y), v(x + 1, y + 1)]);
+            idx.extend_from_slice(&[v(x, y), v(x + 1, y + 1), v(x, y + 1)]);
+        }
+    }
+    (pos, uv, idx)
+}
+
+/// The test document: three primitives in two meshes, a node transform, a textured material,
+/// extras. Returns the JSON and the binary buffer.
+fn document() -> (Value, Vec<u8>) {
+    let mut b = Builder::default();
+    // Primitive A: the seam grid, u16 indices, POSITION, NORMAL, TEXCOORD_0, COLOR_0 (u8).
+    let (pos, uv, idx) = seam_grid(12);
+    let nv = pos.len() / 3;
+    let pa = b.floats(&pos, "VEC3", 3);
+    let normals: Vec<f32> = (0..nv)
+        .flat_map(|i| [0.0, (i as f32) * 1e-3, 1.0])
+        .collect();
+    let na = b.floats(&normals, "VEC3", 3);
+    let ta = b.floats(&uv, "VEC2", 2);
+    let colors: Vec<u8> = (0..nv)
+        .flat_map(|i| [i as u8, (i * 3) as u8, 7, 255])
+        .collect();
+    let cv = b.view(&colors, None);
+    let ca = b.accessor(cv, 0, 5121, "VEC4", nv);
+    b.accessors[ca]["normalized"] = json!(true);
+    let ib: Vec<u8> = idx.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
+    let iv = b.view(&ib, None);
+    let ia = b.accessor(iv, 0, 5123, "SCALAR", idx.len());
+
+    // Primitive B: a 6x6 grid, POSITION and NORMAL interleaved (stride 24), u8 indices.
+    let m = 6;
+    let mut inter = Vec::new();
+    for y in 0..=m {
+        for x in 0..=m {
+            for f in [
+                x as f32,
+                y as f32,
+                ((x * y) % 3) as f32 * 0.1,
+                0.0,
+                0.0,
+                1.0,
+            ] {
+                inter.extend_from_slice(&f.to_le_bytes());
+            }
+        }
+    }
+    let vv = b.view(&inter, Some(24));
+    let nb = (m + 1) * (m + 1);
+    let pb = b.accessor(vv, 0, 5126, "VEC3", nb);
+    b.accessors[pb]["min"] = json!([0.0, 0.0, 0.0]);
+    b.accessors[pb]["max"] = json!([m as f32, m as f32, 0.2]);
+    let nbn = b.accessor(vv, 12, 5126, "VEC3", nb);
+    let mut ib8 = Vec::new();
+    for y in 0..m {
+        for x in 0..m {
+            let v = (y * (m + 1) + x) as u8;
+            let w = (m + 1) as u8;
+            ib8.extend_from_slice(&[v, v + 1, v + w + 1, v, v + w + 1, v + w]);
+        }
+    }
+    let ivb = b.view(&ib8, None);
+    let ib_acc = b.accessor(ivb, 0, 5121, "SCALAR", ib8.len());
+
+    // Primitive C: not indexed, one quad.
+    let quad = [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0,
+    ];
+    let pc = b.floats(&quad, "VEC3", 3);
+
+    let json = json!({
+        "asset": {"version": "2.0", "generator": "tinydecimate test"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"mesh": 0, "translation": [1.0, 2.0, 3.0], "rotation": [0.0, 0.0, 0.70710677, 0.70710677],
+             "extras": {"keep": "me"}},
+            {"mesh": 1, "scale": [2.0, 2.0, 2.0], "name": "second"}
+        ],
+        "meshes": [
+            {"primitives": [
+                {"attributes": {"POSITION": pa, "NORMAL": na, "TEXCOORD_0": ta, "COLOR_0": ca},
+                 "indices": ia, "material": 0, "extras": {"part": "A"}},
+                {"attributes": {"POSITION": pc}}
+            ]},
+            {"primitives": [{"attributes": {"POSITION": pb, "NORMAL": nbn}, "indices": ib_acc, "mode": 4}]}
+        ],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "name": "checker"}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9729}],
+        "images": [{"uri": "checker.png"}],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{"byteLength": b.bin.len()}],
+        "extras": {"author": "test"}
+    });
+    (json, b.bin)
+}
+
+fn glb(json: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).unwrap();
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((12 + 8 + j.len() + 8 + b.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b);
+    out
+}
+
+/// Every vertex of every primitive as the `gltf` crate reads it: the primitive's label and
+/// the bits of position, normal, uv and colour.
+type Vertex = (
+    usize,
+    [u32; 3],
+    Option<[u32; 3]>,
+    Option<[u32; 2]>,
+    Option<[u8; 4]>,
+);
+
+/// Reads with the `gltf` crate (validation, then its accessor reader over the BIN chunk):
+/// each primitive's vertices and triangle count, in mesh order.
+fn read_with_gltf_crate(bytes: &[u8]) -> Vec<(Vec<Vertex>, Vec<u32>)> {
+    let g = gltf::Gltf::from_slice(bytes).expect("the gltf crate reads the output");
+    let blob = g.blob.clone().expect("a BIN chunk");
+    let mut out = Vec::new();
+    let mut k = 0;
+    for mesh in g.document.meshes() {
+        for p in mesh.primitives() {
+            let r = p.reader(|b| (b.index() == 0).then_some(&blob[..]));
+            let pos: Vec<[f32; 3]> = r.read_positions().unwrap().collect();
+            let nrm: Option<Vec<[f32; 3]>> = r.read_normals().map(|n| n.collect());
+            let uv: Option<Vec<[f32; 2]>> = r.read_tex_coords(0).map(|t| t.into_f32().collect());
+            let col: Option<Vec<[u8; 4]>> = r.read_colors(0).map(|c| c.into_rgba_u8().collect());
+            let idx: Vec<u32> = match r.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..pos.len() as u32).collect(),
+            };
+            let verts = (0..pos.len())
+                .map(|i| {
+                    (
+                        k,
+                        pos[i].map(f32::to_bits),
+                        nrm.as_ref().map(|n| n[i].map(f32::to_bits)),
+                        uv.as_ref().map(|t| t[i].map(f32::to_bits)),
+                        col.as_ref().map(|c| c[i]),
+                    )
+                })
+                .collect();
+            out.push((verts, idx));
+            k += 1;
+        }
+    }
+    out
+}
+
+/// The second reader: JSON by serde_json, GLB chunks and accessor ranges checked by hand.
+fn check_ranges_by_hand(bytes: &[u8]) -> Value {
+    assert_eq!(&bytes[..4], b"glTF");
+    let u = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!(u(4), 2);
+    assert_eq!(u(8), bytes.len());
+    let jl = u(12);
+    assert_eq!(&bytes[16..20], b"JSON");
+    assert_eq!(jl % 4, 0);
+    let json: Value = serde_json::from_slice(&bytes[20..20 + jl]).unwrap();
+    let bl = u(20 + jl);
+    assert_eq!(&bytes[24 + jl..28 + jl], b"BIN\0");
+    assert_eq!(28 + jl + bl, bytes.len());
+    let bin = &bytes[28 + jl..];
+    let buffers = json["buffers"].as_array().unwrap();
+    assert_eq!(buffers.len(), 1);
+    let blen = buffers[0]["byteLength"].as_u64().unwrap() as usize;
+    assert!(blen <= bin.len() && bin.len() - blen < 4);
+    let views = json["bufferViews"].as_array().unwrap();
+    for v in views {
+        let end = v["byteOffset"].as_u64().unwrap_or(0) + v["byteLength"].as_u64().unwrap();
+        assert!(end as usize <= blen, "view {v} past the buffer");
+    }
+    for a in json["accessors"].as_array().unwrap() {
+        let v = &views[a["bufferView"].as_u64().unwrap() as usize];
+        let csize = match a["componentType"].as_u64().unwrap() {
+            5120 | 5121 => 1,
+            5122 | 5123 => 2,
+            _ => 4,
+        };
+        let n = match a["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC2" => 2,
+            "VEC3" => 3,
+            "VEC4" => 4,
+            "MAT4" => 16,
+            t => panic!("type {t}"),
+        };
+        let elem = csize * n;
+        let stride = v["byteStride"].as_u64().map_or(elem, |s| s as usize);
+        let count = a["count"].as_u64().unwrap() as usize;
+        let off = a["byteOffset"].as_u64().unwrap_or(0) as usize;
+        assert!(count > 0);
+        assert!(off + stride * (count - 1) + elem <= v["byteLength"].as_u64().unwrap() as usize);
+        assert_eq!(
+            (v["byteOffset"].as_u64().unwrap_or(0) as usize + off) % csize,
+            0
+        );
+    }
+    // POSITION's min and max are those of its data.
+    for m in json["meshes"].as_array().unwrap() {
+        for p in m["primitives"].as_array().unwrap() {
+            let a = &json["accessors"][p["attributes"]["POSITION"].as_u64().unwrap() as usize];
+            let v = &views[a["bufferView"].as_u64().unwrap() as usize];
+            let start = v["byteOffset"].as_u64().unwrap_or(0) as usize
+                + a["byteOffset"].as_u64().unwrap_or(0) as usize;
+            let stride = v["byteStride"].as_u64().map_or(12, |s| s as usize);
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for i in 0..a["count"].as_u64().unwrap() as usize {
+                for k in 0..3 {
+                    let at = start + i * stride + 4 * k;
+                    let x = f32::from_le_bytes(bin[at..at + 4].try_into().unwrap());
+                    lo[k] = lo[k].min(x);
+                    hi[k] = hi[k].max(x);
+                }
+            }
+            assert_eq!(a["min"], json!(lo));
+            assert_eq!(a["max"], json!(hi));
+        }
+    }
+    json
+}
+
+fn simplify_all(file: &GltfFile, ratio: f32) -> Vec<Vec<[u32; 3]>> {
+    let config = tinydecimate::Config::new().with_ratio(ratio);
+    file.primitives
+        .iter()
+        .map(|p| {
+            let mesh = host_sim::io::MeshData {
+                positions: p.positions.clone(),
+                triangles: p.triangles.clone(),
+            };
+            host_sim::simplify::simplify(&mesh, &config)
+                .unwrap()
+                .0
+                .triangles
+        })
+        .collect()
+}
+
+#[test]
+fn glb_round_trip_keeps_every_attribute_bit_for_bit() {
+    let (json, bin) = document();
+    let input = glb(&json, &bin);
+    let file = parse(&input, None).unwrap();
+    assert_eq!(file.primitives.len(), 3);
+    let results = simplify_all(&file, 0.25);
+    // The grid really was simplified.
+    assert!(results[0].len() < file.primitives[0].triangles.len() / 2);
+    assert!(results[2].len() < file.primitives[2].triangles.len() / 2);
+    let (out, bin_out) = write(&file, &results, true, "unused.bin").unwrap();
+    assert!(bin_out.is_none());
+
+    let before = read_with_gltf_crate(&input);
+    let after = read_with_gltf_crate(&out);
+    assert_eq!(after.len(), before.len());
+    // Primitive order in the crate's reading: mesh 0 (A, C), mesh 1 (B); results follow
+    // file.primitives, which is the same order.
+    for (k, ((vin, _), (vout, iout))) in before.iter().zip(&after).enumerate() {
+        let known: HashSet<&Vertex> = vin.iter().collect();
+        for v in vout {
+            assert!(
+                known.contains(v),
+                "primitive {k}: vertex {v:?} is not an input vertex"
+            );
+        }
+        assert_eq!(
+            iout.len(),
+            results[k].len() * 3,
+            "primitive {k}: triangle count"
+        );
+        // Unused vertices dropped: every output vertex is used.
+        let used: HashSet<u32> = iout.iter().copied().collect();
+        assert_eq!(
+            used.len(),
+            vout.len(),
+            "primitive {k}: unused vertices kept"
+        );
+        // The same triangles, vertex by vertex, as the library's result.
+        let p = &file.primitives[k];
+        for (t, tri) in results[k].iter().enumerate() {
+            for c in 0..3 {
+                let want = &vin[tri[c] as usize];
+                let got = &vout[iout[3 * t + c] as usize];
+                assert_eq!(want, got, "primitive {k} triangle {t}");
+            }
+        }
+        assert_eq!(p.attributes.len(), file.primitives[k].attributes.len());
+    }
+
+    let j = check_ranges_by_hand(&out);
+    // Passed through untouched.
+    for key in [
+        "asset",
+        "scene",
+        "scenes",
+        "nodes",
+        "materials",
+        "textures",
+        "samplers",
+        "images",
+        "extras",
+    ] {
+        assert_eq!(j[key], json[key], "{key}");
+    }
+    assert_eq!(j["meshes"][0]["primitives"][0]["material"], json!(0));
+    assert_eq!(
+        j["meshes"][0]["primitives"][0]["extras"],
+        json!({"part": "A"})
+    );
+    // Only the new accessors are left (3 + 1 + 1 indices and attributes), and their views.
+    assert_eq!(j["accessors"].as_array().unwrap().len(), 5 + 2 + 3);
+    assert!(out.len() < input.len());
+
+    // Read back by our own reader: the same vertices as the crate saw.
+    let again = parse(&out, None).unwrap();
+    for (p, (vout, _)) in again.primitives.iter().zip(&after) {
+        assert_eq!(p.positions.len(), vout.len());
+    }
+}
+
+#[test]
+fn gltf_with_bin_beside_it_reads_back_the_same() {
+    let (json, bin) = document();
+    let file = parse(&glb(&json, &bin), None).unwrap();
+    let results = simplify_all(&file, 0.25);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("out model.gltf");
+    host_sim::gltf::save(&path, &file, &results).unwrap();
+    let text: Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(text["buffers"][0]["uri"], json!("out model.bin"));
+    let back = host_sim::gltf::load(&path).unwrap();
+    let (glb_bytes, _) = write(&file, &results, true, "").unwrap();
+    let via_glb = parse(&glb_bytes, None).unwrap();
+    assert_eq!(back.primitives, via_glb.primitives);
+    // A data: URI buffer reads like the BIN chunk.
+    use base64::Engine as _;
+    let mut embedded = json.clone();
+    embedded["buffers"][0]["uri"] = json!(format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    ));
+    let e = parse(&serde_json::to_vec(&embedded).unwrap(), None).unwrap();
+    assert_eq!(e.primitives, file.primitives);
+}
+
+fn err(json: &Value, bin: &[u8]) -> String {
+    match parse(&glb(json, bin), None) {
+        Ok(_) => panic!("accepted: {json}"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn malformed_files_get_clear_errors() {
+    let (json, bin) = document();
+    // A missing accessor.
+    let mut j = json.clone();
+    j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(99);
+    assert!(err(&j, &bin).contains("accessor 99"), "{}", err(&j, &bin));
+    // An index past the vertices.
+    let mut b = bin.clone();
+    let ia = json["meshes"][0]["primitives"][0]["indices"]
+        .as_u64()
+        .unwrap() as usize;
+    let view = json["accessors"][ia]["bufferView"].as_u64().unwrap() as usize;
+    let at = json["bufferViews"][view]["byteOffset"].as_u64().unwrap() as usize;
+    b[at..at + 2].copy_from_slice(&60000u16.to_le_bytes());
+    assert!(err(&json, &b).contains("past the"), "{}", err(&json, &b));
+    // Huge counts: refused before anything of that size is allocated (4 G elements of 12
+    // bytes would abort the test).
+    for count in [u32::MAX as u64, 1 << 40, 100_000] {
+        let mut j = json.clone();
+        j["accessors"][0]["count"] = json!(count);
+        let e = err(&j, &bin);
+        assert!(e.contains("do not fit"), "{e}");
+    }
+    // A view past its buffer, a stride below the element, a sparse accessor.
+    let mut j = json.clone();
+    j["bufferViews"][0]["byteLength"] = json!(1 << 30);
+    assert!(!err(&j, &bin).is_empty());
+    let mut j = json.clone();
+    j["bufferViews"][0]["byteStride"] = json!(8);
+    assert!(err(&j, &bin).contains("byteStride"));
+    let mut j = json.clone();
+    j["accessors"][0]["sparse"] = json!({"count": 1, "indices": {"bufferView": 0, "componentType": 5125}, "values": {"bufferView": 0}});
+    assert!(err(&j, &bin).contains("sparse"));
+    // POSITION not float VEC3, corners not a multiple of 3.
+    let mut j = json.clone();
+    j["accessors"][0]["componentType"] = json!(5123);
+    assert!(err(&j, &bin).contains("only float VEC3"));
+    let mut j = json.clone();
+    j["accessors"][ia]["count"] = json!(json["accessors"][ia]["count"].as_u64().unwrap() - 1);
+    assert!(err(&j, &bin).contains("multiple of 3"));
+    // A non-finite position (its min/max could not be written).
+    let mut b = bin.clone();
+    b[4..8].copy_from_slice(&f32::NAN.to_le_bytes());
+    assert!(err(&json, &b).contains("non-finite"), "{}", err(&json, &b));
+    // Attributes of different counts.
+    let mut j = json.clone();
+    let na = json["meshes"][0]["primitives"][0]["attributes"]["NORMAL"]
+        .as_u64()
+        .unwrap() as usize;
+    j["accessors"][na]["count"] = json!(3);
+    assert!(err(&j, &bin).contains("elements, POSITION"));
+    // A missing buffer: an external file where none can be read, a file that is not there,
+    // a GLB without its BIN chunk.
+    let mut j = json.clone();
+    j["buffers"][0]["uri"] = json!("missing.bin");
+    let text = serde_json::to_vec(&j).unwrap();
+    assert!(parse(&text, None).unwrap_err().contains("not available"));
+    let dir = tempfile::tempdir().unwrap();
+    assert!(parse(&text, Some(dir.path()))
+        .unwrap_err()
+        .contains("cannot read"));
+    let short = glb(&json, &[]);
+    let no_bin = &short[..short.len() - 8];
+    let mut no_bin = no_bin.to_vec();
+    let l = no_bin.len() as u32;
+    no_bin[8..12].copy_from_slice(&l.to_le_bytes());
+    assert!(parse(&no_bin, None).is_err());
+    // Draco compression is named.
+    let mut j = json.clone();
+    j["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+    j["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    assert!(err(&j, &bin).contains("Draco") || err(&j, &bin).contains("draco"));
+}
+
+#[test]
+fn every_truncation_and_header_lie_is_an_error() {
+    let (json, bin) = document();
+    let good = glb(&json, &bin);
+    for len in 0..good.len() {
+        assert!(
+            parse(&good[..len], None).is_err(),
+            "prefix of {len} bytes accepted"
+        );
+    }
+    // A header or chunk claiming more than the file holds.
+    for (at, v) in [(8, u32::MAX), (8, 3), (12, u32::MAX), (4, 1)] {
+        let mut b = good.clone();
+        b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        assert!(parse(&b, None).is_err());
+    }
+    let jl = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let mut b = good.clone();
+    b[20 + jl..24 + jl].copy_from_slice(&u32::MAX.to_le_bytes());
+    let e = parse(&b, None).unwrap_err();
+    assert!(e.contains("truncated"), "{e}");
+}
+
+#[test]
+fn simplify_command_writes_glb_and_refuses_optimal_placement() {
+    let dir = tempfile::tempdir().unwrap();
+    let (json, bin) = document();
+    let input = dir.path().join("in.glb");
+    std::fs::write(&input, glb(&json, &bin)).unwrap();
+    let output = dir.path().join("out.glb");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_host-sim"))
+            .arg("simplify")
+            .arg(&input)
+            .arg(&output)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["--ratio", "0.25"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        text.contains("mesh 0 primitive 0") && text.contains("valid"),
+        "{text}"
+    );
+    assert!(!text.contains("NOT valid"), "{text}");
+    let out = std::fs::read(&output).unwrap();
+    assert!(gltf::Gltf::from_slice(&out).is_ok());
+    check_ranges_by_hand(&out);
+    let o = run(&[
+        "--ratio",
+        "0.25",
+        "--quadric",
+        "stored",
+        "--placement",
+        "optimal",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("optimal placement moves vertices"));
+    // glTF in, OBJ out: refused with the reason.
+    let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["simplify"])
+        .arg(&input)
+        .arg(dir.path().join("x.obj"))
+        .args(["--ratio", "0.5"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("only as glTF"));
+}
+
+#[test]
+fn obj_keeps_texture_coordinates_normals_and_materials() {
+    // The seam grid as OBJ: positions shared across the seam, texture coordinates split.
+    let n = 10;
+    let mut s = String::from("mtllib grid.mtl\n");
+    for y in 0..=n {
+        for x in 0..=n {
+            s += &format!(
+                "v {} {} {} 0.5 0.25 1\n",
+                x as f32 / n as f32,
+                y,
+                ((x * 7 + y * 3) % 5) as f32 * 0.02
+            );
+        }
+    }
+    for y in 0..=n {
+        for x in 0..=n {
+            s += &format!("vt {} {}\n", x as f32 / n as f32, y as f32 / n as f32);
+        }
+    }
+    // The seam's second texture coordinates.
+    for y in 0..=n {
+        s += &format!("vt 1.{} {}\n", y, y as f32 / n as f32);
+    }
+    s += "vn 0 0 1\nvn 0 0.1 0.99\n";
+    let vt_seam = (n + 1) * (n + 1);
+    for (mat, rows) in [("left", 0..n / 2), ("right", n / 2..n)] {
+        s += &format!("usemtl {mat}\n");
+        for y in rows {
+            for x in 0..n {
+                let v = |xx: usize, yy: usize| yy * (n + 1) + xx + 1;
+                let t = |xx: usize, yy: usize| {
+                    if xx == n / 2 && x >= n / 2 {
+                        vt_seam + yy + 1
+                    } else {
+                        v(xx, yy)
+                    }
+                };
+                let c = |xx: usize, yy: usize| {
+                    format!("{}/{}/{}", v(xx, yy), t(xx, yy), 1 + (xx + yy) % 2)
+                };
+                // A quad: the reader splits it.
+                s += &format!(
+                    "f {} {} {} {}\n",
+                    c(x, y),
+                    c(x + 1, y),
+                    c(x + 1, y + 1),
+                    c(x, y + 1)
+                );
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("grid.obj");
+    std::fs::write(&input, &s).unwrap();
+    let output = dir.path().join("out.obj");
+    let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&output)
+        .args(["--ratio", "0.3"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{report}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        report.contains("material left") && report.contains("material right"),
+        "{report}"
+    );
+    let out = std::fs::read_to_string(&output).unwrap();
+    assert!(out.starts_with("mtllib grid.mtl\n"));
+    assert!(out.contains("usemtl left\n") && out.contains("usemtl right\n"));
+    // Every output corner's (v, vt, vn) text is an input corner's.
+    let corners = |text: &str| -> Vec<(String, String, String)> {
+        let (mut v, mut t, mut nn) = (vec![], vec![], vec![]);
+        let mut out = vec![];
+        for l in text.lines() {
+            let (k, rest) = l.split_once(' ').unwrap_or((l, ""));
+            match k {
+                "v" => v.push(rest.to_string()),
+                "vt" => t.push(rest.to_string()),
+                "vn" => nn.push(rest.to_string()),
+                "f" => {
+                    for c in rest.split_whitespace() {
+                        let i: Vec<usize> = c.split('/').map(|x| x.parse().unwrap()).collect();
+                        out.push((
+                            v[i[0] - 1].clone(),
+                            t[i[1] - 1].clone(),
+                            nn[i[2] - 1].clone(),
+                        ));
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
+    };
+    let inputs: HashSet<_> = corners(&s).into_iter().collect();
+    let outputs = corners(&out);
+    assert!(
+        outputs.len() / 3 < 2 * n * n / 2,
+        "not simplified: {} triangles",
+        outputs.len() / 3
+    );
+    for c in &outputs {
+        assert!(inputs.contains(c), "{c:?} is not an input corner");
+    }
+    // tobj, an independent reader, reads the output with the same counts.
+    let (models, _) = tobj::load_obj(
+        &output,
+        &tobj::LoadOptions {
+            triangulate: false,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let faces: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    assert_eq!(faces, outputs.len() / 3);
+    assert!(models
+        .iter()
+        .all(|m| !m.mesh.texcoords.is_empty() && !m.mesh.normals.is_empty()));
+}
+
+/// What the fuzz target `gltf` checks, on mutations of the test file: no panic; read files
+/// write and read back with the same attribute bytes per corner.
+fn round_trip(data: &[u8]) -> bool {
+    let Ok(file) = parse(data, None) else {
+        return false;
+    };
+    for p in &file.primitives {
+        let n = p.positions.len();
+        assert!(p.triangles.iter().flatten().all(|&i| (i as usize) < n));
+        for s in p.attributes.iter().chain(p.targets.iter().flatten()) {
+            assert_eq!(s.count(), n, "{}", s.semantic);
+        }
+    }
+    let results: Vec<Vec<[u32; 3]>> = file
+        .primitives
+        .iter()
+        .map(|p| p.triangles.clone())
+        .collect();
+    let (out, _) = write(&file, &results, true, "").expect("writes what it read");
+    let again = parse(&out, None).expect("reads what it wrote");
+    assert_eq!(again.primitives.len(), file.primitives.len());
+    for (a, b) in file.primitives.iter().zip(&again.primitives) {
+        assert_eq!(a.triangles.len(), b.triangles.len());
+        for (sa, sb) in a.attributes.iter().zip(&b.attributes) {
+            assert_eq!(sa.semantic, sb.semantic);
+            for (ta, tb) in a.triangles.iter().zip(&b.triangles) {
+                for k in 0..3 {
+                    assert_eq!(sa.element(ta[k] as usize), sb.element(tb[k] as usize));
+                }
+            }
+        }
+    }
+    true
+}
+
+#[test]
+fn mutated_files_never_panic() {
+    use rand::{RngExt, SeedableRng};
+    let (json, bin) = document();
+    let good = glb(&json, &bin);
+    assert!(round_trip(&good));
+    let mut read = 0;
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+    for _ in 0..3000 {
+        let mut b = good.clone();
+        for _ in 0..rng.random_range(1..8) {
+            let at = rng.random_range(0..b.len());
+            b[at] = rng.random();
+        }
+        read += usize::from(round_trip(&b));
+    }
+    // The JSON text mutated: digits changed in place.
+    let text = serde_json::to_string(&json).unwrap();
+    let digits: Vec<usize> = text
+        .bytes()
+        .enumerate()
+        .filter(|(_, c)| c.is_ascii_digit())
+        .map(|(i, _)| i)
+        .collect();
+    for _ in 0..3000 {
+        let mut t = text.clone().into_bytes();
+        for _ in 0..rng.random_range(1..4) {
+            let at = digits[rng.random_range(0..digits.len())];
+            t[at] = b"0123456789"[rng.random_range(0..10)];
+        }
+        read += usize::from(round_trip(&glb(
+            &serde_json::from_slice(&t).unwrap_or(json!({})),
+            &bin,
+        )));
+    }
+    // Enough mutants were read (and so written and read back) for the test to mean something.
+    assert!(read > 500, "only {read} mutants read");
+}
+
+#[test]
+fn ply_keeps_extra_vertex_properties() {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::DefaultElement;
+    let n = 10;
+    let mut s = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty uchar red\nproperty float s\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        (n + 1) * (n + 1),
+        n * n
+    );
+    for y in 0..=n {
+        for x in 0..=n {
+            s += &format!(
+                "{x} {y} {} 0.{x}{y} {} {}.5\n",
+                (x * y) % 3,
+                (x * 11 + y) % 256,
+                x
+            );
+        }
+    }
+    for y in 0..n {
+        for x in 0..n {
+            let v = y * (n + 1) + x;
+            s += &format!("4 {} {} {} {}\n", v, v + 1, v + n + 2, v + n + 1);
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("grid.ply");
+    std::fs::write(&input, &s).unwrap();
+    let output = dir.path().join("out.ply");
+    let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("simplify")
+        .arg(&input)
+        .arg(&output)
+        .args(["--ratio", "0.3"])
+        .output()
+        .unwrap();
+    let report = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{report}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(report.contains("nx, red, s kept"), "{report}");
+    let read = |bytes: &[u8]| {
+        Parser::<DefaultElement>::new()
+            .read_ply(&mut std::io::Cursor::new(bytes))
+            .unwrap()
+    };
+    let a = read(s.as_bytes());
+    let b = read(&std::fs::read(&output).unwrap());
+    let key = |e: &DefaultElement| format!("{e:?}");
+    let known: HashSet<String> = a.payload["vertex"].iter().map(key).collect();
+    let kept = &b.payload["vertex"];
+    assert!(kept.len() < (n + 1) * (n + 1) / 2);
+    for v in kept {
+        assert_eq!(v.len(), 6);
+        assert!(known.contains(&key(v)), "{v:?} is not an input vertex");
+    }
+    let faces = &b.payload["face"];
+    assert!(faces.len() < 2 * n * n / 2);
+}
