@@ -24,18 +24,9 @@ use crate::simplify::{Args, PlacementArg, QuadricArg};
 /// report.
 fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
-    let (out, report, _) = if args.max_error.is_some() {
-        crate::simplify::simplify_bounded(mesh, config, stored, false)?
-    } else if stored {
-        crate::simplify::simplify_stored(
-            mesh,
-            config,
-            tinydecimate::cost::Placement::Subset,
-            false,
-        )?
-    } else {
-        crate::simplify::simplify(mesh, config)?
-    };
+    let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
+    let (out, report, _) =
+        crate::simplify::simplify_with(mesh, config, placement, args.max_error.is_some(), false)?;
     Ok((out.triangles, report))
 }
 
