@@ -36,7 +36,7 @@ pub(crate) mod flag {
     pub const LOCKED: u8 = 2;
     /// On a boundary (an edge with one triangle).
     pub const BOUNDARY: u8 = 4;
-    /// Feature vertex (seed 004 §3).
+    /// Feature vertex (Lin 2007 §3).
     pub const FEATURE: u8 = 8;
     /// Already paired in the current pass (Passes schedule).
     pub const DONE: u8 = 16;
@@ -638,7 +638,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Moves `a` onto `b` (half-edge collapse with subset placement, seed 004 §2): the (one or
+    /// Moves `a` onto `b` (half-edge collapse with subset placement, Lin 2007 §2): the (one or
     /// two) triangles on edge `a-b` are removed, `a`'s other triangles now use `b`. The caller
     /// has checked legality. Returns the number of triangles removed.
     ///

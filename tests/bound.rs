@@ -1,4 +1,4 @@
-//! The guaranteed error bound (issue 14; Zhu, Wang and Meng 2007, seed 001 §2-§4), checked
+//! The guaranteed error bound (Zhu, Wang and Meng 2007, §2-§4), checked
 //! from outside the library.
 //!
 //! For every mesh and bound: every original triangle's centroid (control points of the first
