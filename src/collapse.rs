@@ -142,7 +142,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         cost: C,
         bound: B,
     ) -> Self {
-        // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
+        // In f32, exact for counts below 2^24; the product is floored.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
             config.target_triangles
@@ -1018,7 +1018,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         // A stored cost's quadric at `b` grew by `a`'s (positive semi-definite), so with `b`
         // where it was, every other neighbour's price onto `b` (`Q_x(p_b) + Q_b(p_b)`) only
         // rose: their keys stay lower bounds, checked exactly when they reach the top, and
-        // re-keying them now is wasted (16 % of the instructions on the cow). A placing cost
+        // re-keying them now is wasted (docs/speed.md). A placing cost
         // (optimal placement) prices onto `b` through a minimiser that a larger `Q_b` can
         // move inside the edge's reach, so there every neighbour is re-keyed (with
         // `keys_only_fall`, by its one price onto `b`).

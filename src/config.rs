@@ -72,7 +72,7 @@ pub struct Config {
     /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue); at least 1.
     pub max_passes: u32,
     /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1; the default is 2,
-    /// chosen by measured error (see the README). Negative or non-finite values are rejected
+    /// chosen by measured error (see docs/algorithm.md). Negative or non-finite values are rejected
     /// (use [`Config::features`] = `false` to turn features off).
     pub lambda: f32,
     /// Detect and keep feature vertices at all.
@@ -145,13 +145,10 @@ impl Config {
     }
 
     /// The defaults for stored quadrics ([`StoredQuadric`](crate::cost::StoredQuadric), either
-    /// placement): [`Config::new`]
-    /// without Lin 2007's feature rule. The stored quadrics keep creases themselves; without
-    /// the rule the Metro mean error is lower on 27 (subset) and 28 (optimal placement) of the
-    /// 30 runs over the shared meshes at 50/25/10 % (the maximum is mixed: lower on 10 and
-    /// 15, higher on 13 and 12), and with
-    /// subset placement the engine then re-keys a collapse's neighbours with one price each
-    /// (README, "Stored quadrics").
+    /// placement): [`Config::new`] without Lin 2007's feature rule. The stored quadrics keep
+    /// creases themselves, and without the rule the Metro mean error is lower in nearly every run
+    /// over the shared meshes, and with subset placement the engine re-keys a collapse's neighbours with one
+    /// price each (figures in docs/stored-quadrics.md, "No feature rule by default").
     pub const fn stored() -> Self {
         let mut c = Self::new();
         c.features = false;

@@ -104,7 +104,7 @@ pub trait Cost {
     fn merge(&mut self, _from: usize, _to: usize, _p_from: V3, _p_to: V3, _p_new: V3) {}
     /// Whether [`Cost::place`] may ever return a position. `false` (the default) lets the
     /// compiler drop the engine's placement paths from the image of a cost that never moves a
-    /// vertex (3.4 KB of Cortex-M0 flash for one instantiation).
+    /// vertex (the flash this saves is in docs/devices.md).
     const PLACES: bool = false;
     /// Where the kept vertex goes for this move, if it moves at all (optimal placement); the
     /// engine checks the legality rules there and writes it to the caller's mutable positions.
@@ -128,10 +128,10 @@ pub trait Cost {
 ///
 /// The factor `1 + Ā/A_fan` (Ā: the mean triangle area of the mesh at the start of the round,
 /// A_fan: the fan's area) is what keeps thin parts: an area-weighted sum alone makes a fan of
-/// small triangles cheap to remove however far it moves, and the cow's teats and tail went
-/// first (Hausdorff 5.1 % of the diagonal at 10 %); dividing by the fan's area alone (a mean
-/// squared distance) keeps them but raises the mean error by 10-30 % on every shared mesh.
-/// Measured on the shared meshes with `host-sim bench`; see the README.
+/// small triangles cheap to remove however far it moves, so thin parts (the cow's teats and
+/// tail) go first; dividing by the fan's area alone (a mean squared distance) keeps them but
+/// raises the mean error on every shared mesh. The variants' figures, measured with
+/// `host-sim bench`, are in docs/algorithm.md.
 ///
 /// Needs [`Config::cost`] = [`CostKind::Quadric`]; the boundary weight is
 /// [`Config::boundary_weight`].
@@ -219,7 +219,8 @@ impl Cost for Quadric {
     }
 }
 
-/// The memoryless quadric under its former name.
+/// Another name for [`Quadric`], the memoryless quadric.
+#[deprecated(note = "use `Quadric`")]
 pub type PlaneDistance = Quadric;
 
 /// The paper's normal variation W (Lin 2007 §2, eq. 1-2, Algorithm 1): the sum over the moving

@@ -316,7 +316,7 @@ fn every_schedule_and_cost_honours_the_bound() {
 #[test]
 fn shared_meshes_stay_within_the_bound() {
     // The ones that run in a few seconds in release; `host-sim simplify --max-error` and the
-    // README's figures cover the others.
+    // figures of docs/error-bound.md cover the others.
     for name in [
         "wuson.obj",
         "spot.obj",
