@@ -35,10 +35,10 @@
 //!   (`bits(t)`), restored triangles − 1 (1 bit); `L` is the length of `s`'s list, known to
 //!   the decoder (at most 64).
 //!   - *Mode 0, fan run* (Cheng, Pan and Shi 1998 §2.2's `vsplit(s, l, r)`: the removed
-//!     vertex's fan sits between its two wings): the first restored triangle's slot of `s` (2
-//!     bits) and whether
-//!     `t` follows `s` in it (1 bit); the place among `s`'s triangles of the one across edge
-//!     `s-w₁` (`bits(L)`; it runs the edge the other way, which names `w₁`); the number `k` of
+//!     vertex's fan sits between its two wings): the first restored triangle's slot of `s`
+//!     (2 bits) and whether `t` follows `s` in it (1 bit); the place among `s`'s triangles of
+//!     the one across edge `s-w₁` (`bits(L)`; it runs the edge the other way, which names
+//!     `w₁`); the number `k` of
 //!     triangles that move (`bits(L + 1)`), found by walking around `s` from `s-w₁`; for a
 //!     second restored triangle, its slot of `s` (2 bits): its `w₂` is where the walk ended
 //!     and its winding is the first one's reversed.
