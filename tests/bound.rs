@@ -475,7 +475,7 @@ fn bad_input_is_refused() {
 #[cfg(feature = "triangle")]
 #[test]
 fn triangle_collapse_honours_the_bound() {
-    // The seed's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
+    // Zhu, Wang and Meng's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
     let tri = unlimited().with_operator(tinydecimate::Operator::Triangle);
     for (name, m) in [
         ("icosphere4", icosphere(4)),
