@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The core figures of README.md: each reference mesh at 10 % in both schedules, with the
+# The core figures of docs/algorithm.md ("Both schedules on four meshes"): each reference mesh at 10 % in both schedules, with the
 # library's time, the right-sized workspace, Metro error and the per-pass triangle counts.
 # Usage: scripts/figures.sh [ratio] [meshes...]
 set -euo pipefail

@@ -1,4 +1,4 @@
-//! A guaranteed error bound: control points (Zhu, Wang and Meng 2007, seed 001 §2-§4).
+//! A guaranteed error bound: control points (Zhu, Wang and Meng 2007, §2-§4).
 //!
 //! *Control points of the first kind* are the centroids of the **original** triangles (§2,
 //! fig. 1); those of the *second kind* are the vertices of original feature edges (§2, fig. 2:
@@ -436,8 +436,8 @@ impl<'a, I: Index, K: Index> Controls<'a, I, K> {
         false
     }
 
-    /// The veto (seed 001 §3, steps 6-8): whether every control point of `a`'s triangles lies
-    /// within `d_hold` of some triangle of `b`'s fan after `a -> b`.
+    /// The veto (Zhu, Wang and Meng 2007 §3, steps 6-8): whether every control point of `a`'s
+    /// triangles lies within `d_hold` of some triangle of `b`'s fan after `a -> b`.
     pub(crate) fn allows<L: Index>(&self, mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
         if self.limit2 == f32::INFINITY {
             return true;
@@ -482,8 +482,8 @@ impl<'a, I: Index, K: Index> Controls<'a, I, K> {
         chain
     }
 
-    /// After the collapse onto `b`: gives each point of `chain` to its nearest triangle of
-    /// `b`'s fan (ties: the lower slot; seed 001 §3, the redistribution after a collapse).
+    /// After the collapse onto `b`: gives each point of `chain` to its nearest triangle of `b`'s
+    /// fan (ties: the lower slot; Zhu, Wang and Meng 2007 §3, the redistribution after a collapse).
     pub(crate) fn attach<L: Index>(&mut self, mesh: &Mesh<'_, L, I>, b: usize, chain: usize) {
         let mut c = chain;
         let mut guard = self.guard();
@@ -505,8 +505,8 @@ impl<'a, I: Index, K: Index> Controls<'a, I, K> {
         }
     }
 
-    /// `d_i,max` of seed 001 eq. 3: the largest distance of triangle `t`'s control points to
-    /// it, in normalised units (0 if it has none).
+    /// `d_i,max` of Zhu, Wang and Meng 2007 eq. 3: the largest distance of triangle `t`'s control
+    /// points to it, in normalised units (0 if it has none).
     pub(crate) fn max_distance<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> f32 {
         let q = mesh.tri(t).map(|v| mesh.p(v));
         let mut max = 0.0f32;
@@ -523,9 +523,9 @@ impl<'a, I: Index, K: Index> Controls<'a, I, K> {
         sqrt(max)
     }
 
-    /// `(E_max, E_mean)` in the input's units (seed 001 §4, eq. 4-5): the largest distance of
-    /// any control point (both kinds) to its controlled triangle, and the mean distance of the
-    /// centroids weighted by their original triangles' areas.
+    /// `(E_max, E_mean)` in the input's units (Zhu, Wang and Meng 2007 §4, eq. 4-5): the largest
+    /// distance of any control point (both kinds) to its controlled triangle, and the mean distance
+    /// of the centroids weighted by their original triangles' areas.
     pub(crate) fn errors<L: Index>(&self, mesh: &Mesh<'_, L, I>) -> (f32, f32) {
         let (mut max, mut sum, mut area) = (0.0f32, 0.0f32, 0.0f32);
         let mut guard = self.guard();

@@ -4,10 +4,10 @@
 //! cubic cells; every vertex falls into one cell; each occupied cell keeps one
 //! *representative*, an existing input vertex; a triangle whose three corners fall into three
 //! distinct cells becomes a triangle of the representatives, all others vanish. This is the
-//! box filter of the survey in seed 002 ("基于长方体滤波的多面体简化": the bounding box cut
+//! box filter of the simplification survey ("基于长方体滤波的多面体简化": the bounding box cut
 //! into small boxes, the vertices of each box merged into one representative vertex, the
 //! triangles rebuilt from the original topology; its stated drawback is the loss of
-//! high-frequency detail), an operator due to Rossignac and Borrel (1993; the seed names no
+//! high-frequency detail), an operator due to Rossignac and Borrel (1993; the survey names no
 //! author). Following Lindstrom's out-of-core simplification (SIGGRAPH 2000), the memory is
 //! proportional to the *output*: one entry per occupied cell and one per output triangle,
 //! never one per input vertex or triangle, and the input is read as a stream, chunk by chunk.

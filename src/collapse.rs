@@ -142,7 +142,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         cost: C,
         bound: B,
     ) -> Self {
-        // In f32, exact for counts below 2^24; the product is floored like the f64 one was.
+        // In f32, exact for counts below 2^24; the product is floored.
         let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
         let target = if config.target_triangles > by_ratio {
             config.target_triangles
@@ -469,7 +469,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
 
     /// Hands the cost `v`'s planes (costs that store per-vertex state): each triangle's plane
     /// weighted by twice its area, and for a boundary vertex the plane through each of its two
-    /// boundary edges perpendicular to the edge's triangle (seed 000 §3.3).
+    /// boundary edges perpendicular to the edge's triangle (Cheng, Pan and Shi 1998 §3.3).
     fn init_vertex(&mut self, v: usize) {
         let f = self.mesh.flags(v);
         if f & flag::USED == 0 {
@@ -694,7 +694,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         }
     }
 
-    /// Σ ‖N_new − N_old‖² over `from`'s triangles that survive the move onto `to` (seed 004
+    /// Σ ‖N_new − N_old‖² over `from`'s triangles that survive the move onto `to` (Lin 2007
     /// eq. 1-2), for costs that need it.
     fn turn(&self, from: usize, to: usize) -> f32 {
         let mesh = &self.mesh;
@@ -846,8 +846,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         self.heap.remove(v);
     }
 
-    /// Triangle collapse (seed 001 eq. 3): the weight of live triangle `t`, `A (α + rc +
-    /// d_max)`; `None` if not finite.
+    /// Triangle collapse (Zhu, Wang and Meng 2007 eq. 3): the weight of live triangle `t`, `A (α +
+    /// rc + d_max)`; `None` if not finite.
     fn triangle_weight(&self, t: usize) -> Option<f32> {
         let tri = self.mesh.tri(t);
         let (w, area) = crate::triangle::weight(&self.mesh, tri)?;
@@ -888,8 +888,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     }
 
     /// Triangle collapse: one pop. `v`'s triangles in weight order; the first that collapses
-    /// ends the pop. All refused: the key times the penalty `p` (seed 001 §3), at most
-    /// `MAX_PENALTIES` times in a row.
+    /// ends the pop. All refused: the key times the penalty `p` (Zhu, Wang and Meng 2007 §3), at
+    /// most `MAX_PENALTIES` times in a row.
     fn pop_triangles(&mut self) {
         use crate::triangle::{MAX_PENALTIES, PENALTY};
         let Some((v, key)) = self.top() else {
@@ -1018,7 +1018,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         // A stored cost's quadric at `b` grew by `a`'s (positive semi-definite), so with `b`
         // where it was, every other neighbour's price onto `b` (`Q_x(p_b) + Q_b(p_b)`) only
         // rose: their keys stay lower bounds, checked exactly when they reach the top, and
-        // re-keying them now is wasted (16 % of the instructions on the cow). A placing cost
+        // re-keying them now is wasted (docs/speed.md). A placing cost
         // (optimal placement) prices onto `b` through a minimiser that a larger `Q_b` can
         // move inside the edge's reach, so there every neighbour is re-keyed (with
         // `keys_only_fall`, by its one price onto `b`).
@@ -1126,7 +1126,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         }
     }
 
-    /// Passes: try to pair the vertex under the cursor (seed 004 Algorithm 3), or end the pass.
+    /// Passes: try to pair the vertex under the cursor (Lin 2007 Algorithm 3), or end the pass.
     fn pair(&mut self) {
         if self.mesh.live <= self.target {
             return self.done(Stop::Target);

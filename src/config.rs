@@ -8,7 +8,7 @@ pub enum Schedule {
     /// The priority is the paper's normal variation W scaled by the squared edge length, so
     /// that it measures how far the surface moves, not only how far normals turn.
     Greedy,
-    /// The paper's own schedule (seed 004, Algorithms 3-4): each pass recomputes feature
+    /// The paper's own schedule (Lin 2007, Algorithms 3-4): each pass recomputes feature
     /// flags, sweeps vertices in index order and pairs each unprocessed non-feature vertex with
     /// the neighbour giving its cheapest legal collapse; both are then done for the pass.
     Passes,
@@ -21,7 +21,7 @@ pub enum CostKind {
     /// Memoryless quadric (Lindstrom-Turk style): the squared distance from the kept vertex to
     /// the planes of the removed vertex's current triangles, plus a boundary term. The default.
     Quadric,
-    /// The paper's normal variation W (seed 004 eq. 1-2); greedy multiplies it by the squared
+    /// The paper's normal variation W (Lin 2007 eq. 1-2); greedy multiplies it by the squared
     /// edge length, passes uses it as written.
     NormalVariation,
 }
@@ -32,14 +32,14 @@ pub enum CostKind {
 pub enum Operator {
     /// Half-edge collapse (the default): one vertex moves onto a neighbour.
     Edge,
-    /// Triangle collapse (Zhu, Wang and Meng 2007, seed 001 §3): a triangle's three vertices
+    /// Triangle collapse (Zhu, Wang and Meng 2007, §3): a triangle's three vertices
     /// merge into one of them, smallest weight `W = A (α + rc + d_max)` (eq. 3) first; see
     /// [`crate::triangle`]. Greedy schedule only, and only with the crate feature `triangle`
     /// (else [`Config::validate`] refuses it).
     Triangle,
 }
 
-/// How the feature test (seed 004 §3, eq. 3-5) weighs a vertex's normal variation D.
+/// How the feature test (Lin 2007 §3, eq. 3-5) weighs a vertex's normal variation D.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum FeatureMode {
@@ -72,7 +72,7 @@ pub struct Config {
     /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue); at least 1.
     pub max_passes: u32,
     /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1; the default is 2,
-    /// chosen by measured error (see the README). Negative or non-finite values are rejected
+    /// chosen by measured error (see docs/algorithm.md). Negative or non-finite values are rejected
     /// (use [`Config::features`] = `false` to turn features off).
     pub lambda: f32,
     /// Detect and keep feature vertices at all.
@@ -92,18 +92,18 @@ pub struct Config {
     /// Weight of the boundary retreat (squared distance of a removed boundary vertex to the new
     /// boundary edge) against the normal variation. Non-negative.
     pub boundary_weight: f32,
-    /// The guaranteed error bound `d_hold` (seed 001 §2-§3), in the input's units: no control
-    /// point (original triangle centroid or feature-edge vertex) ends farther than this from
-    /// the result. Infinite (the default): no bound. A finite value needs
+    /// The guaranteed error bound `d_hold` (Zhu, Wang and Meng 2007 §2-§3), in the input's units:
+    /// no control point (original triangle centroid or feature-edge vertex) ends farther than this
+    /// from the result. Infinite (the default): no bound. A finite value needs
     /// [`Controls`](crate::bound::Controls); with [`NoBound`](crate::bound::NoBound) it is
     /// [`Error::InvalidConfig`](crate::Error::InvalidConfig) for `MaxError`. Non-negative.
     pub max_error: f32,
     /// With an error bound: an original edge is a feature edge (its vertices are control
-    /// points of the second kind, seed 001 §2 fig. 2) when its two triangles' normals differ
-    /// by more than this many degrees, in `(0, 180)`. Boundary and non-manifold edges always
-    /// are.
+    /// points of the second kind, Zhu, Wang and Meng 2007 §2 fig. 2) when its two triangles'
+    /// normals differ by more than this many degrees, in `(0, 180)`. Boundary and non-manifold
+    /// edges always are.
     pub control_angle_deg: f32,
-    /// The simplification operator: edge collapse (default) or the seed 001 triangle
+    /// The simplification operator: edge collapse (default) or Zhu, Wang and Meng's triangle
     /// collapse ([`Schedule::Greedy`] and the crate feature `triangle` only).
     pub operator: Operator,
 }
@@ -133,7 +133,7 @@ impl Config {
         }
     }
 
-    /// The paper as written (seed 004): the `Passes` schedule, λ = 1, features take no part in
+    /// The paper as written (Lin 2007): the `Passes` schedule, λ = 1, features take no part in
     /// any collapse.
     pub const fn paper() -> Self {
         let mut c = Self::new();
@@ -145,13 +145,10 @@ impl Config {
     }
 
     /// The defaults for stored quadrics ([`StoredQuadric`](crate::cost::StoredQuadric), either
-    /// placement): [`Config::new`]
-    /// without seed 004's feature rule. The stored quadrics keep creases themselves; without
-    /// the rule the Metro mean error is lower on 27 (subset) and 28 (optimal placement) of the
-    /// 30 runs over the shared meshes at 50/25/10 % (the maximum is mixed: lower on 10 and
-    /// 15, higher on 13 and 12), and with
-    /// subset placement the engine then re-keys a collapse's neighbours with one price each
-    /// (README, "Stored quadrics").
+    /// placement): [`Config::new`] without Lin 2007's feature rule. The stored quadrics keep
+    /// creases themselves, and without the rule the Metro mean error is lower in nearly every run
+    /// over the shared meshes, and with subset placement the engine re-keys a collapse's neighbours with one
+    /// price each (figures in docs/stored-quadrics.md, "No feature rule by default").
     pub const fn stored() -> Self {
         let mut c = Self::new();
         c.features = false;

@@ -30,7 +30,7 @@ pub struct Move {
     /// For a boundary vertex moving along its boundary: squared distance from it to the new
     /// boundary edge, i.e. how far the boundary retreats. Zero otherwise.
     pub retreat2: f32,
-    /// Σ ‖N_new − N_old‖² over the surviving triangles (unit normals; seed 004 eq. 2), when
+    /// Σ ‖N_new − N_old‖² over the surviving triangles (unit normals; Lin 2007 eq. 2), when
     /// [`Cost::needs_turn`]; zero otherwise.
     pub turn: f32,
     /// The moving vertex (removed by the collapse).
@@ -95,15 +95,16 @@ pub trait Cost {
     /// each vertex's state in a frame centred on it, which keeps `f32` sums of nearby planes
     /// free of the cancellation a global origin causes.
     fn plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
-    /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle
-    /// (seed 000 §3.3); `weight` is the squared edge length, the cost applies its own factor.
+    /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle (Cheng,
+    /// Pan and Shi 1998 §3.3); `weight` is the squared edge length, the cost applies its own
+    /// factor.
     fn boundary_plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
     /// Vertex `from` (at `p_from`) was collapsed onto `to` (at `p_to`), which is now at `p_new`
     /// (only if [`Cost::stores`]).
     fn merge(&mut self, _from: usize, _to: usize, _p_from: V3, _p_to: V3, _p_new: V3) {}
     /// Whether [`Cost::place`] may ever return a position. `false` (the default) lets the
     /// compiler drop the engine's placement paths from the image of a cost that never moves a
-    /// vertex (3.4 KB of Cortex-M0 flash for one instantiation).
+    /// vertex (the flash this saves is in docs/devices.md).
     const PLACES: bool = false;
     /// Where the kept vertex goes for this move, if it moves at all (optimal placement); the
     /// engine checks the legality rules there and writes it to the caller's mutable positions.
@@ -114,10 +115,9 @@ pub trait Cost {
 }
 
 /// Memoryless quadric error (Lindstrom and Turk's "memoryless" simplification, 1998; the
-/// plane quadrics of seed 000 §2.3 (Cheng/Pan/Shi, eq. for K_p and Q_s) and of seed 003 (an
-/// implementation of Garland's edge collapse) without
-/// the per-vertex matrix): the area-weighted squared distance from the kept vertex to the
-/// planes of the removed vertex's current triangles,
+/// plane quadrics of Cheng, Pan and Shi 1998 §2.3 (their K_p and Q_s) and of an
+/// implementation of Garland's edge collapse, without the per-vertex matrix): the area-weighted
+/// squared distance from the kept vertex to the planes of the removed vertex's current triangles,
 ///
 /// ```text
 /// E(a -> b) = dᵀ Q d · (1 + Ā / A_fan),   Q = Σ_t A_t n_t n_tᵀ,   d = p_b − p_a
@@ -128,10 +128,10 @@ pub trait Cost {
 ///
 /// The factor `1 + Ā/A_fan` (Ā: the mean triangle area of the mesh at the start of the round,
 /// A_fan: the fan's area) is what keeps thin parts: an area-weighted sum alone makes a fan of
-/// small triangles cheap to remove however far it moves, and the cow's teats and tail went
-/// first (Hausdorff 5.1 % of the diagonal at 10 %); dividing by the fan's area alone (a mean
-/// squared distance) keeps them but raises the mean error by 10-30 % on every shared mesh.
-/// Measured on the shared meshes with `host-sim bench`; see the README.
+/// small triangles cheap to remove however far it moves, so thin parts (the cow's teats and
+/// tail) go first; dividing by the fan's area alone (a mean squared distance) keeps them but
+/// raises the mean error on every shared mesh. The variants' figures, measured with
+/// `host-sim bench`, are in docs/algorithm.md.
 ///
 /// Needs [`Config::cost`] = [`CostKind::Quadric`]; the boundary weight is
 /// [`Config::boundary_weight`].
@@ -219,21 +219,22 @@ impl Cost for Quadric {
     }
 }
 
-/// The memoryless quadric under its former name.
+/// Another name for [`Quadric`], the memoryless quadric.
+#[deprecated(note = "use `Quadric`")]
 pub type PlaneDistance = Quadric;
 
-/// The paper's normal variation W (seed 004 §2, eq. 1-2, Algorithm 1): the sum over the moving
+/// The paper's normal variation W (Lin 2007 §2, eq. 1-2, Algorithm 1): the sum over the moving
 /// vertex's surviving triangles of ‖N_new − N_old‖², with no trigonometry.
 ///
 /// Needs [`Config::cost`] = [`CostKind::NormalVariation`]; both settings come from the
 /// configuration when the run starts:
 ///
-/// * `length_weighted`: multiply by the squared edge length (the greedy schedule). W measures how far
-///   normals turn, not how far the surface moves; as a *global* priority alone it prefers long
+/// * `length_weighted`: multiply by the squared edge length (the greedy schedule). W measures how
+///   far normals turn, not how far the surface moves; as a *global* priority alone it prefers long
 ///   collapses across flat regions. Displacement is about length × normal change, so W·ℓ²
 ///   ranks collapses by a squared distance.
-/// * `boundary_weight` ([`Config::boundary_weight`]): a boundary vertex moving along its boundary adds
-///   `boundary_weight · retreat² / ℓ²` (scale-free like W; with W·ℓ², `boundary_weight ·
+/// * `boundary_weight` ([`Config::boundary_weight`]): a boundary vertex moving along its boundary
+///   adds `boundary_weight · retreat² / ℓ²` (scale-free like W; with W·ℓ², `boundary_weight ·
 ///   retreat²`), so open meshes keep their rims.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NormalVariation {
@@ -389,18 +390,18 @@ pub type VertexQuadric = [f32; 10];
 pub enum Placement {
     /// At one of the two endpoints (positions are only read, flash is fine).
     Subset,
-    /// At the minimiser of Δ over the edge's summed quadric (seed 000 §2.3 and Garland),
-    /// written into the caller's mutable positions; the best of the endpoints and the midpoint
-    /// when the 3×3 system is ill-conditioned or its solution lies far from the edge.
+    /// At the minimiser of Δ over the edge's summed quadric (Cheng, Pan and Shi 1998 §2.3, and
+    /// Garland), written into the caller's mutable positions; the best of the endpoints and the
+    /// midpoint when the 3×3 system is ill-conditioned or its solution lies far from the edge.
     Optimal,
 }
 
-/// Accumulated quadric error metric (Garland's, seed 000 ref. 5) with per-vertex storage: seed 000 §2.3-2.5
-/// (Cheng, Pan and Shi: `K_p = p pᵀ`, `Q_s` the sum over the vertex's triangles, `Q = Q_s + Q_t`
-/// on a collapse, `Δ = vᵀ Q v` and an error-cost queue) and seed 003 (an implementation of
-/// Garland's edge collapse). Planes are area-weighted; a boundary vertex also gets, for each
-/// boundary edge it is on, the plane through that edge perpendicular to its triangle (seed 000
-/// §3.3), weighted by `boundary_weight` times the squared edge length.
+/// Accumulated quadric error metric (Garland's, as Cheng, Pan and Shi 1998 use it, §2.3-2.5)
+/// with per-vertex storage (`K_p = p pᵀ`, `Q_s` the sum over the vertex's triangles,
+/// `Q = Q_s + Q_t` on a collapse, `Δ = vᵀ Q v` and an error-cost queue), as in an
+/// implementation of Garland's edge collapse. Planes are area-weighted; a boundary vertex also
+/// gets, for each boundary edge it is on, the plane through that edge perpendicular to its triangle
+/// (Cheng, Pan and Shi 1998 §3.3), weighted by `boundary_weight` times the squared edge length.
 ///
 /// The matrices live in a caller-provided slice, one [`VertexQuadric`] (40 bytes) per vertex, at
 /// least as long as the positions (else [`Error::Capacity`] for
@@ -452,9 +453,9 @@ impl<'q> StoredQuadric<'q> {
         )
     }
 
-    /// The best position for `m` relative to `p_to`, and its error: the solution of the 3×3 system if it is
-    /// well conditioned and near the edge, else (and if better) an endpoint or the midpoint.
-    /// Candidates are compared in a fixed order with `<`, so ties go to the earlier one.
+    /// The best position for `m` relative to `p_to`, and its error: the solution of the 3×3 system
+    /// if it is well conditioned and near the edge, else (and if better) an endpoint or the
+    /// midpoint. Candidates are compared in a fixed order with `<`, so ties go to the earlier one.
     fn best(&self, m: &Move) -> (V3, f32) {
         if m.keep || self.placement == Placement::Subset {
             // At p_to, the edge's quadric is `Q_from` read at `p_to − p_from` plus `Q_to`'s
@@ -491,7 +492,8 @@ impl<'q> StoredQuadric<'q> {
     }
 }
 
-/// The quadric `p pᵀ` of the plane `p = (n, d)` (seed 000 eq. 3, `K_p`), upper triangle.
+/// The quadric `p pᵀ` of the plane `p = (n, d)` (Cheng, Pan and Shi 1998 eq. 3, `K_p`), upper
+/// triangle.
 #[inline]
 pub(crate) fn outer(n: V3, d: f32) -> VertexQuadric {
     let [a, b, c] = n;

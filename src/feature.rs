@@ -1,4 +1,4 @@
-//! Feature vertices (seed 004 §3, eq. 3-5).
+//! Feature vertices (Lin 2007 §3, eq. 3-5).
 //!
 //! A vertex's *variation* D is the sum, over ordered pairs of its triangles, of the squared
 //! distance between their unit normals (eq. 3-4, quantised by eq. 2). A vertex is a feature iff

@@ -3,22 +3,22 @@
 //! A triangle mesh simplifier for microcontrollers: no heap, no `unsafe`, no panics, and every
 //! byte of working memory fixed at compile time.
 //!
-//! It follows the mobile-terminal method of Lin Mouguang (seed 004, "A Geometry Compression
-//! Method for Mobile Computing Terminal", 2007): edge collapse with subset placement (§2), so
+//! It follows the mobile-terminal method of Lin Mouguang ("A Geometry Compression Method for
+//! Mobile Computing Terminal", 2007): edge collapse with subset placement (§2), so
 //! the positions are only ever read and may stay in flash, and *feature vertices*, whose
 //! triangles' normals differ most from each other (§3, eq. 3-5), are never removed while they
 //! are features. The
-//! default cost is a memoryless quadric (Lindstrom-Turk style; the plane quadrics of seed 000
-//! §2.3 without per-vertex storage); the paper's own normal variation W (eq. 1-2, Algorithm 1)
-//! and its passes are [`Config::paper`]. Legality follows seed 000 (Cheng, Pan and Shi, "A
+//! default cost is a memoryless quadric (Lindstrom-Turk style; the plane quadrics of Cheng, Pan
+//! and Shi 1998 §2.3 without per-vertex storage); the paper's own normal variation W (eq. 1-2,
+//! Algorithm 1) and its passes are [`Config::paper`]. Legality follows Cheng, Pan and Shi 1998 ("A
 //! fast algorithm for generating progressive meshes"): irregular vertices locked (§3.1), the
 //! link condition and boundary edges only between boundary vertices (§3.2(1)), a dihedral
 //! (normal-turn and fold) threshold (§3.2(2)); plus no sliver or duplicate triangles.
 //!
-//! A guaranteed error bound (Zhu, Wang and Meng 2007, seed 001 §2-§4) is a policy of the same
-//! engine: [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control points
-//! (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
-//! seed's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
+//! A guaranteed error bound (Zhu, Wang and Meng 2007, §2-§4) is a policy of the same engine:
+//! [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control
+//! points (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
+//! paper's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
 //!
 //! Data flows one way:
 //!

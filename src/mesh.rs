@@ -1,12 +1,12 @@
 //! The mesh as the engine sees it: the caller's read-only positions and triangle buffer, plus
 //! adjacency in the workspace.
 //!
-//! Adjacency is a *corner list*: corner `3t + k` is slot `k` of triangle `t`, and every vertex
+//! Adjacency is a *corner list*: corner `4t + k` is slot `k` of triangle `t`, and every vertex
 //! owns a singly linked list of its corners (`head[v]`, then `next[corner]`). That is one link
 //! per vertex and three per triangle, the least that still lets a collapse re-home a vertex's
 //! triangles in O(valence). A link stores only the next *triangle*: the slot is found again by
 //! looking for the vertex among the triangle's three (live triangles never repeat a vertex), so
-//! `u16` links reach 65 535 triangles instead of the 21 845 that corner numbers would allow.
+//! `u16` links reach 65 535 triangles instead of the 16 384 that corner numbers would allow.
 //! Removed triangles are unlinked from every list, then written as `[b, b, b]` in the caller's
 //! buffer (a degenerate triangle, which renders as nothing), so lists only hold live corners.
 //!
@@ -36,7 +36,7 @@ pub(crate) mod flag {
     pub const LOCKED: u8 = 2;
     /// On a boundary (an edge with one triangle).
     pub const BOUNDARY: u8 = 4;
-    /// Feature vertex (seed 004 §3).
+    /// Feature vertex (Lin 2007 §3).
     pub const FEATURE: u8 = 8;
     /// Already paired in the current pass (Passes schedule).
     pub const DONE: u8 = 16;
@@ -44,9 +44,10 @@ pub(crate) mod flag {
     pub const MARK: u8 = 32;
     /// Build only: the vertex is some corner's `a` in the fan being ordered.
     pub const SEEN_A: u8 = 64;
-    /// Greedy queue, after the build (`SEEN_A`'s bit, free by then): the vertex went back in
-    /// at its cheapest *legal* price, above a cheaper refused candidate, so its key is no
-    /// lower bound of its prices (see `Simplifier::keys_only_fall`).
+    /// Greedy queue, after the build: the vertex went back in at its cheapest *legal* price,
+    /// above a cheaper refused candidate, so its key is no lower bound of its prices (see
+    /// `Simplifier::keys_only_fall`).
+    /// `SEEN_A`'s bit, never both at once: `order` (build only) clears `SEEN_A` before it returns.
     pub const RAISED: u8 = 64;
     /// Build only: the vertex is some corner's `b` in the fan being ordered.
     pub const SEEN_B: u8 = 128;
@@ -638,7 +639,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Moves `a` onto `b` (half-edge collapse with subset placement, seed 004 §2): the (one or
+    /// Moves `a` onto `b` (half-edge collapse with subset placement, Lin 2007 §2): the (one or
     /// two) triangles on edge `a-b` are removed, `a`'s other triangles now use `b`. The caller
     /// has checked legality. Returns the number of triangles removed.
     ///

@@ -1,18 +1,18 @@
 //! Progressive meshes: the collapses of a simplification turned into vertex splits, and a
 //! level-of-detail slider that moves between levels in place.
 //!
-//! Seed 000 (Cheng, Pan and Shi, "A fast algorithm for generating progressive meshes") §2.1-2.2:
+//! Cheng, Pan and Shi 1998 ("A fast algorithm for generating progressive meshes") §2.1-2.2:
 //! the input `M = Mⁿ` is simplified by edge collapses to a base mesh `M⁰`, and each collapse
 //! is undone by a vertex split, so `M⁰ → M¹ → … → Mⁿ` recovers the input exactly. Here a
-//! collapse keeps one endpoint (subset placement, seed 004 §2), so a split needs no new
+//! collapse keeps one endpoint (subset placement, Lin 2007 §2), so a split needs no new
 //! position on the device.
 //!
 //! # Layout
 //! [`Progressive::from_log`] rearranges the input once:
 //! - **Vertices** are renumbered: the base mesh's vertices first (in input order), then the
-//!   removed vertices in reverse collapse order (seed 000 names them `m₀+i+1`), so split `j`
-//!   always creates vertex `m₀ + j` and a record need not name it. `order[new] = input index`
-//!   finds the positions, which stay where they are (they may be in flash).
+//!   removed vertices in reverse collapse order (Cheng, Pan and Shi 1998 name them `m₀+i+1`),
+//!   so split `j` always creates vertex `m₀ + j` and a record need not name it. `order[new] =
+//!   input index` finds the positions, which stay where they are (they may be in flash).
 //! - **Triangles**: the base mesh first (in input order), then the triangles each split
 //!   restores, in split order. Every level is a prefix of the buffer, so a split or a collapse
 //!   only moves the end of the prefix and rewrites the corners that change vertex.
@@ -39,7 +39,7 @@ const NIL: usize = usize::MAX;
 /// One vertex split (the inverse of one logged collapse). Split `j` creates vertex `m₀ + j`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Split<I> {
-    /// The vertex that stays (`s` of seed 000's `vsplit(s, l, r)`), in the new numbering.
+    /// The vertex that stays (`s` of Cheng, Pan and Shi's `vsplit(s, l, r)`), in the new numbering.
     pub kept: I,
     /// Triangles the split restores: 2 for an interior edge, 1 for a boundary edge. They sit
     /// in the buffer right after the level's prefix.

@@ -102,11 +102,11 @@ pub struct Report {
     /// Refused candidate collapses by reason.
     pub rejected: Rejections,
     /// With an error bound ([`Controls`](crate::bound::Controls)):
-    /// E_max of seed 001 eq. 4, the largest distance of a control point (original centroid
-    /// or feature-edge vertex) to its controlled triangle, in the input's units. Never more
-    /// than [`Config::max_error`](crate::Config::max_error). `None` without a bound.
+    /// E_max of Zhu, Wang and Meng 2007 eq. 4, the largest distance of a control point (original
+    /// centroid or feature-edge vertex) to its controlled triangle, in the input's units. Never
+    /// more than [`Config::max_error`](crate::Config::max_error). `None` without a bound.
     pub max_error: Option<f32>,
-    /// With an error bound: E_mean of seed 001 eq. 5, `Σ dc_i·A_i / Σ A_i` over the original
-    /// triangles' centroids (`A_i`: the original triangle's area), in the input's units.
+    /// With an error bound: E_mean of Zhu, Wang and Meng 2007 eq. 5, `Σ dc_i·A_i / Σ A_i` over the
+    /// original triangles' centroids (`A_i`: the original triangle's area), in the input's units.
     pub mean_error: Option<f32>,
 }

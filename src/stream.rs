@@ -1,11 +1,11 @@
 //! The progressive transmission stream: a base mesh, then vertex splits with the positions of
 //! their new vertices, in checksummed chunks, decoded incrementally as bytes arrive.
 //!
-//! Why (seed 004 §1-2): a small screen at the end of a slow link must show something at once
-//! and refine as bytes arrive. The splits are those of [`Progressive`] (seed 000 §2.1-2.2);
-//! a split names its corners by their places in the kept vertex's list, so its connectivity
-//! costs a few bits per neighbour, and it is only applied once its whole chunk has arrived and
-//! its checksum matches, so a bad stream never leaves a broken mesh behind.
+//! Why (Lin 2007 §1-2): a small screen at the end of a slow link must show something at once
+//! and refine as bytes arrive. The splits are those of [`Progressive`] (Cheng, Pan and Shi 1998
+//! §2.1-2.2); a split names its corners by their places in the kept vertex's list, so its
+//! connectivity costs a few bits per neighbour, and it is only applied once its whole chunk has
+//! arrived and its checksum matches, so a bad stream never leaves a broken mesh behind.
 //!
 //! # Format (version 1, little-endian)
 //! Header, 56 bytes:
@@ -34,10 +34,11 @@
 //! - **Vertex split** creating vertex `t = m₀ + j`: a mode bit, the kept vertex `s`
 //!   (`bits(t)`), restored triangles − 1 (1 bit); `L` is the length of `s`'s list, known to
 //!   the decoder (at most 64).
-//!   - *Mode 0, fan run* (seed 000 §2.2's `vsplit(s, l, r)`: the removed vertex's fan sits
-//!     between its two wings): the first restored triangle's slot of `s` (2 bits) and whether
-//!     `t` follows `s` in it (1 bit); the place among `s`'s triangles of the one across edge
-//!     `s-w₁` (`bits(L)`; it runs the edge the other way, which names `w₁`); the number `k` of
+//!   - *Mode 0, fan run* (Cheng, Pan and Shi 1998 §2.2's `vsplit(s, l, r)`: the removed
+//!     vertex's fan sits between its two wings): the first restored triangle's slot of `s`
+//!     (2 bits) and whether `t` follows `s` in it (1 bit); the place among `s`'s triangles of
+//!     the one across edge `s-w₁` (`bits(L)`; it runs the edge the other way, which names
+//!     `w₁`); the number `k` of
 //!     triangles that move (`bits(L + 1)`), found by walking around `s` from `s-w₁`; for a
 //!     second restored triangle, its slot of `s` (2 bits): its `w₂` is where the walk ended
 //!     and its winding is the first one's reversed.

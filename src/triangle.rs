@@ -1,4 +1,4 @@
-//! Triangle collapse (Zhu, Wang and Meng 2007, seed 001 §3), selected with
+//! Triangle collapse (Zhu, Wang and Meng 2007, §3), selected with
 //! [`Operator::Triangle`](crate::Operator::Triangle).
 //!
 //! A triangle's three vertices merge into one. The paper puts the new vertex where the normal
@@ -34,7 +34,7 @@ use crate::index::Index;
 use crate::math::{self, V3};
 use crate::mesh::Mesh;
 
-/// The penalty factor `p > 1` for a refused triangle (seed 001 §3: `p = 5`).
+/// The penalty factor `p > 1` for a refused triangle (Zhu, Wang and Meng 2007 §3: `p = 5`).
 pub const PENALTY: f32 = 5.0;
 
 /// How many times in a row a vertex's key is multiplied by [`PENALTY`] before it is dropped

@@ -250,7 +250,7 @@ pub struct Workspace<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: u
     /// Per vertex: the triangle of the first corner of its corner list (NIL: none), its heap
     /// slot and its slot's vertex (the greedy schedule's binary heap).
     links: [[L; MAX_VERTICES]; 3],
-    /// For corner `3t + k`, the triangle of the next corner around the same vertex.
+    /// For corner `4t + k`, the triangle of the next corner around the same vertex.
     next: [[L; 3]; MAX_TRIANGLES],
     /// Per-vertex flags, see `mesh::flag`.
     flags: [u8; MAX_VERTICES],

@@ -1,4 +1,4 @@
-//! The guaranteed error bound (issue 14; Zhu, Wang and Meng 2007, seed 001 §2-§4), checked
+//! The guaranteed error bound (Zhu, Wang and Meng 2007, §2-§4), checked
 //! from outside the library.
 //!
 //! For every mesh and bound: every original triangle's centroid (control points of the first
@@ -316,7 +316,7 @@ fn every_schedule_and_cost_honours_the_bound() {
 #[test]
 fn shared_meshes_stay_within_the_bound() {
     // The ones that run in a few seconds in release; `host-sim simplify --max-error` and the
-    // README's figures cover the others.
+    // figures of docs/error-bound.md cover the others.
     for name in [
         "wuson.obj",
         "spot.obj",
@@ -475,7 +475,7 @@ fn bad_input_is_refused() {
 #[cfg(feature = "triangle")]
 #[test]
 fn triangle_collapse_honours_the_bound() {
-    // The seed's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
+    // Zhu, Wang and Meng's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
     let tri = unlimited().with_operator(tinydecimate::Operator::Triangle);
     for (name, m) in [
         ("icosphere4", icosphere(4)),

@@ -141,7 +141,7 @@ fn real_meshes_keep_every_invariant() {
     }
 }
 
-/// A bit per vertex (`cluster_with_seen`) or an 8-byte cache per vertex (`cluster_with_cache`)
+/// A bit per vertex (`Scratch::seen`) or an 8-byte cache per vertex (`Scratch::cache`)
 /// gives the same output and report as none, also when too short (the vertices beyond take
 /// the path without), with cleanup, with a given bounding box and with a cell size.
 #[test]
@@ -178,7 +178,7 @@ fn vertex_memory_changes_nothing_but_time() {
                             ..Scratch::new()
                         },
                     )
-                    .expect("cluster_with_cache");
+                    .expect("cluster with a cache");
                 out.truncate(r.triangles_out);
                 assert_eq!(r, wr, "{name} config {frac}, cache {n}: report");
                 assert_eq!(out, want, "{name} config {frac}, cache {n}: output");
@@ -203,7 +203,7 @@ fn vertex_memory_changes_nothing_but_time() {
                             ..Scratch::new()
                         },
                     )
-                    .expect("cluster_with_keys");
+                    .expect("cluster with cache and keys");
                 out.truncate(r.triangles_out);
                 assert_eq!(r, wr, "{name} config {frac}, cache {n}, keys {nk}: report");
                 assert_eq!(
@@ -228,7 +228,7 @@ fn vertex_memory_changes_nothing_but_time() {
                             ..Scratch::new()
                         },
                     )
-                    .expect("cluster_with_seen");
+                    .expect("cluster with seen bits");
                 out.truncate(r.triangles_out);
                 assert_eq!(r, wr, "{name} {frac}% {n} words: report");
                 assert_eq!(out, want, "{name} {frac}% {n} words: output");

@@ -1,4 +1,4 @@
-//! Stored quadrics (issue 15): `StoredQuadric` with `Placement::Subset` (subset placement) and
+//! Stored quadrics: `StoredQuadric` with `Placement::Subset` (subset placement) and
 //! `StoredQuadric` with `Placement::Optimal` (optimal placement on mutable positions).
 //!
 //! Properties: valid output (the shared checker, moved positions allowed for optimal), optimal

@@ -62,9 +62,9 @@ fn operations_are_bounded_by_the_mesh_size() {
             );
             assert!(passes <= config.max_passes);
             // The proof's bound is far looser (O(V) pops between collapses); in practice the
-            // queue needs about one pop per collapse (~1.1 measured on an earlier engine; on
-            // these four meshes today every run stays within the sweep allowance alone). 2 per
-            // collapse is what this claims, and fails a regression that loses track of its keys.
+            // queue needs about one pop per collapse (on these four meshes every run stays
+            // within the sweep allowance alone). 2 per collapse is what this claims, and fails a
+            // regression that loses track of its keys.
             match config.schedule {
                 Schedule::Greedy => assert!(
                     ops <= sweeps + 2 * (collapses as u64 + 1) + v,

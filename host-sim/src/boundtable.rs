@@ -1,4 +1,4 @@
-//! `host-sim bound-table`: the error-bound figures of the README ("Error bound"). For each
+//! `host-sim bound-table`: the error-bound figures of docs/error-bound.md ("Figures"). For each
 //! mesh: the triangles tinydecimate reaches under a guaranteed bound (a fraction of the
 //! bounding-box diagonal; control points of Zhu, Wang and Meng 2007), with the edge
 //! and the triangle operator, their E_max / E_mean (eq. 4-5) and the Metro one-sided maximum

@@ -50,8 +50,8 @@ pub struct Args {
     #[arg(long)]
     pub cleanup: bool,
     /// Memory per input vertex besides the table and the output (the same output; time
-    /// only): none (`Clusterer::cluster`), a bit (`cluster_with_seen`), 8 bytes
-    /// (`cluster_with_cache`) or 40 bytes (`cluster_with_keys`).
+    /// only), given to `Clusterer::cluster` in its `Scratch`: none, a bit (`seen`), 8 bytes
+    /// (`cache`) or 40 bytes (`cache` and `keys`).
     #[arg(long, value_enum, default_value_t = VertexMemory::None)]
     pub vertex_memory: VertexMemory,
     /// Skip the Metro measurement.
@@ -65,13 +65,13 @@ pub struct Args {
 /// Memory per input vertex given to the library besides the table and the output.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum VertexMemory {
-    /// None: memory for the output only (`Clusterer::cluster`).
+    /// None: memory for the output only (`Scratch::new()`).
     None,
-    /// A bit per vertex (`Clusterer::cluster_with_seen`).
+    /// A bit per vertex (`Scratch::seen`).
     Bit,
-    /// 8 bytes per vertex (`Clusterer::cluster_with_cache`).
+    /// 8 bytes per vertex (`Scratch::cache`).
     Cache,
-    /// 8 + 32 bytes per vertex (`Clusterer::cluster_with_keys`).
+    /// 8 + 32 bytes per vertex (`Scratch::cache` and `Scratch::keys`).
     Keys,
 }
 
@@ -524,7 +524,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let sdups: usize = rows.iter().map(|r| r.sloppy.2 + r.sloppy.3).sum();
     let _ = writeln!(
         s,
-        "\nTime ours/sloppy (40 B per input vertex, `Clusterer::cluster_with_keys`): worst row {worst_k:.2}x, all rows together {tot_k:.2}x, geometric mean {geo_k:.2}x. With 8 B per vertex (`Clusterer::cluster_with_cache`): worst row {worst_t:.2}x, all rows together {tot_t:.2}x, geometric mean {geo_t:.2}x. With a bit per vertex (`Clusterer::cluster_with_seen`): worst row {worst_b:.2}x, geometric mean {geo_b:.2}x. With memory for the output only (`Clusterer::cluster`, same output): worst row {worst_s:.2}x, all rows together {tot_s:.2}x, geometric mean {geo_s:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
+        "\nTime ours/sloppy (40 B per input vertex, `Scratch` `cache` + `keys`): worst row {worst_k:.2}x, all rows together {tot_k:.2}x, geometric mean {geo_k:.2}x. With 8 B per vertex (`Scratch` `cache`): worst row {worst_t:.2}x, all rows together {tot_t:.2}x, geometric mean {geo_t:.2}x. With a bit per vertex (`Scratch` `seen`): worst row {worst_b:.2}x, geometric mean {geo_b:.2}x. With memory for the output only (`Scratch::new()`, same output): worst row {worst_s:.2}x, all rows together {tot_s:.2}x, geometric mean {geo_s:.2}x. Mean error ours/sloppy at our count: worst row {worst_e:.2}x. Duplicate + degenerate triangles: ours {dups}, sloppy {sdups}."
     );
     s
 }

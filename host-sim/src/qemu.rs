@@ -99,7 +99,7 @@ pub static QEMU_RISCV32: Qemu = Qemu {
 /// buffers (host-sim/firmware/src/board.rs). `qemu --check` fails on any other skip (a board
 /// whose buffers shrank would otherwise pass with its cases skipped) and on a listed case that
 /// ran after all (the list is stale). The small-RAM boards (Cortex-M0 16 KB, Cortex-M3 64 KB,
-/// the 32 KB RISC-V) are the only ones that skip; README.md names their cases. Checked against
+/// the 32 KB RISC-V) are the only ones that skip; docs/devices.md names their cases. Checked against
 /// the boards' capacities in the tests.
 pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
     ("microbit", MICROBIT_SKIPS),

@@ -49,8 +49,9 @@ fn texts() -> Vec<(String, String)> {
     out
 }
 
-/// Seed 000 is Cheng, Pan and Shi (not Hoppe), seed 001 is Zhu, Wang and Meng (not
-/// Garland-Heckbert); the link condition is seed 000 §3.2(1).
+/// The progressive-mesh paper is Cheng, Pan and Shi's (not Hoppe's), the bounded-error one
+/// Zhu, Wang and Meng's (not Garland-Heckbert's); the link condition is Cheng, Pan and Shi
+/// §3.2(1).
 #[test]
 fn seed_citations() {
     let this = file!();
@@ -70,7 +71,7 @@ fn seed_citations() {
             if line.contains("§3.1") {
                 assert!(
                     line.contains("irregular") || line.contains("(§3.1)"),
-                    "{name}: §3.1 of seed 000 is the vertex classification: {line}"
+                    "{name}: §3.1 of Cheng, Pan and Shi is the vertex classification: {line}"
                 );
             }
         }

@@ -90,9 +90,9 @@ fn labelled(t: &str, word: &str) -> Option<String> {
     })
 }
 
-/// Internal labels ("issue 10", "seed 001") are not in what users read: help texts, printed
-/// output (its strings live in host-sim/src) or host-sim's doc comments; and `run-elf` names
-/// the example that exists.
+/// Internal labels (issue numbers, the papers' seed numbers) are not in what users read: help
+/// texts, printed output (its strings live in host-sim/src) or host-sim's doc comments; and
+/// `run-elf` names the example that exists.
 #[test]
 fn no_internal_labels_in_help_or_sources() {
     for (cmd, help) in all_help() {
