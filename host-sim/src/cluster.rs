@@ -101,49 +101,22 @@ pub fn cluster(
     let mut src = SliceSource::new(&mesh.positions, &mesh.triangles);
     let start = Instant::now();
     let q = if quadric { Some(&mut *quads) } else { None };
-    let r = match mem {
-        VertexMemory::None => table.cluster(
-            &mut src,
-            config,
-            &mut out,
-            Scratch {
-                quadrics: q,
-                ..Scratch::new()
-            },
-        ),
-        VertexMemory::Bit => table.cluster(
+    // Each buffer is empty unless `mem` asks for it, and an empty buffer is the path without
+    // it, so one call serves every choice.
+    let r = table
+        .cluster(
             &mut src,
             config,
             &mut out,
             Scratch {
                 quadrics: q,
                 seen: &mut bits,
-                ..Scratch::new()
-            },
-        ),
-        VertexMemory::Cache => table.cluster(
-            &mut src,
-            config,
-            &mut out,
-            Scratch {
-                quadrics: q,
-                cache: &mut cache,
-                ..Scratch::new()
-            },
-        ),
-        VertexMemory::Keys => table.cluster(
-            &mut src,
-            config,
-            &mut out,
-            Scratch {
-                quadrics: q,
                 cache: &mut cache,
                 keys: &mut keys,
                 ..Scratch::new()
             },
-        ),
-    }
-    .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
+        )
+        .map_err(|e| anyhow!("tinydecimate::cluster: {e}"))?;
     let dt = start.elapsed();
     out.truncate(r.triangles_out);
     Ok((
