@@ -87,7 +87,9 @@ pub struct Config {
     /// in `(0, 180)`.
     pub max_normal_turn_deg: f32,
     /// Reject a collapse that leaves a triangle with quality (`4√3·area / Σ edge²`, 1 for an
-    /// equilateral triangle) below this, unless the triangle was already worse. In `[0, 1)`.
+    /// equilateral triangle) below this, unless the triangle was already worse or stays in its
+    /// plane (within about 1°: a flat face stays flat, so the sliver costs no error). In
+    /// `[0, 1)`.
     pub min_quality: f32,
     /// Weight of the boundary retreat (squared distance of a removed boundary vertex to the new
     /// boundary edge) against the normal variation. Non-negative.

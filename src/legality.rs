@@ -13,9 +13,15 @@
 //! - **validity** (`locked`, `boundary`, `link`, `duplicate`, `fold`): without the rule the
 //!   output can stop being a valid mesh of the same topology (a non-manifold edge, a pinched
 //!   vertex, a duplicate or folded triangle, a boundary loop closed or left).
-//! - **validity and quality** (`sliver`): a triangle of zero area is always refused
-//!   (validity); one whose quality falls below [`Config::min_quality`] is refused only when it
-//!   also got worse (a preference).
+//! - **validity and quality** (`sliver`): a triangle of zero area, or so thin that rounding
+//!   decides which way it faces, is always refused (validity); one whose quality falls below
+//!   [`Config::min_quality`] is refused only when it also got worse *and* left its plane (a
+//!   preference). A collapse that keeps a flat face flat is never refused for its slivers: on a
+//!   flat CAD face the triangles are long fans into holes and corners, nearly every collapse
+//!   there makes a thinner triangle, and a veto on them left only the expensive collapses
+//!   (corners, holes) to reach the count. Such a sliver costs no error and a later collapse
+//!   can remove it; meshoptimizer has no shape veto at all (only its flip test), VCG's quality
+//!   check is a soft penalty.
 //! - **quality** (`feature`, `normal_turn`): the output stays valid without them; they keep
 //!   the feature vertices of Lin Mouguang 2007 and bound how far a triangle may turn in one
 //!   collapse ([`Config::max_normal_turn_deg`]).
@@ -198,8 +204,9 @@ pub const RULES: &[Rule] = &[
     Rule {
         reject: Reject::Sliver,
         name: "sliver",
-        protects: "a surviving triangle gets zero area (validity), or a quality below \
-                   Config::min_quality that is also worse than before (preference)",
+        protects: "a surviving triangle gets zero area or a normal that rounding decides \
+                   (validity), or leaves its plane with a quality below Config::min_quality \
+                   that is also worse than before (preference)",
         kind: Kind::ValidityAndQuality,
         source: "",
     },
@@ -294,6 +301,15 @@ pub(crate) use on;
 /// Two adjacent triangles whose unit normals have a dot product below −0.9 are folded onto
 /// each other (more than about 154° apart); compared squared: 0.81.
 const FOLD_DOT2: f32 = 0.81;
+
+/// A triangle whose normal turns by less than this (cosine of about 1°) stays in its plane:
+/// a sliver there costs no error, so the sliver preference does not apply.
+const COS_PLANAR: f32 = 0.999_85;
+
+/// Below this quality (`|n|² / (Σ edge²)²`: a height about 10⁻⁴ of the longest edge) a
+/// triangle's normal is at the mercy of rounding, so it could flip unseen: it counts as zero
+/// area, unless it was already that thin.
+const FLAT: f32 = 1e-8;
 
 /// The geometric limits of a [`Config`], precomputed.
 #[derive(Clone, Copy, Debug)]
@@ -397,7 +413,11 @@ fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
 #[inline]
 fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
     if on!(Sliver)
-        && (now.quality <= 0.0 || (now.quality < rules.min_ratio && now.quality < was.quality))
+        && (now.quality <= 0.0
+            || (now.quality < FLAT && now.quality < was.quality)
+            || (now.quality < rules.min_ratio
+                && now.quality < was.quality
+                && (was.quality <= 0.0 || turned(was, now, COS_PLANAR, COS_PLANAR * COS_PLANAR))))
     {
         return Err(Reject::Sliver);
     }
