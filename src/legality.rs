@@ -305,6 +305,7 @@ const FOLD_DOT2: f32 = 0.81;
 /// A triangle whose normal turns by less than this (cosine of about 1°) stays in its plane:
 /// a sliver there costs no error, so the sliver preference does not apply.
 const COS_PLANAR: f32 = 0.999_85;
+const COS_PLANAR2: f32 = COS_PLANAR * COS_PLANAR;
 
 /// Below this quality (`|n|² / (Σ edge²)²`: a height about 10⁻⁴ of the longest edge) a
 /// triangle's normal is at the mercy of rounding, so it could flip unseen: it counts as zero
@@ -396,33 +397,31 @@ impl Shape {
     }
 }
 
-/// Whether the angle between the normals of `u` and `v` exceeds the one whose cosine is `cos`.
-#[inline]
-fn turned(u: &Shape, v: &Shape, cos: f32, cos2: f32) -> bool {
-    let d = math::dot(u.n, v.n);
-    let lim = cos2 * u.n2 * v.n2;
-    if cos >= 0.0 {
-        d < 0.0 || d * d < lim
-    } else {
-        d < 0.0 && d * d > lim
-    }
-}
-
 /// The sliver and normal-turn rules on one surviving triangle, `was` before the collapse and
-/// `now` after it.
+/// `now` after it. One dot product serves both: the turn limit and the plane test (a sliver
+/// that stays within about 1° of its plane is allowed).
 #[inline]
 fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
+    let d = math::dot(was.n, now.n);
+    let (d2, n2) = (d * d, was.n2 * now.n2);
+    // Whether the angle between the normals exceeds the one whose cosine is `cos`.
+    let turned = |cos: f32, cos2: f32| {
+        if cos >= 0.0 {
+            d < 0.0 || d2 < cos2 * n2
+        } else {
+            d < 0.0 && d2 > cos2 * n2
+        }
+    };
+    let q = now.quality;
     if on!(Sliver)
-        && (now.quality <= 0.0
-            || (now.quality < FLAT && now.quality < was.quality)
-            || (now.quality < rules.min_ratio
-                && now.quality < was.quality
-                && (was.quality <= 0.0 || turned(was, now, COS_PLANAR, COS_PLANAR * COS_PLANAR))))
+        && (q <= 0.0
+            || (q < was.quality
+                && (q < FLAT || (q < rules.min_ratio && turned(COS_PLANAR, COS_PLANAR2)))))
     {
         return Err(Reject::Sliver);
     }
     // A zero-area triangle has no direction to turn from.
-    if on!(NormalTurn) && was.quality > 0.0 && turned(was, now, rules.cos_turn, rules.cos_turn2) {
+    if on!(NormalTurn) && was.quality > 0.0 && turned(rules.cos_turn, rules.cos_turn2) {
         return Err(Reject::NormalTurn);
     }
     Ok(())
