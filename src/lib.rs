@@ -89,26 +89,24 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod bound;
 pub mod cluster;
-mod collapse;
 mod config;
-pub mod cost;
-mod feature;
-mod heap;
+mod engine;
 mod index;
-pub mod legality;
 mod math;
 mod mesh;
+mod policy;
 pub mod progressive;
 pub mod remap;
 mod report;
-pub mod stream;
-pub mod triangle;
 mod workspace;
 
+pub use engine::triangle;
+pub use policy::{bound, cost, legality};
+pub use progressive::stream;
+
 pub use bound::{Controls, NoBound};
-pub use collapse::Simplifier;
+pub use engine::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
 pub use cost::{Builtin, Placement, StoredQuadric};
 pub use index::Index;

@@ -33,6 +33,8 @@
 
 use crate::index::Index;
 
+pub mod stream;
+
 /// Marks the end of a list.
 const NIL: usize = usize::MAX;
 

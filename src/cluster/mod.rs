@@ -1133,7 +1133,7 @@ fn add_plane(q: &mut [[f32; 10]], grid: &Grid, s: [usize; 3], k: [u32; 3], p: [V
         let o = grid.corner(kj);
         let d = -math::dot(n, math::sub(p[0], o));
         if let Some(e) = q.get_mut(sj) {
-            for (x, y) in e.iter_mut().zip(crate::cost::outer(n, d)) {
+            for (x, y) in e.iter_mut().zip(crate::policy::cost::outer(n, d)) {
                 *x += y * w;
             }
         }

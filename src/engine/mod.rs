@@ -26,16 +26,19 @@
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 
-use crate::bound::{Bound, NoBound};
-use crate::cost::{Cost, Move};
-use crate::feature::{Mean, Variation};
-use crate::heap::Heap;
 use crate::index::Index;
-use crate::legality::{self, on, Rules, Shape};
+use crate::policy::bound::{Bound, NoBound};
+use crate::policy::cost::{Cost, Move};
+use crate::policy::feature::{Mean, Variation};
+use crate::policy::legality::{self, on, Rules, Shape};
 use crate::math::{self, V3};
 use crate::mesh::{flag, next3, prev3, Mesh, NIL};
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Operator, Schedule};
+use heap::Heap;
+
+pub(crate) mod heap;
+pub mod triangle;
 
 /// Candidates priced per vertex: its first `MAX_CANDIDATES` neighbours in fan order (a vertex
 /// of higher valence never moves onto the others).
@@ -850,7 +853,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// rc + d_max)`; `None` if not finite.
     fn triangle_weight(&self, t: usize) -> Option<f32> {
         let tri = self.mesh.tri(t);
-        let (w, area) = crate::triangle::weight(&self.mesh, tri)?;
+        let (w, area) = triangle::weight(&self.mesh, tri)?;
         let d = match self.bound.controls() {
             Some(c) if B::ON => c.max_distance(&self.mesh, t),
             _ => 0.0,
@@ -891,7 +894,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// ends the pop. All refused: the key times the penalty `p` (Zhu, Wang and Meng 2007 §3), at
     /// most `MAX_PENALTIES` times in a row.
     fn pop_triangles(&mut self) {
-        use crate::triangle::{MAX_PENALTIES, PENALTY};
+        use triangle::{MAX_PENALTIES, PENALTY};
         let Some((v, key)) = self.top() else {
             return;
         };
@@ -1264,7 +1267,7 @@ fn less(a: (f32, usize), b: (f32, usize)) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cost::{Placement, StoredQuadric, VertexQuadric};
+    use crate::policy::cost::{Placement, StoredQuadric, VertexQuadric};
     use crate::{Positions, Workspace};
 
     impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
