@@ -106,9 +106,9 @@ pub use policy::{bound, cost, legality};
 pub use progressive::stream;
 
 pub use bound::{Controls, NoBound};
-pub use engine::Simplifier;
 pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
 pub use cost::{Builtin, Placement, StoredQuadric};
+pub use engine::Simplifier;
 pub use index::Index;
 pub use legality::{Reject, RULES};
 pub use progressive::Progressive;

@@ -26,10 +26,10 @@
 
 use crate::engine::heap::Heap;
 use crate::engine::Simplifier;
-use crate::policy::bound::{Bound, NoBound};
-use crate::policy::cost::{Builtin, Cost, Placement};
 use crate::index::Index;
 use crate::mesh::Mesh;
+use crate::policy::bound::{Bound, NoBound};
+use crate::policy::cost::{Builtin, Cost, Placement};
 use crate::{Capacity, Config, ConfigField, Error, Report};
 
 pub use crate::mesh::Positions;
