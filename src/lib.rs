@@ -99,6 +99,7 @@ mod policy;
 pub mod progressive;
 pub mod remap;
 mod report;
+mod tri;
 mod workspace;
 
 pub use engine::triangle;

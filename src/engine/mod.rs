@@ -220,7 +220,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// Vertex `v`'s current position in the input's units (moved by optimal placement);
     /// `None` past the end.
     pub fn position(&self, v: usize) -> Option<[f32; 3]> {
-        self.mesh.raw(v)
+        self.mesh.input_position(v)
     }
 
     /// Whether vertex `v` currently has triangles.

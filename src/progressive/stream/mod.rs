@@ -546,7 +546,7 @@ pub fn encode<I: Index>(
         bits: 0,
         max_bits: h.max_payload as usize * 8,
     };
-    chunks.raw(&head)?;
+    chunks.put_bytes(&head)?;
     pm.set_level(0);
     // Base positions and triangles.
     let mut rec = [0u8; MIN_PAYLOAD as usize];
@@ -679,7 +679,7 @@ struct Chunks<'a> {
 }
 
 impl Chunks<'_> {
-    fn raw(&mut self, b: &[u8]) -> Result<(), StreamError> {
+    fn put_bytes(&mut self, b: &[u8]) -> Result<(), StreamError> {
         let dst = self.out.get_mut(self.at..).ok_or(StreamError::OutputFull)?;
         if dst.len() < b.len() {
             return Err(StreamError::OutputFull);
@@ -698,7 +698,7 @@ impl Chunks<'_> {
             self.close()?;
             self.kind = kind;
             self.start = self.at;
-            self.raw(&[0, 0, kind, 0, 0])?;
+            self.put_bytes(&[0, 0, kind, 0, 0])?;
         }
         let base = self.start + 5;
         let payload = self.out.get_mut(base..).ok_or(StreamError::OutputFull)?;
@@ -742,7 +742,7 @@ impl Chunks<'_> {
         }
         let c = crc32(chunk);
         self.at = end;
-        self.raw(&c.to_le_bytes())?;
+        self.put_bytes(&c.to_le_bytes())?;
         self.kind = 0;
         self.count = 0;
         self.bits = 0;
