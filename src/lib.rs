@@ -97,6 +97,7 @@ mod math;
 mod mesh;
 mod policy;
 pub mod progressive;
+mod quadric;
 pub mod remap;
 mod report;
 mod tri;
