@@ -32,7 +32,7 @@ pub(super) struct Pass<'a, I: Index> {
     /// The caller's per-vertex cache of quantised coordinates ([`Scratch::cache`]);
     /// empty without.
     pub(super) cache: &'a mut [u64],
-    /// The caller's key entries ([`Scratch::keys`]): lane 6 holds the vertex's
+    /// The caller's key entries ([`Scratch::keys`](super::Scratch::keys)): lane 6 holds the vertex's
     /// cell on this pass's grid where lane [`STAMP`] is [`FINAL`], and lane 0 the cell's slot
     /// + 1 once it is known (0 before); empty without.
     pub(super) keys: &'a mut [[u32; KEY_LANES]],
@@ -400,7 +400,7 @@ impl<I: Index> Pass<'_, I> {
 
 /// A single-pass clustering of a stream that may be read only once (a UART, a radio), with a
 /// grid fixed in advance and the nearest-to-centre representative. From
-/// [`Clusterer::stream`]: [`Stream::push`] the chunks, then [`Stream::finish`].
+/// [`Clusterer::stream`](super::Clusterer::stream): [`Stream::push`] the chunks, then [`Stream::finish`].
 pub struct Stream<'a, I: Index> {
     pub(super) pass: Pass<'a, I>,
 }

@@ -9,7 +9,7 @@ use super::{ClusterError, Clusterer, Source, CHUNK, MAX_RESOLUTION};
 /// Resolutions probed per counting pass of the target search.
 pub const PROBES: usize = 6;
 
-/// Lanes of a per-vertex key entry of [`Scratch::keys`]: the cells of the
+/// Lanes of a per-vertex key entry of [`Scratch::keys`](super::Scratch::keys): the cells of the
 /// [`PROBES`] resolutions of a counting pass, padded to 8 (32 bytes, two SIMD registers).
 pub const KEY_LANES: usize = 8;
 

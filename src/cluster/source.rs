@@ -30,9 +30,9 @@ impl<F: FnMut(usize) -> Option<[f32; 3]>> PositionSource for PositionFn<F> {
 }
 
 /// A stream of triangles that can be read again from the start, with their positions: what
-/// [`Clusterer::cluster`] needs for the bounding box, the search for a target count and the
+/// [`Clusterer::cluster`](super::Clusterer::cluster) needs for the bounding box, the search for a target count and the
 /// quadric representative. A stream that can be read only once goes through
-/// [`Clusterer::stream`] instead.
+/// [`Clusterer::stream`](super::Clusterer::stream) instead.
 pub trait Source {
     /// Goes back to the first triangle; `false` if the source cannot.
     fn rewind(&mut self) -> bool;

@@ -2,7 +2,7 @@
 //! their new vertices, in checksummed chunks, decoded incrementally as bytes arrive.
 //!
 //! Why (Lin 2007 §1-2): a small screen at the end of a slow link must show something at once
-//! and refine as bytes arrive. The splits are those of [`Progressive`] (Cheng, Pan and Shi 1998
+//! and refine as bytes arrive. The splits are those of [`Progressive`](crate::Progressive) (Cheng, Pan and Shi 1998
 //! §2.1-2.2); a split names its corners by their places in the kept vertex's list, so its
 //! connectivity costs a few bits per neighbour, and it is only applied once its whole chunk has
 //! arrived and its checksum matches, so a bad stream never leaves a broken mesh behind.
