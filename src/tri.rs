@@ -1,6 +1,7 @@
 //! Index triples, shared by the mesh, the progressive mesh and the stream: the slot order of a
 //! triangle's corners, the end-of-list marker, and the two rules that drop an input triangle
-//! before simplifying (the simplifier and the progressive mesh must drop the same ones).
+//! before simplifying (the simplifier and the progressive mesh must drop the same ones; each
+//! walks its own lists for the earlier triangles).
 
 /// Marks the end of a list, or "no vertex".
 pub(crate) const NIL: usize = usize::MAX;
@@ -26,7 +27,8 @@ pub(crate) const fn prev3(k: usize) -> usize {
     }
 }
 
-/// Same three vertices. Both directions, so a removed `[x, x, x]` never matches.
+/// Same three vertices (any order or winding): a later copy of a kept triangle is dropped.
+/// Both directions, so a removed `[x, x, x]` never matches.
 pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
     a.iter().all(|x| b.contains(x)) && b.iter().all(|x| a.contains(x))
 }
@@ -35,11 +37,4 @@ pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
 #[inline]
 pub(crate) fn is_degenerate([a, b, c]: [usize; 3]) -> bool {
     a == b || b == c || a == c
-}
-
-/// Whether `tri` repeats one of `earlier` (same vertices, any order or winding): then it is
-/// dropped and the first copy kept. `earlier` holds the kept triangles before it that share a
-/// vertex with it (callers walk the list of its first vertex).
-pub(crate) fn repeats(tri: [usize; 3], earlier: impl IntoIterator<Item = [usize; 3]>) -> bool {
-    earlier.into_iter().any(|u| same_set(u, tri))
 }

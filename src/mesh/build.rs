@@ -5,7 +5,7 @@ use core::cell::Cell;
 
 use super::{corner, flag, is_dead, Mesh, Positions};
 use crate::index::Index;
-use crate::math::{self, V3};
+use crate::math;
 use crate::tri::{self, next3, prev3, NIL};
 use crate::Error;
 
@@ -20,8 +20,37 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         flags: &'a mut [u8],
         scratch: (&mut [L], &mut [L]),
     ) -> Result<Self, Error> {
-        // 1. Validate before touching anything.
-        let (centre, inv_half) = validate(&pos, tris)?;
+        // Steps 2-4 are `#[inline(always)]`: each is called once, and as calls (or with step
+        // 1 as a function of its own) they cost flash (scripts/flash.sh).
+        // 1. Validate before touching anything: indices in range, used positions finite.
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for (t, tri) in tris.iter().enumerate() {
+            for &i in tri {
+                let index = i.to_usize();
+                let Some(p) = pos.get(index) else {
+                    return Err(Error::IndexOutOfRange { triangle: t, index });
+                };
+                if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
+                    return Err(Error::NonFinitePosition { vertex: index });
+                }
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+        // Halves first, so that `hi - lo` cannot overflow for coordinates near f32::MAX.
+        let mut centre = [0.0; 3];
+        let mut half = 0.0f32;
+        if !tris.is_empty() {
+            for a in 0..3 {
+                centre[a] = lo[a] * 0.5 + hi[a] * 0.5;
+                half = half.max(hi[a] * 0.5 - lo[a] * 0.5);
+            }
+        }
+        let inv = 1.0 / half;
+        let inv_half = if inv.is_finite() { inv } else { 1.0 };
         // A workspace is reused: nothing of an earlier run's flags may reach the fan
         // ordering below (its SEEN bits are the queue's RAISED bit).
         for f in flags.iter_mut() {
@@ -52,6 +81,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     }
 
     /// Writes every triangle with a repeated index as removed (before the lists are built).
+    #[inline(always)]
     fn drop_degenerate(&mut self) {
         for t in 0..self.tris.len() {
             if tri::is_degenerate(self.tri(t)) {
@@ -65,18 +95,24 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// later copy shows up in the corner list of its first vertex. A copy leaves all three
     /// lists while it is intact (a list walk finds its slot by its vertex), and only then is
     /// written as removed, so no walk ever meets it.
+    #[inline(always)]
     fn drop_duplicates(&mut self) {
         for t in 0..self.tris.len() {
             let tri = self.tri(t);
             if is_dead(tri) {
                 continue;
             }
-            let earlier = self
-                .corners(tri[0])
-                .map(|(u, _)| u)
-                .filter(|&u| u < t)
-                .map(|u| self.tri(u));
-            if tri::repeats(tri, earlier) {
+            let mut c = self.first(tri[0]);
+            let mut dup = false;
+            while c != NIL {
+                let u = c >> 2;
+                if u < t && tri::same_set(self.tri(u), tri) {
+                    dup = true;
+                    break;
+                }
+                c = self.after(c);
+            }
+            if dup {
                 for &x in &tri {
                     self.unlink(x, t);
                 }
@@ -89,6 +125,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
 
     /// Sets every vertex's flags: used, and boundary or locked from its fan (which
     /// [`Mesh::order`] puts in fan order when it is regular).
+    #[inline(always)]
     fn classify(&mut self, scratch: (&mut [L], &mut [L])) {
         for v in 0..self.head.len() {
             let mut f = 0;
@@ -216,39 +253,4 @@ enum Fan {
     Interior,
     Boundary,
     Irregular,
-}
-
-/// Checks that every index is in range and every used position finite, reading only, and
-/// returns the centre and the inverse half-extent of the used positions' box (the map into
-/// roughly `[-1, 1]³` that [`Mesh::p`] applies).
-fn validate<I: Index>(pos: &Positions<'_>, tris: &[[I; 3]]) -> Result<(V3, f32), Error> {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for (t, tri) in tris.iter().enumerate() {
-        for &i in tri {
-            let index = i.to_usize();
-            let Some(p) = pos.get(index) else {
-                return Err(Error::IndexOutOfRange { triangle: t, index });
-            };
-            if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
-                return Err(Error::NonFinitePosition { vertex: index });
-            }
-            for a in 0..3 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
-    }
-    // Halves first, so that `hi - lo` cannot overflow for coordinates near f32::MAX.
-    let mut centre = [0.0; 3];
-    let mut half = 0.0f32;
-    if !tris.is_empty() {
-        for a in 0..3 {
-            centre[a] = lo[a] * 0.5 + hi[a] * 0.5;
-            half = half.max(hi[a] * 0.5 - lo[a] * 0.5);
-        }
-    }
-    let inv = 1.0 / half;
-    let inv_half = if inv.is_finite() { inv } else { 1.0 };
-    Ok((centre, inv_half))
 }

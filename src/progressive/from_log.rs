@@ -197,11 +197,20 @@ fn check_capacity<I: Index>(
 fn link_input<I: Index>(lists: &mut Lists<'_, I>, rank: &mut [I], dropped: I) {
     for u in 0..lists.tris.len() {
         let tri = lists.tri(u);
-        let a = tri[0];
-        let earlier = core::iter::successors(Some(lists.first(a)), |&w| Some(lists.after(w, a)))
-            .take_while(|&w| w != NIL && w < u)
-            .map(|w| lists.tri(w));
-        if tri::is_degenerate(tri) || tri::repeats(tri, earlier) {
+        let mut drop = tri::is_degenerate(tri);
+        if !drop {
+            // A later copy: the same vertices as a kept triangle before it in the list of
+            // its first vertex.
+            let mut w = lists.first(tri[0]);
+            while w != NIL && w < u {
+                if tri::same_set(lists.tri(w), tri) {
+                    drop = true;
+                    break;
+                }
+                w = lists.after(w, tri[0]);
+            }
+        }
+        if drop {
             if let Some(r) = rank.get_mut(u) {
                 *r = dropped;
             }
