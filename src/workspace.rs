@@ -24,11 +24,12 @@
 //! [`StoredQuadric`]: crate::cost::StoredQuadric
 //! [`Controls`]: crate::bound::Controls
 
-use crate::bound::{Bound, NoBound};
-use crate::collapse::Simplifier;
-use crate::cost::{Builtin, Cost, Placement};
+use crate::engine::heap::Heap;
+use crate::engine::Simplifier;
 use crate::index::Index;
 use crate::mesh::Mesh;
+use crate::policy::bound::{Bound, NoBound};
+use crate::policy::cost::{Builtin, Cost, Placement};
 use crate::{Capacity, Config, ConfigField, Error, Report};
 
 pub use crate::mesh::Positions;
@@ -225,7 +226,7 @@ impl<'a, L: Index> Storage<'a, L> {
         )?;
         Ok(Simplifier::new(
             mesh,
-            crate::heap::Heap::new(heap, heap_pos, key),
+            Heap::new(heap, heap_pos, key),
             *config,
             cost,
             bound,

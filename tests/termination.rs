@@ -1,7 +1,7 @@
 //! Deterministic termination, measured: the number of operations `step` performs is bounded by
 //! the mesh size.
 //!
-//! Proof sketch (also in `src/collapse.rs`). Every collapse removes a vertex, so there are at
+//! Proof sketch (also in `src/engine/mod.rs`). Every collapse removes a vertex, so there are at
 //! most V collapses. Sweeps (feature mean, flags, keys, pairing) visit each vertex once per
 //! pass or round, and a pass or round without a collapse ends the run, so there are at most
 //! min(max_passes, collapses + 1) of them; greedy also refreshes its feature threshold with one

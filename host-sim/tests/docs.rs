@@ -76,7 +76,7 @@ fn seed_citations() {
             }
         }
     }
-    let legality = read("src/legality.rs");
+    let legality = read("src/policy/legality.rs");
     // The link rule's row of `RULES`: its `source` follows its `name`.
     let link = legality
         .split("name: \"link\",")

@@ -1,0 +1,44 @@
+//! The collapse log: `[removed, kept]` per collapse, for progressive meshes.
+
+use super::Simplifier;
+use crate::index::Index;
+use crate::policy::bound::Bound;
+use crate::policy::cost::Cost;
+use crate::report::Stop;
+
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
+    /// vertex numbers: the history that [`Progressive::from_log`](crate::Progressive::from_log)
+    /// turns into vertex splits (call it before the first step to have the whole history).
+    /// When `log` is full the run stops with [`Stop::LogFull`] before the next collapse, so
+    /// the log always holds every collapse made and the mesh stays valid.
+    pub fn record_into(mut self, log: &'a mut [[I; 2]]) -> Self {
+        self.log = log;
+        self.logging = true;
+        self.logged = 0;
+        self
+    }
+
+    /// The collapses logged so far (see [`Simplifier::record_into`]).
+    pub fn records(&self) -> &[[I; 2]] {
+        self.log.get(..self.logged).unwrap_or(&[])
+    }
+
+    /// Appends `[a, b]` to the log; `false` (and the run stops) if the log is full.
+    pub(super) fn log_collapse(&mut self, a: usize, b: usize) -> bool {
+        if !self.logging {
+            return true;
+        }
+        match self.log.get_mut(self.logged) {
+            Some(slot) => {
+                *slot = [I::narrow(a), I::narrow(b)];
+                self.logged += 1;
+                true
+            }
+            None => {
+                self.done(Stop::LogFull);
+                false
+            }
+        }
+    }
+}

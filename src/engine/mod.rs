@@ -1,0 +1,354 @@
+//! The collapse engine: schedule, legality, apply.
+//!
+//! One [`Simplifier`] drives a mesh from start to finish as a small state machine, so that it
+//! can stop after any number of operations and resume later (watchdogs, frame deadlines) and
+//! still give exactly the bytes of a one-shot run: one-shot *is* stepping with an unlimited
+//! budget.
+//!
+//! ```text
+//! Greedy: Mean ─> Keys ─> Queue: pop the cheapest vertex, check the rules on its candidates
+//!                   ^             in cost order, collapse, re-key the vertices whose fan changed
+//!                   └── when the mesh has halved (fresh feature threshold) or the queue is empty
+//! Passes: Mean ─> Flags ─> Pairs: sweep vertices in index order, pair, collapse ─> next pass
+//! ```
+//!
+//! A vertex's key is a lower bound: the price of its cheapest candidate under the flag and
+//! boundary rules only, from one walk around its fan. The connectivity and shape rules run when
+//! it reaches the top; if its cheapest *legal* collapse costs more than the key it goes back in
+//! at that price, so collapses still come out in exact cost order.
+//!
+//! Termination: every collapse removes a vertex, so there are fewer collapses than vertices.
+//! Between two collapses the queue only re-keys a popped vertex to a strictly higher price of
+//! one of its at most `MAX_CANDIDATES` candidates (its exact current cost, or for a stored
+//! cost without the feature rule possibly a refused candidate's price first) or drops it, and
+//! prices do not change without a collapse, so at most `(MAX_CANDIDATES + 1)·V` pops separate
+//! two collapses; a
+//! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
+//! ends the run. Every operation below is bounded by the valences involved.
+
+use crate::index::Index;
+use crate::math::V3;
+use crate::mesh::{flag, Mesh, NIL};
+use crate::policy::bound::{Bound, NoBound};
+use crate::policy::cost::Cost;
+use crate::policy::feature::Mean;
+use crate::policy::legality::Rules;
+use crate::report::{Rejections, Report, Stop};
+use crate::{Config, Schedule};
+use heap::Heap;
+
+mod greedy;
+pub(crate) mod heap;
+mod log;
+mod passes;
+mod price;
+mod report;
+pub mod triangle;
+mod walk;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Phase {
+    /// Summing D for the feature threshold.
+    Mean,
+    /// Setting feature flags.
+    Flags,
+    /// Once, for a cost that stores per-vertex state: handing it every vertex's planes.
+    Init,
+    /// Greedy: classifying every vertex and computing its key.
+    Keys,
+    /// Greedy: collapsing from the queue.
+    Queue,
+    /// Passes: pairing vertices in index order.
+    Pairs,
+    /// Finished.
+    Done(Stop),
+}
+
+/// A simplification in progress; see [`Storage::start`](crate::Storage::start).
+///
+/// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
+/// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
+/// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
+///
+/// `B` is the error bound: [`NoBound`] (none, the default) or
+/// [`Controls`](crate::bound::Controls).
+pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound> {
+    mesh: Mesh<'a, L, I>,
+    heap: Heap<'a, L>,
+    config: Config,
+    rules: Rules,
+    cost: C,
+    target: usize,
+    phase: Phase,
+    /// Vertex cursor of the current sweep.
+    v: usize,
+    mean: Mean,
+    threshold: f32,
+    /// Sum of twice the fan areas over a Mean sweep.
+    area2: f32,
+    features: usize,
+    locked: usize,
+    used_in: usize,
+    collapses: usize,
+    passes: u32,
+    pass_collapses: usize,
+    /// A legal collapse was skipped because it cost more than `max_cost`.
+    over_cost: bool,
+    /// Greedy: refresh the feature threshold when the mesh is down to this many triangles.
+    refresh_at: usize,
+    /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
+    refresh_only: bool,
+    pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
+    rejected: Rejections,
+    /// Collapse log (`[removed, kept]`), written only once `record_into` gave one.
+    log: &'a mut [[I; 2]],
+    logging: bool,
+    logged: usize,
+    /// The cost's per-vertex state has been filled (costs that store it only).
+    initialised: bool,
+    /// The error bound (control points), if any.
+    bound: B,
+}
+
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    #[inline(always)]
+    pub(crate) fn new(
+        mesh: Mesh<'a, L, I>,
+        heap: Heap<'a, L>,
+        config: Config,
+        cost: C,
+        bound: B,
+    ) -> Self {
+        // In f32, exact for counts below 2^24; the product is floored.
+        let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
+        let target = if config.target_triangles > by_ratio {
+            config.target_triangles
+        } else {
+            by_ratio
+        };
+        let (mut locked, mut used_in) = (0, 0);
+        for v in 0..mesh.vertex_count() {
+            locked += mesh.has(v, flag::LOCKED) as usize;
+            used_in += mesh.has(v, flag::USED) as usize;
+        }
+        let mut s = Simplifier {
+            mesh,
+            heap,
+            rules: Rules::new(&config),
+            config,
+            cost,
+            target,
+            phase: Phase::Mean,
+            v: 0,
+            mean: Mean::default(),
+            threshold: f32::INFINITY,
+            area2: 0.0,
+            features: 0,
+            locked,
+            used_in,
+            collapses: 0,
+            passes: 0,
+            pass_collapses: 0,
+            over_cost: false,
+            refresh_at: 0,
+            refresh_only: false,
+            pass_triangles: heapless::Vec::new(),
+            rejected: Rejections::default(),
+            log: &mut [],
+            logging: false,
+            logged: 0,
+            initialised: false,
+            bound,
+        };
+        if B::ON {
+            s.enrol();
+        }
+        s
+    }
+
+    /// Enrols the control points of a bounded run (nothing without a bound).
+    fn enrol(&mut self) {
+        let d = self.config.max_error;
+        if let Some(c) = self.bound.controls_mut() {
+            c.enrol(&self.mesh, d);
+        }
+    }
+
+    /// Runs at most `budget` operations and returns `true` once the run is finished.
+    ///
+    /// An operation is one vertex visited by a sweep, one queue pop, or one collapse with the
+    /// updates around it; each is bounded by the valences involved. A budget of 0 does nothing.
+    pub fn step(&mut self, budget: u32) -> bool {
+        let mut ops = 0;
+        while ops < budget {
+            if let Phase::Done(_) = self.phase {
+                return true;
+            }
+            self.operate();
+            ops += 1;
+        }
+        matches!(self.phase, Phase::Done(_))
+    }
+
+    /// Runs to the end and [finishes](Simplifier::finish): the one-shot run.
+    pub fn run(mut self) -> Report {
+        while !self.step(u32::MAX) {}
+        self.finish()
+    }
+
+    /// Live triangles now.
+    pub fn live_triangles(&self) -> usize {
+        self.mesh.live
+    }
+
+    /// The live triangles now, in buffer order (the order [`Simplifier::finish`] keeps).
+    pub fn triangles(&self) -> impl Iterator<Item = [I; 3]> + '_ {
+        self.mesh.tris.iter().copied().filter(|t| t[0] != t[1])
+    }
+
+    /// The caller's buffer as it is now: live triangles in their original slots, removed ones
+    /// written as `[i, i, i]`.
+    pub fn buffer(&self) -> &[[I; 3]] {
+        self.mesh.tris
+    }
+
+    /// Whether vertex `v` is currently a feature vertex (never removed while it is one).
+    pub fn is_feature(&self, v: usize) -> bool {
+        self.mesh.has(v, flag::FEATURE)
+    }
+
+    /// Vertex `v`'s current position in the input's units (moved by optimal placement);
+    /// `None` past the end.
+    pub fn position(&self, v: usize) -> Option<[f32; 3]> {
+        self.mesh.input_position(v)
+    }
+
+    /// Whether vertex `v` currently has triangles.
+    pub fn is_used(&self, v: usize) -> bool {
+        self.mesh.first(v) != NIL
+    }
+
+    /// One operation of the state machine.
+    fn operate(&mut self) {
+        let nv = self.mesh.vertex_count();
+        match self.phase {
+            Phase::Done(_) => {}
+            Phase::Mean => {
+                if self.v == 0 {
+                    if self.mesh.live <= self.target {
+                        return self.done(Stop::Target);
+                    }
+                    self.mean = Mean::default();
+                    self.area2 = 0.0;
+                }
+                if self.v < nv && !self.normals() {
+                    // Nothing reads the sums: skip the sweep.
+                    self.v = nv;
+                } else if self.v < nv {
+                    if self.mesh.has(self.v, flag::USED) {
+                        let w = self.walk(self.v);
+                        if self.config.features {
+                            self.mean.add(w.variation.value(self.config.feature_mode));
+                        }
+                        self.area2 += w.area2;
+                    }
+                    self.v += 1;
+                } else {
+                    self.threshold = self.mean.threshold(self.config.lambda);
+                    // Each triangle was seen from its three corners.
+                    let live = self.mesh.live as f32;
+                    self.cost.round(if live > 0.0 {
+                        self.area2 / (3.0 * live)
+                    } else {
+                        0.0
+                    });
+                    self.v = 0;
+                    if self.refresh_only {
+                        // Vertices meet the new threshold as they are re-keyed.
+                        self.refresh_only = false;
+                        self.refresh_at = self.mesh.live / 2;
+                        self.phase = Phase::Queue;
+                        return;
+                    }
+                    self.features = 0;
+                    self.passes += 1;
+                    self.pass_collapses = 0;
+                    self.phase = if self.cost.stores() && !self.initialised {
+                        Phase::Init
+                    } else {
+                        self.after_init()
+                    };
+                }
+            }
+            Phase::Init => {
+                if self.v < nv {
+                    self.init_vertex(self.v);
+                    self.v += 1;
+                } else {
+                    self.initialised = true;
+                    self.v = 0;
+                    self.phase = self.after_init();
+                }
+            }
+            Phase::Flags => {
+                if self.v < nv {
+                    let v = self.v;
+                    let is = self.config.features
+                        && self.mesh.has(v, flag::USED)
+                        && self.is_feature_now(&self.walk(v));
+                    self.mesh.set_flag(v, flag::FEATURE, is);
+                    self.mesh.set_flag(v, flag::DONE, false);
+                    self.features += is as usize;
+                    self.v += 1;
+                } else {
+                    self.v = 0;
+                    self.phase = Phase::Pairs;
+                }
+            }
+            Phase::Keys => {
+                if self.v < nv {
+                    self.rekey(self.v);
+                    self.features += self.mesh.has(self.v, flag::FEATURE) as usize;
+                    self.v += 1;
+                } else {
+                    self.refresh_at = self.mesh.live / 2;
+                    self.phase = Phase::Queue;
+                }
+            }
+            Phase::Queue => self.pop(),
+            Phase::Pairs => self.pair(),
+        }
+    }
+
+    /// The phase that starts a round's work.
+    fn after_init(&self) -> Phase {
+        if self.config.schedule == Schedule::Passes {
+            Phase::Flags
+        } else {
+            Phase::Keys
+        }
+    }
+
+    /// Collapses `a -> b` in the mesh, moves `b` to its placement and merges the cost's state.
+    fn apply(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
+        let (pa, pb) = (self.mesh.p(a), self.mesh.p(b));
+        let chain = match self.bound.controls_mut() {
+            Some(c) if B::ON => c.detach(&self.mesh, a),
+            _ => NIL,
+        };
+        self.mesh.collapse(a, b);
+        if B::ON {
+            if let Some(c) = self.bound.controls_mut() {
+                c.attach(&self.mesh, b, chain);
+            }
+        }
+        let mut p_new = pb;
+        if let Some((q, p)) = at {
+            self.mesh.place(b, q);
+            p_new = p;
+        }
+        if self.cost.stores() {
+            self.cost.merge(a, b, pa, pb, p_new);
+        }
+    }
+}

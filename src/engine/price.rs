@@ -1,0 +1,217 @@
+//! Pricing a collapse and checking it: the cheap flag and boundary rules that make a key a lower
+//! bound, the placement of the kept vertex, then the legality rules and the bound's veto.
+
+use super::walk::{FanSummary, MAX_CANDIDATES};
+use super::Simplifier;
+use crate::index::Index;
+use crate::math::{self, V3};
+use crate::mesh::{flag, NIL};
+use crate::policy::bound::Bound;
+use crate::policy::cost::{Cost, Move};
+use crate::policy::legality::{self, on};
+
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    /// The legality rules for `from -> to` (at `at` if the cost places the kept vertex), then
+    /// the error bound's veto.
+    #[inline(always)]
+    pub(super) fn check(
+        &self,
+        from: usize,
+        to: usize,
+        at: Option<V3>,
+    ) -> Result<(), crate::Reject> {
+        // Inlined, so that the read-only modes (always `None`) drop the moved-`b` rules.
+        match at {
+            Some(p) => legality::check_placed(&self.mesh, &self.rules, from, to, p)?,
+            None => legality::check(&self.mesh, &self.rules, from, to, None)?,
+        }
+        if B::ON && on!(Bound) {
+            if let Some(c) = self.bound.controls() {
+                if !c.allows(&self.mesh, from, to) {
+                    return Err(crate::Reject::Bound);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The price of moving `from` (walked as `w`) onto `to`, if the flag and boundary rules
+    /// allow it: the cheap half of legality, enough for a lower bound.
+    pub(super) fn price(&self, from: usize, w: &FanSummary<C::Fan>, to: usize) -> Option<f32> {
+        self.price_kept(from, w, to, false)
+    }
+
+    /// [`Self::price`]; with `keep`, at `to`'s own position even for a placing cost.
+    pub(super) fn price_kept(
+        &self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        keep: bool,
+    ) -> Option<f32> {
+        let m = self.make_move(from, w, to, keep)?;
+        let c = self.cost.price(&w.fan, &m);
+        if c.is_finite() {
+            Some(if c > 0.0 { c } else { 0.0 })
+        } else {
+            None
+        }
+    }
+
+    /// Whether collapses may move the kept vertex: a placing cost on mutable positions
+    /// (compile-time `false` for every other cost).
+    #[inline]
+    pub(super) fn movable(&self) -> bool {
+        C::PLACES && self.mesh.movable()
+    }
+
+    /// The move `from -> to` as a cost sees it, if the flag and boundary rules allow it.
+    pub(super) fn make_move(
+        &self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        keep: bool,
+    ) -> Option<Move> {
+        let mesh = &self.mesh;
+        let ff = mesh.flags(from);
+        legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
+        let mut retreat2 = 0.0;
+        if ff & flag::BOUNDARY != 0 && on!(Boundary) {
+            // Only along its own boundary edges; the boundary retreats to the segment from
+            // its other boundary neighbour to `to`.
+            let (x1, x2) = w.ends;
+            let other = if to == x1 {
+                x2
+            } else if to == x2 {
+                x1
+            } else {
+                return None;
+            };
+            retreat2 = math::segment_distance2(w.p, mesh.p(other), mesh.p(to));
+        }
+        let turn = if self.cost.needs_turn() {
+            self.turn(from, to)
+        } else {
+            0.0
+        };
+        let p_to = mesh.p(to);
+        Some(Move {
+            d: math::sub(p_to, w.p),
+            retreat2,
+            turn,
+            from,
+            to,
+            p_from: w.p,
+            p_to,
+            keep: keep || !self.movable() || mesh.has(to, flag::FEATURE),
+        })
+    }
+
+    /// Where the kept vertex of `from -> to` goes if the cost places it (optimal placement on
+    /// mutable positions): its input-unit coordinates and the normalised position they read
+    /// back as. `None`: it stays.
+    pub(super) fn placement(
+        &self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+    ) -> Option<([f32; 3], V3)> {
+        if !self.movable() {
+            return None;
+        }
+        let m = self.make_move(from, w, to, false)?;
+        if m.keep {
+            return None;
+        }
+        let p = self.cost.place(&m)?;
+        self.mesh.stored_form(p)
+    }
+
+    /// The legality rules for `from -> to` priced `c`, at the cost's placement if it places
+    /// the kept vertex. If the rules refuse the placed position but allow the kept vertex to
+    /// stay, the collapse goes ahead at `to`'s own position and price. Returns the price and
+    /// the placement.
+    #[allow(clippy::type_complexity)]
+    pub(super) fn legal(
+        &self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        c: f32,
+    ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
+        if !self.movable() {
+            return self.check(from, to, None).map(|()| (c, None));
+        }
+        self.legal_placed(from, w, to, c)
+    }
+
+    /// [`Self::legal`] on mutable positions. Never inlined, so that the read-only modes (every
+    /// device mode) do not carry its frame: the micro:bit has 4.5 KB of stack.
+    #[allow(clippy::type_complexity)]
+    #[inline(never)]
+    pub(super) fn legal_placed(
+        &self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        c: f32,
+    ) -> Result<(f32, Option<([f32; 3], V3)>), crate::Reject> {
+        let at = self.placement(from, w, to);
+        match self.check(from, to, at.map(|x| x.1)) {
+            Ok(()) => Ok((c, at)),
+            Err(r) => {
+                if at.is_some() && self.check(from, to, None).is_ok() {
+                    if let Some(kept) = self.price_kept(from, w, to, true) {
+                        return Ok((kept, None));
+                    }
+                }
+                Err(r)
+            }
+        }
+    }
+
+    /// `v`'s candidates with their prices, in fan order; returns how many.
+    pub(super) fn candidates(
+        &self,
+        v: usize,
+        w: &FanSummary<C::Fan>,
+        out: &mut [(f32, usize); MAX_CANDIDATES],
+    ) -> usize {
+        let mut n = 0;
+        for x in w.neighbours() {
+            if let Some(p) = self.price(v, w, x) {
+                if let Some(slot) = out.get_mut(n) {
+                    *slot = (p, x);
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+}
+
+/// Removes and returns the cheapest `(price, vertex)` (ties: lower vertex), if any is left.
+pub(super) fn take_cheapest(cand: &mut [(f32, usize)]) -> Option<(f32, usize)> {
+    let mut min: Option<usize> = None;
+    for (i, c) in cand.iter().enumerate() {
+        if c.1 != NIL {
+            if let Some(m) = min.and_then(|m| cand.get(m)) {
+                if !less(*c, *m) {
+                    continue;
+                }
+            }
+            min = Some(i);
+        }
+    }
+    let slot = cand.get_mut(min?)?;
+    let c = *slot;
+    slot.1 = NIL;
+    Some(c)
+}
+
+/// `(cost, vertex)` order: cheaper first, then the lower vertex number.
+#[inline]
+fn less(a: (f32, usize), b: (f32, usize)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+}

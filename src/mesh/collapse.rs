@@ -1,0 +1,205 @@
+//! Changing the mesh: a half-edge collapse with its list splicing, and the final compaction.
+
+use super::Mesh;
+use crate::index::Index;
+use crate::tri::{next3, NIL};
+
+impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
+    /// Removes triangle `t` (still intact) from `v`'s list; a vertex left without triangles
+    /// loses its flags.
+    pub(super) fn unlink(&mut self, v: usize, t: usize) {
+        let mut prev = NIL;
+        let mut c = self.first(v);
+        let mut guard = self.tris.len() + 1;
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let n = self.after(c);
+            if (c >> 2) == t {
+                if prev == NIL {
+                    self.set_first(v, n);
+                } else {
+                    self.set_after(prev, n);
+                }
+                break;
+            }
+            prev = c;
+            c = n;
+        }
+        if self.first(v) == NIL {
+            self.set_flags(v, 0);
+        }
+    }
+
+    /// Moves `a` onto `b` (half-edge collapse with subset placement, Lin 2007 §2): the (one or
+    /// two) triangles on edge `a-b` are removed, `a`'s other triangles now use `b`. The caller
+    /// has checked legality. Returns the number of triangles removed.
+    ///
+    /// Fan order is kept: in `a`'s fan the survivors run from the triangle after `(a, b, o1)`
+    /// to the one before `(a, o2, b)`; in `b`'s fan the removed `(b, o1, a)` and `(b, a, o2)`
+    /// are adjacent, and the run takes their place. `o1` and `o2` just lose one triangle.
+    pub(crate) fn collapse(&mut self, a: usize, b: usize) -> usize {
+        // Rotate a's list to start right after (a, b, o1), so that the survivors come out in
+        // fan order whether a's fan is a disc or a half-disc.
+        let first = self.first(a);
+        let (mut c1, mut last) = (NIL, NIL);
+        let mut c = first;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let tri = self.tri(c >> 2);
+            if tri[next3(c & 3)] == b {
+                c1 = c;
+            }
+            last = c;
+            c = self.after(c);
+        }
+        let mut c = first;
+        if c1 != NIL && c1 != last {
+            self.set_after(last, first);
+            c = self.after(c1);
+            self.set_after(c1, NIL);
+        }
+        // Walk the rotated list: survivors are re-pointed at b and chained into the run;
+        // removed triangles are noted (at most two in a regular fan).
+        let (mut run_head, mut run_tail) = (NIL, NIL);
+        let mut dead = [NIL; 2];
+        let mut n_dead = 0;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let n = self.after(c);
+            let t = c >> 2;
+            if self.tri(t).contains(&b) {
+                if let Some(d) = dead.get_mut(n_dead) {
+                    *d = t;
+                    n_dead += 1;
+                } else {
+                    // Only with a switched-off rule: a third triangle on a-b.
+                    self.remove_triangle(t, a);
+                }
+            } else {
+                self.set_corner(c, b);
+                self.set_after(c, NIL);
+                if run_tail == NIL {
+                    run_head = c;
+                } else {
+                    self.set_after(run_tail, c);
+                }
+                run_tail = c;
+            }
+            c = n;
+        }
+        let dead = dead.get(..n_dead).unwrap_or(&[]);
+        self.splice(b, dead, run_head, run_tail);
+        self.set_first(a, NIL);
+        self.set_flags(a, 0);
+        for &t in dead {
+            self.remove_triangle(t, b);
+        }
+        dead.len()
+    }
+
+    /// Replaces the (adjacent) corners of `b` in the `dead` triangles with the run
+    /// `head..tail`. Non-adjacent windows only arise from a switched-off rule: then the dead
+    /// corners are unlinked and the run goes in front.
+    pub(super) fn splice(&mut self, b: usize, dead: &[usize], head: usize, tail: usize) {
+        let (mut w_first, mut w_pred, mut w_last, mut w_last_pred, mut w_succ) =
+            (NIL, NIL, NIL, NIL, NIL);
+        let mut adjacent = true;
+        let (mut prev, mut c) = (NIL, self.first(b));
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            let n = self.after(c);
+            if dead.contains(&(c >> 2)) {
+                if w_first == NIL {
+                    w_first = c;
+                    w_pred = prev;
+                } else if prev != w_last {
+                    adjacent = false;
+                }
+                w_last = c;
+                w_last_pred = prev;
+                w_succ = n;
+            }
+            prev = c;
+            c = n;
+        }
+        let list_last = prev;
+        // What comes after the run, and where the run hangs.
+        if w_first != NIL && adjacent {
+            // ... pred, [dead], succ ...  ->  ... pred, run, succ ...
+            self.link_run(b, w_pred, head, tail, w_succ);
+        } else if dead.len() == 2 && w_first == self.first(b) && w_last == list_last {
+            // The window wraps around the end of a disc's list: [d2, x.., y, d1]
+            // -> [x.., y, run].
+            let x = self.after(w_first);
+            if w_last_pred == w_first {
+                self.set_first(b, NIL);
+                self.link_run(b, NIL, head, tail, NIL);
+            } else {
+                self.set_first(b, x);
+                self.link_run(b, w_last_pred, head, tail, NIL);
+            }
+        } else {
+            for &t in dead {
+                self.unlink(b, t);
+            }
+            let h = self.first(b);
+            self.link_run(b, NIL, head, tail, h);
+        }
+    }
+
+    /// Links `pred -> head..tail -> succ` in `b`'s list (`pred` NIL: the run becomes the head;
+    /// an empty run links `pred -> succ`).
+    pub(super) fn link_run(
+        &mut self,
+        b: usize,
+        pred: usize,
+        head: usize,
+        tail: usize,
+        succ: usize,
+    ) {
+        let (h, t) = if head == NIL {
+            (succ, NIL)
+        } else {
+            (head, tail)
+        };
+        if pred == NIL {
+            self.set_first(b, h);
+        } else {
+            self.set_after(pred, h);
+        }
+        if t != NIL {
+            self.set_after(t, succ);
+        }
+    }
+
+    /// Takes triangle `t` (still intact) out of the lists of its vertices other than `skip`
+    /// and writes it as removed.
+    pub(super) fn remove_triangle(&mut self, t: usize, skip: usize) {
+        for x in self.tri(t) {
+            if x != skip {
+                self.unlink(x, t);
+            }
+        }
+        self.kill(t);
+        self.live = self.live.saturating_sub(1);
+    }
+
+    /// Moves the live triangles to the front of the buffer, in their original order, and
+    /// returns how many there are. The workspace's lists are stale afterwards.
+    pub(crate) fn compact(&mut self) -> usize {
+        let mut n = 0;
+        for t in 0..self.tris.len() {
+            let Some(&tri) = self.tris.get(t) else { break };
+            if tri[0] != tri[1] {
+                if let Some(slot) = self.tris.get_mut(n) {
+                    *slot = tri;
+                }
+                n += 1;
+            }
+        }
+        n
+    }
+}

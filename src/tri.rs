@@ -1,0 +1,40 @@
+//! Index triples, shared by the mesh, the progressive mesh and the stream: the slot order of a
+//! triangle's corners, the end-of-list marker, and the two rules that drop an input triangle
+//! before simplifying (the simplifier and the progressive mesh must drop the same ones; each
+//! walks its own lists for the earlier triangles).
+
+/// Marks the end of a list, or "no vertex".
+pub(crate) const NIL: usize = usize::MAX;
+
+/// The slot after `k` in winding order (a corner's `a`).
+#[inline]
+pub(crate) const fn next3(k: usize) -> usize {
+    // Written so that the result is below 3 for any `k`: indexing with it needs no check.
+    match k {
+        0 => 1,
+        1 => 2,
+        _ => 0,
+    }
+}
+
+/// The slot before `k` in winding order (a corner's `b`).
+#[inline]
+pub(crate) const fn prev3(k: usize) -> usize {
+    match k {
+        1 => 0,
+        2 => 1,
+        _ => 2,
+    }
+}
+
+/// Same three vertices (any order or winding): a later copy of a kept triangle is dropped.
+/// Both directions, so a removed `[x, x, x]` never matches.
+pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
+    a.iter().all(|x| b.contains(x)) && b.iter().all(|x| a.contains(x))
+}
+
+/// An input triangle with a repeated index: dropped.
+#[inline]
+pub(crate) fn is_degenerate([a, b, c]: [usize; 3]) -> bool {
+    a == b || b == c || a == c
+}
