@@ -751,6 +751,7 @@ fn check_output<I: Idx>(
             min_quality: MIN_Q,
         }),
         allow_moved: false,
+        welded: false,
     };
     let mesh = |triangles| meshcheck::MeshRef {
         positions: pos,

@@ -22,6 +22,17 @@ pub fn compare(input: &MeshData, output: &MeshData) -> Validity {
 
 /// [`compare`]; with `allow_moved`, kept vertices may have moved (optimal placement).
 pub fn compare_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> Validity {
+    compare_opts(input, output, allow_moved, false)
+}
+
+/// [`compare_with`]; with `welded`, seams were welded (`tinydecimate::seam`): both meshes are
+/// compared welded by position, and the kept positions' wedges must survive.
+pub fn compare_opts(
+    input: &MeshData,
+    output: &MeshData,
+    allow_moved: bool,
+    welded: bool,
+) -> Validity {
     meshcheck::check_with(
         meshcheck::MeshRef {
             positions: &input.positions,
@@ -34,6 +45,7 @@ pub fn compare_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> V
         &meshcheck::Options {
             view: None,
             allow_moved,
+            welded,
         },
     )
 }

@@ -284,6 +284,15 @@ fn parse_samples(v: &str) -> std::result::Result<f64, String> {
     ranged(v, |x| x > 0.0, "above 0", "samples per triangle").map(f64::from)
 }
 
+/// How vertices at identical positions are treated (`--seams`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum SeamsArg {
+    /// One vertex with several wedges, collapsed together.
+    Weld,
+    /// Separate vertices (each seam an open boundary).
+    Split,
+}
+
 /// `host-sim simplify IN OUT ...`
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
@@ -306,6 +315,12 @@ pub struct Args {
     /// a firmware's index buffer into the same positions needs). STL has no numbering.
     #[arg(long)]
     pub keep_numbering: bool,
+    /// Vertices at identical positions (a renderer's split on UV seams, hard normals,
+    /// materials): `weld` collapses them together as one vertex with several wedges, each
+    /// triangle keeping its own wedge (the default); `split` treats each as its own vertex, so
+    /// every seam is an open boundary that only shrinks along itself.
+    #[arg(long, value_enum, default_value_t = SeamsArg::Weld)]
+    pub seams: SeamsArg,
     /// Target fraction of the input triangles, 0 to 1.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
     pub ratio: Option<f32>,
@@ -478,6 +493,20 @@ pub fn simplify_with(
     bounded: bool,
     progress: bool,
 ) -> Result<(MeshData, Report, Duration)> {
+    simplify_seams(mesh, config, placement, bounded, progress, false)
+}
+
+/// [`simplify_with`]; with `weld`, seams are welded first (`tinydecimate::seam::weld`: the
+/// vertices at one position collapse together, each keeping its own wedge), when the mesh has
+/// any (none: the run is the same as without).
+pub fn simplify_seams(
+    mesh: &MeshData,
+    config: &Config,
+    placement: Option<Placement>,
+    bounded: bool,
+    progress: bool,
+    weld: bool,
+) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
     let mut positions = mesh.positions.clone();
     let n = if placement.is_some() {
@@ -500,13 +529,33 @@ pub fn simplify_with(
         )
     });
     let start = Instant::now();
+    // Welded seams: the wedges (one triangle per triangle) and the welded triangles, which a
+    // bound's control points are taken from.
+    let mut wedges: Vec<[u32; 3]> = Vec::new();
+    let mut welded = Vec::new();
+    if weld {
+        let mut w = vec![[0u32; 3]; tris.len()];
+        let mut order = vec![0u32; positions.len()];
+        if tinydecimate::seam::weld(&positions, &mut tris, &mut w, &mut order)
+            .map_err(library_error)?
+            > 0
+        {
+            wedges = w;
+            welded = tris.clone();
+        }
+    }
     let budget = if bounded { 1 << 12 } else { 1 << 14 };
     macro_rules! drive {
         ($p:expr, $cost:expr, $bound:expr) => {{
-            let mut s = ws
+            let s = ws
                 .storage()
                 .start($p, &mut tris, config, $cost, $bound)
                 .map_err(library_error)?;
+            let mut s = if wedges.is_empty() {
+                s
+            } else {
+                s.with_wedges(&mut wedges).map_err(library_error)?
+            };
             let n0 = s.live_triangles();
             while !s.step(budget) {
                 if let Some(b) = &bar {
@@ -516,7 +565,11 @@ pub fn simplify_with(
             s.finish()
         }};
     }
-    let original = &mesh.triangles;
+    let original = if welded.is_empty() {
+        &mesh.triangles
+    } else {
+        &welded
+    };
     // Optimal placement writes the positions; every other run only reads them.
     let report = match (placement, bounded) {
         (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
@@ -693,7 +746,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     // The library refuses what it cannot run (stored quadrics with the passes schedule,
     // optimal placement with a bound) before any work, naming the option.
     let placement = stored.then(|| args.placement.into());
-    let (out, report, elapsed) = simplify_with(&mesh, &config, placement, bounded, true)?;
+    let weld = args.seams == SeamsArg::Weld;
+    let (out, report, elapsed) = simplify_seams(&mesh, &config, placement, bounded, true, weld)?;
     let written = if keep_numbering {
         out.clone()
     } else {
@@ -828,7 +882,13 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             .map_err(|e| anyhow!("{e}"))
             .and_then(|b| crate::io::parse_bytes(&b, &ext))
             .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
-        let (_, note, validity) = crate::check::verdict(&mesh, &as_read, moved)?;
+        let (_, note, mut validity) = crate::check::verdict(&mesh, &as_read, moved)?;
+        if weld {
+            // Welded seams: the result in the input's numbering (a written file matches
+            // twins by position in order, which cannot say which wedge a corner was), both
+            // welded by position, and the wedges of the kept positions.
+            validity = crate::check::compare_opts(&mesh, &out, moved, true);
+        }
         valid = validity.is_valid();
         let _ = writeln!(
             text,

@@ -7,6 +7,29 @@ use crate::policy::cost::Cost;
 use crate::report::Stop;
 
 impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    /// Welded seams ([`crate::seam`]): `wedges` holds each triangle's corners as the caller's
+    /// vertices (filled by [`seam::weld`](crate::seam::weld), which also renumbered the
+    /// triangles given to the run to one vertex per position). Call it before the first step.
+    /// Collapses keep it up to date, and [`Simplifier::finish`] writes the result's triangles
+    /// as wedges; until then [`Simplifier::triangles`] and [`Simplifier::buffer`] show the
+    /// welded numbering. [`Error::Capacity`](crate::Error::Capacity) (triangles) if it is
+    /// shorter than the triangle buffer.
+    pub fn with_wedges(mut self, wedges: &'a mut [[I; 3]]) -> Result<Self, crate::Error> {
+        let n = self.mesh.triangle_count();
+        let available = wedges.len();
+        match wedges.get_mut(..n) {
+            Some(w) => {
+                self.mesh.wedges = w;
+                Ok(self)
+            }
+            None => Err(crate::Error::Capacity {
+                what: crate::Capacity::Triangles,
+                needed: n,
+                available,
+            }),
+        }
+    }
+
     /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
     /// vertex numbers: the history that [`Progressive::from_log`](crate::Progressive::from_log)
     /// turns into vertex splits (call it before the first step to have the whole history).

@@ -90,6 +90,9 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             c = n;
         }
         let dead = dead.get(..n_dead).unwrap_or(&[]);
+        if !self.wedges.is_empty() {
+            self.move_wedges(a, b, dead, run_head);
+        }
         self.splice(b, dead, run_head, run_tail);
         self.set_first(a, NIL);
         self.set_flags(a, 0);
@@ -97,6 +100,59 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             self.remove_triangle(t, b);
         }
         dead.len()
+    }
+
+    /// Welded seams: the corners of `a`'s survivors (the run from `head`, in fan order from the
+    /// side of `(a, b, o1)`, already re-pointed at `b`) take wedges of `b`
+    /// ([`crate::seam::moved_wedge`]). Never inlined: only welded runs call it.
+    #[inline(never)]
+    fn move_wedges(&mut self, a: usize, b: usize, dead: &[usize], head: usize) {
+        // Each removed triangle's (a wedge, b wedge); the one whose a-corner is followed by b
+        // (`(a, b, o1)`) first: the survivors' walk starts next to it.
+        let mut sides = [(NIL, NIL); 2];
+        for &t in dead {
+            let (tri, w) = (self.tri(t), self.wedges.get(t).copied());
+            let (Some(ka), Some(kb), Some(w)) = (
+                tri.iter().position(|&x| x == a),
+                tri.iter().position(|&x| x == b),
+                w,
+            ) else {
+                continue;
+            };
+            let side = (w[ka].to_usize(), w[kb].to_usize());
+            if tri[next3(ka)] == b {
+                sides[0] = side;
+            } else {
+                sides[1] = side;
+            }
+        }
+        // One removed triangle (a boundary edge): both sides are it.
+        if sides[0].0 == NIL {
+            sides[0] = sides[1];
+        } else if sides[1].0 == NIL {
+            sides[1] = sides[0];
+        }
+        let mut n = 0;
+        let mut c = head;
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            n += 1;
+            c = self.after(c);
+        }
+        let (mut i, mut c) = (0, head);
+        let mut guard = self.tris.len();
+        while c != NIL && guard > 0 {
+            guard -= 1;
+            if let Some(x) = self.wedges.get_mut(c >> 2).and_then(|w| w.get_mut(c & 3)) {
+                let w = crate::seam::moved_wedge(x.to_usize(), sides, 2 * i < n);
+                if w != NIL {
+                    *x = I::narrow(w);
+                }
+            }
+            i += 1;
+            c = self.after(c);
+        }
     }
 
     /// Replaces the (adjacent) corners of `b` in the `dead` triangles with the run
@@ -194,6 +250,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         for t in 0..self.tris.len() {
             let Some(&tri) = self.tris.get(t) else { break };
             if tri[0] != tri[1] {
+                // Welded seams: the wedges (the caller's vertices) go out, not the positions.
+                let tri = self.wedges.get(t).copied().unwrap_or(tri);
                 if let Some(slot) = self.tris.get_mut(n) {
                     *slot = tri;
                 }

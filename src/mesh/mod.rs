@@ -123,6 +123,10 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     pub(crate) degenerate: usize,
     pub(crate) duplicates: usize,
     pub(crate) valid_in: usize,
+    /// With welded seams ([`crate::seam`]): each triangle's corners as wedges (the caller's
+    /// vertices), kept up to date by [`Mesh::collapse`] and written back by [`Mesh::compact`];
+    /// empty otherwise.
+    pub(crate) wedges: &'a mut [[I; 3]],
 }
 
 impl<'a, L: Index, I: Index> Mesh<'a, L, I> {

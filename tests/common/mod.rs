@@ -276,6 +276,7 @@ pub fn verdict_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> V
         &meshcheck::Options {
             view: None,
             allow_moved,
+            welded: false,
         },
     )
 }

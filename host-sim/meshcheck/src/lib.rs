@@ -87,6 +87,12 @@ pub struct Options<'a> {
     /// stored quadrics writes new positions). Every other rule still applies, on the output's
     /// own positions.
     pub allow_moved: bool,
+    /// Seams welded (`tinydecimate::seam`): vertices at identical positions are one vertex
+    /// with several wedges. Both meshes are welded by position ([`weld`]) before every test,
+    /// so a crack (a seam opened by the simplification) shows as new boundary vertices and
+    /// changed boundary loops; and the input wedges of positions the output still uses but
+    /// the output does not are counted ([`Verdict::lost_wedges`]).
+    pub welded: bool,
 }
 
 /// Topology and defect counts of a mesh. See the crate documentation for the definitions.
@@ -280,6 +286,10 @@ pub struct Verdict {
     pub new_vertices: usize,
     /// Output boundary vertices that were interior (compared only with a clean input).
     pub new_boundary_vertices: usize,
+    /// With welded seams: input wedges of kept positions that the output does not use
+    /// (information, not a defect: a face of a flat-shaded model collapsed away takes its own
+    /// wedges with it).
+    pub lost_wedges: usize,
     /// Boundary loops of the cleaned input and of the output.
     pub boundary_loops: (usize, usize),
     /// Euler characteristic of the cleaned input and of the output.
@@ -348,6 +358,13 @@ impl fmt::Display for Verdict {
         ];
         for (name, n) in counts {
             writeln!(f, "  {name:<24} {n:<6} {}", mark(n == 0))?;
+        }
+        if v.lost_wedges > 0 {
+            writeln!(
+                f,
+                "  wedges gone with faces   {}      (welded seams: their regions collapsed away)",
+                v.lost_wedges
+            )?;
         }
         let note = if v.topology_compared {
             ""
@@ -716,8 +733,76 @@ pub fn check(positions: &[[f32; 3]], input: &[Tri], output: &[Tri]) -> Verdict {
     )
 }
 
+/// `triangles` with every index renumbered to the first vertex of `positions` at the same
+/// position (`-0.0` equal to `0.0`): one vertex per position, as `tinydecimate::seam::weld`
+/// numbers them. Out-of-range indices stay.
+pub fn weld(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
+    let key = |p: &[f32; 3]| p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+    let mut first = std::collections::HashMap::new();
+    for (i, p) in positions.iter().enumerate() {
+        first.entry(key(p)).or_insert(i as u32);
+    }
+    triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                positions
+                    .get(v as usize)
+                    .and_then(|p| first.get(&key(p)).copied())
+                    .unwrap_or(v)
+            })
+        })
+        .collect()
+}
+
 /// [`check`] with separate position arrays (same vertex numbering) and [`Options`].
 pub fn check_with(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
+    if opts.welded {
+        return check_welded(input, output, opts);
+    }
+    check_split(input, output, opts)
+}
+
+/// [`check_with`] for welded seams: the tests on both meshes welded by position, then the
+/// wedges of the kept positions.
+fn check_welded(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
+    let (wi, wo) = (
+        weld(input.positions, input.triangles),
+        weld(output.positions, output.triangles),
+    );
+    let split = Options {
+        welded: false,
+        ..*opts
+    };
+    let mut v = check_split(
+        MeshRef {
+            positions: input.positions,
+            triangles: &wi,
+        },
+        MeshRef {
+            positions: output.positions,
+            triangles: &wo,
+        },
+        &split,
+    );
+    let kept: BTreeSet<u32> = wo.iter().flatten().copied().collect();
+    let used: BTreeSet<u32> = output.triangles.iter().flatten().copied().collect();
+    let mut lost = BTreeSet::new();
+    for (t, w) in input.triangles.iter().zip(&wi) {
+        for (&raw, &rep) in t.iter().zip(w) {
+            if kept.contains(&rep) && !used.contains(&raw) {
+                lost.insert(raw);
+            }
+        }
+    }
+    // Counted, not a defect: a wedge whose whole attribute region was collapsed away (a face
+    // of a flat-shaded model, where every face has its own wedges) is lost on purpose, and
+    // the output alone cannot tell that from a region whose corners took another wedge.
+    v.lost_wedges = lost.len();
+    v
+}
+
+fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     let raw = analyse_with(input.positions, input.triangles, opts);
     let cleaned = clean(input.positions, input.triangles);
     let cin = analyse_with(input.positions, &cleaned, opts);
@@ -832,6 +917,7 @@ pub fn check_with(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         out_of_range_triangles: to.out_of_range_triangles,
         new_vertices,
         new_boundary_vertices,
+        lost_wedges: 0,
         boundary_loops: (ti.boundary_loops, to.boundary_loops),
         euler: (ti.euler, to.euler),
         components: (ti.components, to.components),
@@ -960,6 +1046,7 @@ mod tests {
             &Options {
                 view: Some(view),
                 allow_moved: false,
+                welded: false,
             },
         );
         assert_eq!((a.folded.len(), a.folded_true.len()), (0, 1));
