@@ -101,6 +101,7 @@ pub mod progressive;
 mod quadric;
 pub mod remap;
 mod report;
+#[cfg(feature = "seams")]
 pub mod seam;
 mod tri;
 mod workspace;

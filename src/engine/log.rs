@@ -14,6 +14,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
     /// as wedges; until then [`Simplifier::triangles`] and [`Simplifier::buffer`] show the
     /// welded numbering. [`Error::Capacity`](crate::Error::Capacity) (triangles) if it is
     /// shorter than the triangle buffer.
+    #[cfg(feature = "seams")]
     pub fn with_wedges(mut self, wedges: &'a mut [[I; 3]]) -> Result<Self, crate::Error> {
         let n = self.mesh.triangle_count();
         let available = wedges.len();

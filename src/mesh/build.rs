@@ -68,6 +68,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             degenerate: 0,
             duplicates: 0,
             valid_in: 0,
+            #[cfg(feature = "seams")]
             wedges: &mut [],
         };
         // 2. Drop triangles with a repeated index.

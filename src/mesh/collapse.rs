@@ -90,6 +90,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             c = n;
         }
         let dead = dead.get(..n_dead).unwrap_or(&[]);
+        #[cfg(feature = "seams")]
         if !self.wedges.is_empty() {
             self.move_wedges(a, b, dead, run_head);
         }
@@ -105,6 +106,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// Welded seams: the corners of `a`'s survivors (the run from `head`, in fan order from the
     /// side of `(a, b, o1)`, already re-pointed at `b`) take wedges of `b`
     /// ([`crate::seam::moved_wedge`]). Never inlined: only welded runs call it.
+    #[cfg(feature = "seams")]
     #[inline(never)]
     fn move_wedges(&mut self, a: usize, b: usize, dead: &[usize], head: usize) {
         // Each removed triangle's (a wedge, b wedge); the one whose a-corner is followed by b
@@ -251,6 +253,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             let Some(&tri) = self.tris.get(t) else { break };
             if tri[0] != tri[1] {
                 // Welded seams: the wedges (the caller's vertices) go out, not the positions.
+                #[cfg(feature = "seams")]
                 let tri = self.wedges.get(t).copied().unwrap_or(tri);
                 if let Some(slot) = self.tris.get_mut(n) {
                     *slot = tri;

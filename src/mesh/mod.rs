@@ -126,6 +126,7 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     /// With welded seams ([`crate::seam`]): each triangle's corners as wedges (the caller's
     /// vertices), kept up to date by [`Mesh::collapse`] and written back by [`Mesh::compact`];
     /// empty otherwise.
+    #[cfg(feature = "seams")]
     pub(crate) wedges: &'a mut [[I; 3]],
 }
 

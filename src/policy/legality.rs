@@ -400,7 +400,7 @@ impl Shape {
 /// The sliver and normal-turn rules on one surviving triangle, `was` before the collapse and
 /// `now` after it. One dot product serves both: the turn limit and the plane test (a sliver
 /// that stays within about 1° of its plane is allowed).
-#[inline]
+#[inline(never)]
 fn shape_rules(rules: &Rules, was: &Shape, now: &Shape) -> Result<(), Reject> {
     let d = math::dot(was.n, now.n);
     let (d2, n2) = (d * d, was.n2 * now.n2);
