@@ -157,6 +157,23 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
+    /// Welded seams: live triangle `t` (positions `tri`) as the caller's wedges; a placing
+    /// cost moved only the position's first vertex, so each wedge takes its position.
+    #[cfg(feature = "seams")]
+    fn wedge_out(&mut self, t: usize, tri: [I; 3]) -> [I; 3] {
+        let Some(w) = self.wedges.get(t).copied() else {
+            return tri;
+        };
+        if self.movable() {
+            for (c, x) in tri.iter().zip(w) {
+                if let Some(q) = self.input_position(c.to_usize()) {
+                    self.place(x.to_usize(), q);
+                }
+            }
+        }
+        w
+    }
+
     /// Replaces the (adjacent) corners of `b` in the `dead` triangles with the run
     /// `head..tail`. Non-adjacent windows only arise from a switched-off rule: then the dead
     /// corners are unlinked and the run goes in front.
@@ -254,7 +271,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             if tri[0] != tri[1] {
                 // Welded seams: the wedges (the caller's vertices) go out, not the positions.
                 #[cfg(feature = "seams")]
-                let tri = self.wedges.get(t).copied().unwrap_or(tri);
+                let tri = self.wedge_out(t, tri);
                 if let Some(slot) = self.tris.get_mut(n) {
                     *slot = tri;
                 }
