@@ -15,6 +15,7 @@
 //! | `sliver`      | no operation leaves a zero-area triangle, or one below `min_quality` that got worse and left its plane | `no_operation_makes_a_sliver` |
 //! | `fold`        | no new folded pair, even with the turn limit at 179° (shared checker)       | `no_new_folds_when_only_the_fold_rule_guards` |
 //! | `bound`       | no control point ends farther than `max_error` from the output (an independent f64 measure, in `tests/bound.rs`) | `generated_meshes_stay_within_the_bound`, `fixtures_stay_within_the_bound` |
+//! | `seam`        | with welded seams, no output triangle takes corners from both sides of a seam, and no crack (`tests/seams.rs`, crate feature `seams`) | `seams_keep_their_shape_and_sides` |
 
 mod common;
 use std::collections::BTreeSet;

@@ -25,8 +25,15 @@ use crate::simplify::{Args, PlacementArg, QuadricArg};
 fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
-    let (out, report, _) =
-        crate::simplify::simplify_with(mesh, config, placement, args.max_error.is_some(), false)?;
+    let weld = args.seams == crate::simplify::SeamsArg::Weld;
+    let (out, report, _) = crate::simplify::simplify_seams(
+        mesh,
+        config,
+        placement,
+        args.max_error.is_some(),
+        false,
+        weld,
+    )?;
     Ok((out.triangles, report))
 }
 
@@ -173,7 +180,8 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
             "report": crate::simplify::report_json(&report),
         });
         if !args.no_measure {
-            let v = crate::check::compare_with(mesh, &result, false);
+            let weld = args.seams == crate::simplify::SeamsArg::Weld;
+            let v = crate::check::compare_opts(mesh, &result, false, weld);
             valid = v.is_valid();
             let opts = crate::metro::MetroOptions {
                 samples_per_triangle: args.samples_per_triangle,

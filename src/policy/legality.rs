@@ -22,9 +22,12 @@
 //!   (corners, holes) to reach the count. Such a sliver costs no error and a later collapse
 //!   can remove it; meshoptimizer has no shape veto at all (only its flip test), VCG's quality
 //!   check is a soft penalty.
-//! - **quality** (`feature`, `normal_turn`): the output stays valid without them; they keep
-//!   the feature vertices of Lin Mouguang 2007 and bound how far a triangle may turn in one
-//!   collapse ([`Config::max_normal_turn_deg`]).
+//! - **quality** (`feature`, `normal_turn`, `seam`): the output stays valid without them; they
+//!   keep the feature vertices of Lin Mouguang 2007, bound how far a triangle may turn in one
+//!   collapse ([`Config::max_normal_turn_deg`]), and with welded seams ([`crate::seam`], crate
+//!   feature `seams`) keep a seam where it is, so that no triangle takes attributes from both
+//!   of its sides (meshoptimizer's vertex kinds: a seam vertex moves along its seam; a vertex
+//!   where more than two wedges meet moves all of them, like its complex kind).
 //! - **guarantee** (`bound`): the error bound of Zhu, Wang and Meng 2007, a promise the caller
 //!   asks for ([`Config::max_error`]); checked after the others, in `collapse`, and only on the
 //!   bounded entry points (see [`crate::bound`]).
@@ -33,7 +36,7 @@
 //!
 //! The engine keys vertices by cost alone and runs the rules only when a vertex reaches the
 //! top of the queue, on its candidates in cost order. The rules, in the order they are
-//! checked: the cheap flag tests (`locked`, `feature`) and `boundary`; then, triangle by
+//! checked: the cheap flag tests (`locked`, `feature`), `seam` (welded runs) and `boundary`; then, triangle by
 //! triangle of a's fan, `duplicate`, `sliver`, `normal_turn` and `fold`; last the link
 //! condition's walks of both fans (`link`), the folds across b's edges to o1 and o2, whose
 //! triangles that walk finds, and the error bound. On flat, sliver-rich (CAD) meshes most
@@ -104,6 +107,8 @@ pub enum Reject {
     Fold,
     /// A control point would end too far from the new fan.
     Bound,
+    /// A seam vertex would leave its seam.
+    Seam,
 }
 
 impl Reject {
@@ -225,6 +230,15 @@ pub const RULES: &[Rule] = &[
                    triangle of the new fan (bounded entry points only)",
         kind: Kind::Guarantee,
         source: "Zhu, Wang and Meng 2007 §3",
+    },
+    Rule {
+        reject: Reject::Seam,
+        name: "seam",
+        protects: "with welded seams (crate::seam): a on a seam (its wedge changes across one \
+                   or two spokes) moves only along that seam, so the seam keeps its shape and \
+                   no triangle takes corners from both sides (welded runs only)",
+        kind: Kind::Quality,
+        source: "meshoptimizer's vertex kinds (a Seam vertex collapses along its seam)",
     },
 ];
 
@@ -569,6 +583,10 @@ pub(crate) fn check<L: Index, I: Index>(
     };
     let fa = mesh.flags(a);
     flags_allow(rules, fa, mesh.flags(b))?;
+    #[cfg(feature = "seams")]
+    if on!(Seam) && !mesh.wedges.is_empty() && !along_seam(mesh, a, b) {
+        return Err(Reject::Seam);
+    }
 
     // The vertices opposite edge a-b: o1 in (a, b, o1), o2 in (a, o2, b).
     let (mut o1, mut o2, mut n_ab) = (NIL, NIL, 0);
@@ -708,6 +726,51 @@ pub(crate) fn check<L: Index, I: Index>(
         }
     }
     Ok(())
+}
+
+/// Welded seams: whether `a` may move onto `b` as far as its wedges go. Around `a`'s fan (in
+/// fan order, a disc's last triangle next to its first) the wedge of `a` changes across some
+/// spokes. No change: `a` is inside one attribute region, anything goes. Exactly two (a seam
+/// through `a`): only along the seam, onto the vertex of one of those spokes. One (a seam
+/// that ends on a boundary): the same, so never (the boundary rule allows only boundary
+/// edges), as meshoptimizer locks a seam's end. More (a corner where seams meet, or a flat-shaded vertex, whose
+/// every face has its own wedge): the wedges go with the removed triangles' neighbours (see
+/// `Mesh::move_wedges`), as meshoptimizer's complex vertices move all their wedges at once.
+#[cfg(feature = "seams")]
+#[inline(never)]
+fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
+    let wedge = |t: usize, k: usize| {
+        mesh.wedges
+            .get(t)
+            .and_then(|w| w.get(k))
+            .map(|x| x.to_usize())
+    };
+    let (mut changes, mut onto_b) = (0, false);
+    let mut first: Option<Option<usize>> = None;
+    let mut prev: Option<(Option<usize>, usize)> = None;
+    for (t, k) in mesh.corners(a) {
+        let tri = mesh.tri(t);
+        let w = wedge(t, k);
+        // The spoke shared with the previous triangle is this one's `x` (its next vertex).
+        if let Some((pw, _)) = prev {
+            if pw != w {
+                changes += 1;
+                onto_b |= tri[next3(k)] == b;
+            }
+        }
+        if first.is_none() {
+            first = Some(w);
+        }
+        prev = Some((w, tri[prev3(k)]));
+    }
+    // A disc closes: its last triangle's `y` spoke is its first triangle's `x`.
+    if let (false, Some(f), Some((lw, ly))) = (mesh.has(a, flag::BOUNDARY), first, prev) {
+        if f != lw {
+            changes += 1;
+            onto_b |= ly == b;
+        }
+    }
+    changes == 0 || changes > 2 || onto_b
 }
 
 /// [`check`] for `b` moved to `at` (optimal placement), then the rules on `b`'s own

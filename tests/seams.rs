@@ -1,0 +1,187 @@
+//! Welded seams (`tinydecimate::seam`, crate feature `seams`): what welding promises on real
+//! output, through the shared checker.
+//!
+//! * `seams_keep_their_shape_and_sides`: a wavy grid split into two texture charts along a
+//!   seam reaches its target without a crack (the output welded by position is a valid
+//!   simplification of the input welded), every wedge of a kept seam position survives, the
+//!   seam's positions stay on the seam, and no output triangle takes corners from both charts
+//!   (the `seam` rule of `legality::RULES`).
+//! * `flat_shaded_faces_simplify_whole`: a box whose every face has its own vertices (a
+//!   flat-shaded export) reaches its target as one closed surface.
+#![cfg(feature = "seams")]
+
+mod common;
+use std::collections::BTreeSet;
+
+use common::*;
+use tinydecimate::{seam, Builtin, Config, NoBound, Positions, Report, Stop};
+
+/// Welds, simplifies (default configuration at `ratio`) and returns the output in the input's
+/// numbering.
+fn simplify_welded(m: &MeshData, ratio: f32) -> (MeshData, Report) {
+    let mut tris = m.triangles.clone();
+    let mut wedges = vec![[0u32; 3]; tris.len()];
+    let mut order = vec![0u32; m.positions.len()];
+    let moved = seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
+    assert!(moved > 0, "the mesh has seams");
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let config = Config::new().with_ratio(ratio);
+    let report = ws
+        .start(
+            Positions::Read(&m.positions),
+            &mut tris,
+            &config,
+            Builtin::new(),
+            NoBound,
+        )
+        .expect("start")
+        .with_wedges(&mut wedges)
+        .expect("wedges")
+        .run();
+    tris.truncate(report.triangles_out);
+    (
+        MeshData {
+            positions: m.positions.clone(),
+            triangles: tris,
+        },
+        report,
+    )
+}
+
+fn welded_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
+    meshcheck::check_with(
+        meshcheck::MeshRef {
+            positions: &input.positions,
+            triangles: &input.triangles,
+        },
+        meshcheck::MeshRef {
+            positions: &output.positions,
+            triangles: &output.triangles,
+        },
+        &meshcheck::Options {
+            welded: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// A wavy `n` x `n` grid whose vertices on a seam (column `n/2`) are duplicated: the left
+/// chart uses the originals, the right chart the copies along the seam. Returns the mesh and
+/// each vertex's chart (0 left, 1 right; a seam position has one vertex in each).
+fn two_charts(n: u32) -> (MeshData, Vec<u8>) {
+    let mut m = grid(n, n, 0.25);
+    let w = n + 1;
+    // The seam: column n/2.
+    let seam_col = |_: u32| n / 2;
+    let mut chart = vec![0u8; m.positions.len()];
+    let mut copy = std::collections::HashMap::new();
+    for j in 0..=n {
+        let v = j * w + seam_col(j);
+        copy.insert(v, m.positions.len() as u32);
+        m.positions.push(m.positions[v as usize]);
+        chart.push(1);
+    }
+    for (i, c) in chart.iter_mut().enumerate().take((w * w) as usize) {
+        let (x, j) = (i as u32 % w, i as u32 / w);
+        if x > seam_col(j) {
+            *c = 1;
+        }
+    }
+    for t in &mut m.triangles {
+        // A triangle is right of the seam when a vertex is.
+        let right = t.iter().any(|&v| chart[v as usize] == 1);
+        if right {
+            for v in t.iter_mut() {
+                if let Some(&c) = copy.get(v) {
+                    *v = c;
+                }
+            }
+        }
+    }
+    (m, chart)
+}
+
+#[test]
+fn seams_keep_their_shape_and_sides() {
+    let (m, chart) = two_charts(24);
+    let seam: BTreeSet<[u32; 3]> = m
+        .positions
+        .iter()
+        .enumerate()
+        .filter(|&(v, _)| v >= 25 * 25)
+        .map(|(_, p)| p.map(f32::to_bits))
+        .collect();
+    for t in &m.triangles {
+        let sides: BTreeSet<u8> = t.iter().map(|&x| chart[x as usize]).collect();
+        assert_eq!(sides.len(), 1, "input triangle {t:?} takes both charts");
+    }
+    for ratio in [0.5, 0.25, 0.1] {
+        let what = format!("two charts at {ratio}");
+        let (out, report) = simplify_welded(&m, ratio);
+        assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
+        let v = welded_verdict(&m, &out);
+        v.assert_valid(&what);
+        assert_eq!(
+            v.lost_wedges, 0,
+            "{what}: wedges of kept seam positions lost"
+        );
+        for t in &out.triangles {
+            let sides: BTreeSet<u8> = t.iter().map(|&x| chart[x as usize]).collect();
+            assert_eq!(sides.len(), 1, "{what}: triangle {t:?} takes both charts");
+        }
+        // The seam stays a seam: both charts still meet, each side on seam positions only.
+        let used: BTreeSet<u32> = out.triangles.iter().flatten().copied().collect();
+        for &x in &used {
+            let on_seam = seam.contains(&m.positions[x as usize].map(f32::to_bits));
+            if x as usize >= 25 * 25 {
+                assert!(on_seam, "{what}: a seam copy off the seam");
+            }
+        }
+        assert!(used.iter().any(|&x| x as usize >= 25 * 25), "{what}");
+    }
+}
+
+/// A box of `n` x `n` quads per face, every face with its own vertices (flat-shaded).
+fn flat_box(n: u32) -> MeshData {
+    let welded = cube(n);
+    let mut m = MeshData::default();
+    // Faces of the cube: triangles in groups by their normal's axis and sign.
+    let mut face_of = std::collections::BTreeMap::new();
+    for t in &welded.triangles {
+        let p = t.map(|v| welded.positions[v as usize]);
+        let e1 = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
+        let e2 = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
+        let c = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let axis = (0..3)
+            .max_by(|&a, &b| c[a].abs().total_cmp(&c[b].abs()))
+            .unwrap();
+        let key = (axis, c[axis] > 0.0);
+        let map: &mut std::collections::HashMap<u32, u32> = face_of.entry(key).or_default();
+        let tri = t.map(|v| {
+            *map.entry(v).or_insert_with(|| {
+                m.positions.push(welded.positions[v as usize]);
+                m.positions.len() as u32 - 1
+            })
+        });
+        m.triangles.push(tri);
+    }
+    m
+}
+
+#[test]
+fn flat_shaded_faces_simplify_whole() {
+    let m = flat_box(6);
+    for ratio in [0.5, 0.1] {
+        let what = format!("flat-shaded box at {ratio}");
+        let (out, report) = simplify_welded(&m, ratio);
+        assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
+        let v = welded_verdict(&m, &out);
+        v.assert_valid(&what);
+        assert_eq!(v.components, (1, 1), "{what}");
+        assert_eq!(v.boundary_loops, (0, 0), "{what}: a crack");
+    }
+}
