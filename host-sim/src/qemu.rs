@@ -113,6 +113,7 @@ pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
 const MICROBIT_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
+    "tray-new-u16",
     "grid12-stored-subset-u16",
     "grid12-stored-optimal-u16",
     "icosphere3-stored-optimal-u32",
@@ -130,6 +131,7 @@ const MICROBIT_SKIPS: &[&str] = &[
 /// cow's progressive stream needs the 4 MB boards.
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
+    "tray-new-u16",
     "grid12-stored-subset-u16",
     "grid12-stored-optimal-u16",
     "icosphere3-stored-optimal-u32",
@@ -149,6 +151,7 @@ const RISCV_400K_SKIPS: &[&str] = &[];
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
+    "tray-new-u16",
     "grid12-stored-subset-u16",
     "grid12-stored-optimal-u16",
     "icosphere3-stored-optimal-u32",

@@ -730,12 +730,13 @@ pub(crate) fn check<L: Index, I: Index>(
 
 /// Welded seams: whether `a` may move onto `b` as far as its wedges go. Around `a`'s fan (in
 /// fan order, a disc's last triangle next to its first) the wedge of `a` changes across some
-/// spokes. No change: `a` is inside one attribute region, anything goes. Exactly two (a seam
-/// through `a`): only along the seam, onto the vertex of one of those spokes. One (a seam
-/// that ends on a boundary): the same, so never (the boundary rule allows only boundary
-/// edges), as meshoptimizer locks a seam's end. More (a corner where seams meet, or a flat-shaded vertex, whose
-/// every face has its own wedge): the wedges go with the removed triangles' neighbours (see
-/// `Mesh::move_wedges`), as meshoptimizer's complex vertices move all their wedges at once.
+/// spokes. One wedge: `a` is inside one attribute region, anything goes. Two (a seam through
+/// `a`, or one that ends on `a`'s boundary): only along the seam, onto the vertex of a spoke
+/// where the wedge changes (at a boundary that is never, since the boundary rule allows only
+/// boundary edges: meshoptimizer locks a seam's end too). More (a corner where seams meet, or
+/// a flat-shaded vertex, whose every face has its own wedge): the wedges go with the removed
+/// triangles' neighbours (`Mesh::move_wedges`), as meshoptimizer's complex vertices move all
+/// their wedges at once.
 #[cfg(feature = "seams")]
 #[inline(never)]
 fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
@@ -770,7 +771,9 @@ fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> 
             onto_b |= ly == b;
         }
     }
-    changes == 0 || changes > 2 || onto_b
+    // A boundary fan's wedges are one more than its changes, a disc's as many.
+    let wedges = changes + usize::from(mesh.has(a, flag::BOUNDARY));
+    wedges != 2 || onto_b
 }
 
 /// [`check`] for `b` moved to `at` (optimal placement), then the rules on `b`'s own
