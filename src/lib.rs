@@ -109,7 +109,7 @@ pub use policy::{bound, cost, legality};
 pub use progressive::stream;
 
 pub use bound::{Controls, NoBound};
-pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
+pub use config::{Config, CostKind, FeatureMode, Operator, Schedule, Target};
 pub use cost::{Builtin, Placement, StoredQuadric};
 pub use engine::Simplifier;
 pub use error::{Capacity, ConfigField, Error};

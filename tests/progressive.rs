@@ -4,7 +4,7 @@
 mod common;
 use common::*;
 use tinydecimate::progressive::{ProgressiveError, Split, Storage};
-use tinydecimate::{Config, Progressive, Stop};
+use tinydecimate::{Config, Progressive, Stop, Target};
 
 /// Triangles in input numbering, each rotated to start at its smallest index (winding kept),
 /// sorted: the mesh as a set.
@@ -137,7 +137,7 @@ fn levels_match(name: &str, m: &MeshData, config: Config) {
             continue;
         }
         pm.set_level(n);
-        let (out, r) = simplify(m, &config.with_target_triangles(n).with_ratio(0.0));
+        let (out, r) = simplify(m, &config.with_target(Target::Triangles(n)));
         assert_eq!(r.triangles_out, pm.triangles().len(), "{name} at {n}");
         same(
             canonical(pm.triangles(), Some(&order)),

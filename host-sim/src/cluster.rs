@@ -14,7 +14,7 @@ use tinydecimate::cluster::{
     cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, GridChoice, Quadrics, Scratch,
     SliceSource, KEY_LANES,
 };
-use tinydecimate::{Config, Report};
+use tinydecimate::{Config, Report, Target};
 
 use crate::io::MeshData;
 use crate::metro::{metro, MetroOptions};
@@ -156,7 +156,7 @@ fn then_collapse(
         &mut table,
         &mut src,
         config,
-        &Config::new().with_target_triangles(target),
+        &Config::new().with_target(Target::Triangles(target)),
         &mut out,
         ws.storage(),
         scratch,

@@ -230,7 +230,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             "Config::new()"
         },
         case.config.schedule,
-        case.config.target_ratio,
+        meshfmt::lib::target_fields(case.config.target).0,
         case.config.lambda
     );
     let host_col = format!("host ({}, std)", std::env::consts::ARCH);

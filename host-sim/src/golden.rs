@@ -257,8 +257,10 @@ impl CaseSpec {
             ScheduleName::Greedy => Schedule::Greedy,
             ScheduleName::Passes => Schedule::Passes,
         })
-        .with_ratio(self.ratio)
-        .with_target_triangles(self.target_triangles)
+        .with_target(meshfmt::lib::target(
+            self.ratio,
+            meshfmt::narrow(self.target_triangles),
+        ))
         .with_lambda(self.lambda);
         match self.features {
             Features::Off => c.features = false,
@@ -621,6 +623,7 @@ fn config_line(c: &Config) -> String {
         (true, FeatureMode::Paper) => "paper",
         (true, FeatureMode::ValenceNormalized) => "valence",
     };
+    let (ratio, target) = meshfmt::lib::target_fields(c.target);
     format!(
         "schedule {}, cost {}, ratio {}, target {}, lambda {}, features {features}, \
          feature_targets {}, max_passes {}, max_cost {}, max_normal_turn_deg {}, min_quality {}, \
@@ -633,8 +636,8 @@ fn config_line(c: &Config) -> String {
             tinydecimate::CostKind::Quadric => "quadric",
             tinydecimate::CostKind::NormalVariation => "normal",
         },
-        c.target_ratio,
-        c.target_triangles,
+        ratio,
+        target,
         c.lambda,
         c.feature_targets,
         c.max_passes,

@@ -11,7 +11,7 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Context, Result};
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder, HEADER};
-use tinydecimate::{Config, Progressive};
+use tinydecimate::{Config, Progressive, Target};
 
 use crate::io::{self, MeshData};
 use crate::metro::{metro, MetroOptions};
@@ -209,7 +209,7 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
     }
     let mesh = io::load(&a.input)?;
     let config = match a.base_triangles {
-        Some(n) => Config::new().with_ratio(0.0).with_target_triangles(n),
+        Some(n) => Config::new().with_target(Target::Triangles(n)),
         None => Config::new().with_ratio(a.base_ratio),
     };
     let start = Instant::now();

@@ -15,7 +15,7 @@ use anyhow::{anyhow, bail, Result};
 use tinydecimate::bound::Controls;
 use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
 use tinydecimate::{
-    Builtin, Config, CostKind, FeatureMode, NoBound, Positions, Report, Schedule, Storage,
+    Builtin, Config, CostKind, FeatureMode, NoBound, Positions, Report, Schedule, Storage, Target,
     Workspace,
 };
 
@@ -397,11 +397,11 @@ impl Args {
         } else {
             FeatureMode::Paper
         });
-        // Only a triangle count: let it alone decide.
-        c = c.with_ratio(self.ratio.unwrap_or(0.0));
-        if let Some(t) = self.target_triangles {
-            c = c.with_target_triangles(t);
-        }
+        // A triangle count, else the ratio.
+        c = c.with_target(match self.target_triangles {
+            Some(t) => Target::Triangles(t),
+            None => Target::Ratio(self.ratio.unwrap_or(0.0)),
+        });
         if let Some(l) = self.lambda {
             c = c.with_lambda(l);
         }
@@ -996,7 +996,7 @@ mod tests {
     fn arguments_make_the_config() {
         let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.25"]).unwrap();
         let cfg = c.args.config();
-        assert_eq!(cfg.target_ratio, 0.25);
+        assert_eq!(cfg.target, Target::Ratio(0.25));
         assert_eq!(cfg.schedule, Schedule::Greedy);
         assert_eq!(cfg.feature_mode, FeatureMode::Paper);
         assert_eq!(cfg.cost, CostKind::Quadric);
@@ -1038,7 +1038,7 @@ mod tests {
         ])
         .unwrap();
         let cfg = c.args.config();
-        assert_eq!((cfg.target_ratio, cfg.target_triangles), (0.0, 500));
+        assert_eq!(cfg.target, Target::Triangles(500));
         assert_eq!(cfg.schedule, Schedule::Passes);
         assert_eq!(cfg.lambda, 1.5);
         assert_eq!(cfg.feature_mode, FeatureMode::ValenceNormalized);

@@ -15,7 +15,7 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
-use tinydecimate::{Config, Report};
+use tinydecimate::{Config, Report, Target};
 
 use crate::io::MeshData;
 use crate::simplify::{Args, PlacementArg, QuadricArg};
@@ -141,7 +141,7 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
-            config = config.with_target_triangles(share as usize);
+            config = config.with_target(Target::Triangles(share as usize));
         }
         if let Some(e) = args.max_error {
             config = config.with_max_error(e.distance(&mesh.positions));

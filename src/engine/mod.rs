@@ -119,13 +119,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         cost: C,
         bound: B,
     ) -> Self {
-        // In f32, exact for counts below 2^24; the product is floored.
-        let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
-        let target = if config.target_triangles > by_ratio {
-            config.target_triangles
-        } else {
-            by_ratio
-        };
+        let target = config.target.triangles(mesh.valid_in);
         let (mut locked, mut used_in) = (0, 0);
         for v in 0..mesh.vertex_count() {
             locked += mesh.has(v, flag::LOCKED) as usize;

@@ -26,7 +26,7 @@ use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
     Config, CostKind, FeatureMode, Index, NoBound, Operator, Positions, Progressive, Report,
-    Schedule, Simplifier, Workspace,
+    Schedule, Simplifier, Target, Workspace,
 };
 
 #[panic_handler]
@@ -64,8 +64,11 @@ fn opaque_config() -> Config {
         } else {
             CostKind::NormalVariation
         },
-        target_triangles: input(1) as usize,
-        target_ratio: opaque_f32(2),
+        target: if input(6) & 16 == 0 {
+            Target::Ratio(opaque_f32(2))
+        } else {
+            Target::Triangles(input(1) as usize)
+        },
         max_cost: opaque_f32(3),
         max_passes: input(4),
         lambda: opaque_f32(5),
@@ -91,7 +94,7 @@ fn opaque_config() -> Config {
     let b = black_box(Config::paper())
         .with_schedule(c.schedule)
         .with_ratio(opaque_f32(10))
-        .with_target_triangles(input(11) as usize)
+        .with_target(Target::Triangles(input(11) as usize))
         .with_lambda(opaque_f32(12))
         .with_feature_mode(c.feature_mode)
         .with_max_passes(input(13))
