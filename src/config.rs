@@ -26,19 +26,6 @@ pub enum CostKind {
     NormalVariation,
 }
 
-/// Which operator simplifies the mesh.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Operator {
-    /// Half-edge collapse (the default): one vertex moves onto a neighbour.
-    Edge,
-    /// Triangle collapse (Zhu, Wang and Meng 2007, §3): a triangle's three vertices
-    /// merge into one of them, smallest weight `W = A (α + rc + d_max)` (eq. 3) first; see
-    /// [`crate::triangle`]. Greedy schedule only, and only with the crate feature `triangle`
-    /// (else [`Config::validate`] refuses it).
-    Triangle,
-}
-
 /// The triangle count a run stops at (or below): the stop of [`Config::target`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -124,9 +111,6 @@ pub struct Config {
     /// normals differ by more than this many degrees, in `(0, 180)`. Boundary and non-manifold
     /// edges always are.
     pub control_angle_deg: f32,
-    /// The simplification operator: edge collapse (default) or Zhu, Wang and Meng's triangle
-    /// collapse ([`Schedule::Greedy`] and the crate feature `triangle` only).
-    pub operator: Operator,
 }
 
 impl Config {
@@ -149,7 +133,6 @@ impl Config {
             boundary_weight: 1.0,
             max_error: f32::INFINITY,
             control_angle_deg: 30.0,
-            operator: Operator::Edge,
         }
     }
 
@@ -219,12 +202,6 @@ impl Config {
     /// Sets the maximum collapse cost.
     pub const fn with_max_cost(mut self, cost: f32) -> Self {
         self.max_cost = cost;
-        self
-    }
-
-    /// Sets the operator.
-    pub const fn with_operator(mut self, operator: Operator) -> Self {
-        self.operator = operator;
         self
     }
 
@@ -309,11 +286,6 @@ impl Config {
         }
         if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
             return bad(F::ControlAngle);
-        }
-        if self.operator == Operator::Triangle
-            && (self.schedule != Schedule::Greedy || !cfg!(feature = "triangle"))
-        {
-            return bad(F::Operator);
         }
         Ok(())
     }

@@ -43,6 +43,7 @@ pub enum ConfigField {
     BoundaryWeight,
     MaxError,
     ControlAngle,
+    /// [`TriangleCollapse`](crate::TriangleCollapse) with another schedule than greedy.
     Operator,
     /// The schedule cannot run this cost ([`StoredQuadric`](crate::StoredQuadric): greedy only).
     Schedule,

@@ -4,6 +4,7 @@
 mod common;
 use common::*;
 use tinydecimate::progressive::{ProgressiveError, Split, Storage};
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, Progressive, Stop, Target};
 
 /// Triangles in input numbering, each rotated to start at its smallest index (winding kept),
@@ -46,6 +47,7 @@ fn simplify_logged(m: &MeshData, config: &Config) -> (Vec<[u32; 2]>, Vec<Tri>, S
             config,
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .unwrap()
         .record_into(&mut log);
@@ -206,6 +208,7 @@ fn a_full_log_stops_the_run_with_a_valid_mesh() {
             &Config::new().with_ratio(0.1),
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .unwrap()
         .record_into(&mut log);

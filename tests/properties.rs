@@ -4,6 +4,7 @@
 mod common;
 use common::*;
 use proptest::prelude::*;
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, FeatureMode, Schedule, Target, Workspace};
 
 #[derive(Clone, Debug)]
@@ -116,7 +117,7 @@ proptest! {
         let input = build(&kind, jitter);
         let mut tris = input.triangles.clone();
         let mut ws = Workspace::<u16, 2048, 2048>::new();
-        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut tris, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut tris, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound, EdgeCollapse).unwrap();
         let mut guard = 0;
         loop {
             let before: Vec<[u32; 3]> = s.buffer().to_vec();
@@ -153,7 +154,7 @@ proptest! {
         let mut ws = Workspace::<u32, 2048, 2048>::new();
         let r1 = ws.simplify(&input.positions, &mut one, &config).unwrap();
         let mut stepped = input.triangles.clone();
-        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut stepped, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut stepped, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound, EdgeCollapse).unwrap();
         let mut i = 0;
         while !s.step(budgets[i % budgets.len()]) {
             i += 1;

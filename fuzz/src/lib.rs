@@ -6,7 +6,9 @@ use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
 use tinydecimate::cost::{NormalVariation, Quadric};
-use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Stop, Target, Workspace};
+use tinydecimate::{
+    Config, EdgeCollapse, Error, FeatureMode, Index, Report, Schedule, Stop, Target, Workspace,
+};
 use tinydecimate::{NoBound, Positions};
 
 /// The caller's index type: `u16` or `u32`, converted from the generator's `u32` by truncation
@@ -628,21 +630,24 @@ fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
             tris,
             &case.config,
             tinydecimate::Builtin::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
         CostKind::Plane => drive!(ws.start(
             Positions::Read(&case.positions),
             tris,
             &case.config,
             Quadric::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
         CostKind::Normal => drive!(ws.start(
             Positions::Read(&case.positions),
             tris,
             &case.config,
             NormalVariation::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
     }
 }

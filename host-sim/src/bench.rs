@@ -754,6 +754,7 @@ fn run_method(
                 let (out, report, elapsed) = crate::simplify::simplify_with(
                     mesh,
                     &config.with_ratio(ratio),
+                    crate::simplify::OperatorArg::Edge,
                     Some(placement),
                     false,
                     false,

@@ -30,7 +30,8 @@ use serde::Deserialize;
 use sha2::{Digest, Sha256};
 use tinydecimate::bound::Controls;
 use tinydecimate::{
-    Builtin, Config, FeatureMode, NoBound, Placement, Positions, Schedule, StoredQuadric,
+    Builtin, Config, EdgeCollapse, FeatureMode, NoBound, Placement, Positions, Schedule,
+    StoredQuadric,
 };
 
 use crate::simplify::HostWorkspace;
@@ -541,7 +542,7 @@ fn run_reference<I: tinydecimate::Index>(
         let bound = Controls::new(&original, &mut links);
         let p = Positions::Read(positions);
         return Ok(storage
-            .start(p, triangles, config, Builtin::new(), bound)?
+            .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
             .run());
     }
     let mut quadrics = vec![[0.0f32; 10]; positions.len()];
@@ -553,6 +554,7 @@ fn run_reference<I: tinydecimate::Index>(
             config,
             StoredQuadric::new(&mut quadrics, Placement::Subset),
             NoBound,
+            EdgeCollapse,
         )?,
         Some(Placement::Optimal) => storage.start(
             Positions::Write(positions),
@@ -560,6 +562,7 @@ fn run_reference<I: tinydecimate::Index>(
             config,
             StoredQuadric::new(&mut quadrics, Placement::Optimal),
             NoBound,
+            EdgeCollapse,
         )?,
     };
     Ok(s.run())

@@ -11,7 +11,7 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Context, Result};
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder, HEADER};
-use tinydecimate::{Config, Progressive, Target};
+use tinydecimate::{Config, EdgeCollapse, Progressive, Target};
 
 use crate::io::{self, MeshData};
 use crate::metro::{metro, MetroOptions};
@@ -161,6 +161,7 @@ pub fn collapse_log(mesh: &MeshData, config: &Config) -> Result<Vec<[u32; 2]>> {
             config,
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .map_err(|e| anyhow!("tinydecimate: {e}"))?
         .record_into(&mut log);

@@ -15,8 +15,8 @@ use anyhow::{anyhow, bail, Result};
 use tinydecimate::bound::Controls;
 use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
 use tinydecimate::{
-    Builtin, Config, CostKind, FeatureMode, NoBound, Positions, Report, Schedule, Storage, Target,
-    Workspace,
+    Builtin, Config, CostKind, EdgeCollapse, FeatureMode, NoBound, Positions, Report, Schedule,
+    Storage, Target, TriangleCollapse, Workspace,
 };
 
 use crate::io::{Format, MeshData};
@@ -130,7 +130,7 @@ impl From<CostArg> for CostKind {
     }
 }
 
-/// Which operator, on the command line (`Config::with_operator`).
+/// Which operator, on the command line (`EdgeCollapse` or `TriangleCollapse`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum OperatorArg {
     /// The default and the one to use: half-edge collapse (one vertex merged into a
@@ -423,9 +423,6 @@ impl Args {
         if let Some(x) = self.boundary_weight {
             c.boundary_weight = x;
         }
-        if self.operator == OperatorArg::Triangle {
-            c = c.with_operator(tinydecimate::Operator::Triangle);
-        }
         c
     }
 }
@@ -465,15 +462,16 @@ pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
     anyhow!("tinydecimate: {e}{hint}")
 }
 
-/// Runs the library on `mesh` with any policies: stored quadrics (`placement`, else the
-/// configuration's built-in cost) and the error bound (`bounded`: control points in a `u32`
-/// link slice; the bound itself is `config.max_error`), stepping with a progress bar when
+/// Runs the library on `mesh` with any policies: the operator, stored quadrics (`placement`,
+/// else the configuration's built-in cost) and the error bound (`bounded`: control points in a
+/// `u32` link slice; the bound itself is `config.max_error`), stepping with a progress bar when
 /// `progress`. The library refuses combinations it cannot run. The result carries the
 /// positions as the library left them (moved by optimal placement). The wall time is that of
 /// the library alone (storage is allocated before).
 pub fn simplify_with(
     mesh: &MeshData,
     config: &Config,
+    operator: OperatorArg,
     placement: Option<Placement>,
     bounded: bool,
     progress: bool,
@@ -501,11 +499,11 @@ pub fn simplify_with(
     });
     let start = Instant::now();
     let budget = if bounded { 1 << 12 } else { 1 << 14 };
-    macro_rules! drive {
-        ($p:expr, $cost:expr, $bound:expr) => {{
+    macro_rules! drive_with {
+        ($p:expr, $cost:expr, $bound:expr, $op:expr) => {{
             let mut s = ws
                 .storage()
-                .start($p, &mut tris, config, $cost, $bound)
+                .start($p, &mut tris, config, $cost, $bound, $op)
                 .map_err(library_error)?;
             let n0 = s.live_triangles();
             while !s.step(budget) {
@@ -514,6 +512,15 @@ pub fn simplify_with(
                 }
             }
             s.finish()
+        }};
+    }
+    // The operator is a type: one instantiation per operator.
+    macro_rules! drive {
+        ($p:expr, $cost:expr, $bound:expr) => {{
+            match operator {
+                OperatorArg::Edge => drive_with!($p, $cost, $bound, EdgeCollapse),
+                OperatorArg::Triangle => drive_with!($p, $cost, $bound, TriangleCollapse),
+            }
         }};
     }
     let original = &mesh.triangles;
@@ -619,7 +626,7 @@ pub fn simplify_with_progress(
     mesh: &MeshData,
     config: &Config,
 ) -> Result<(MeshData, Report, Duration)> {
-    simplify_with(mesh, config, None, false, true)
+    simplify_with(mesh, config, OperatorArg::Edge, None, false, true)
 }
 
 /// The report as JSON: every field of `Report`.
@@ -693,7 +700,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     // The library refuses what it cannot run (stored quadrics with the passes schedule,
     // optimal placement with a bound) before any work, naming the option.
     let placement = stored.then(|| args.placement.into());
-    let (out, report, elapsed) = simplify_with(&mesh, &config, placement, bounded, true)?;
+    let (out, report, elapsed) =
+        simplify_with(&mesh, &config, args.operator, placement, bounded, true)?;
     let written = if keep_numbering {
         out.clone()
     } else {
@@ -727,7 +735,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         let _ = writeln!(
             text,
             "  schedule, cost, op     {:?}, {:?}, {:?} collapse",
-            config.schedule, config.cost, config.operator
+            config.schedule, config.cost, args.operator
         );
     }
     if let Some(e) = args.max_error {
@@ -808,7 +816,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "keep_numbering": keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
-        "operator": format!("{:?}", config.operator),
+        "operator": format!("{:?}", args.operator),
         "quadric": format!("{:?}", args.quadric),
         "placement": format!("{:?}", args.placement),
         "max_error": args.max_error.map(|e| e.to_string()),

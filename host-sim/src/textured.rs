@@ -25,8 +25,14 @@ use crate::simplify::{Args, PlacementArg, QuadricArg};
 fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
-    let (out, report, _) =
-        crate::simplify::simplify_with(mesh, config, placement, args.max_error.is_some(), false)?;
+    let (out, report, _) = crate::simplify::simplify_with(
+        mesh,
+        config,
+        args.operator,
+        placement,
+        args.max_error.is_some(),
+        false,
+    )?;
     Ok((out.triangles, report))
 }
 

@@ -2,11 +2,12 @@
 
 use super::Simplifier;
 use crate::index::Index;
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::report::Stop;
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// Writes every collapse made from now on into `log`, as `[removed, kept]` in the input's
     /// vertex numbers: the history that [`Progressive::from_log`](crate::Progressive::from_log)
     /// turns into vertex splits (call it before the first step to have the whole history).
