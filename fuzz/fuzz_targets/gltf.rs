@@ -17,11 +17,7 @@ fuzz_target!(|data: &[u8]| {
             assert_eq!(s.count(), n, "{}", s.semantic);
         }
     }
-    let results: Vec<Vec<[u32; 3]>> = file
-        .primitives
-        .iter()
-        .map(|p| p.triangles.clone())
-        .collect();
+    let results: Vec<Vec<[u32; 3]>> = file.primitives.iter().map(|p| p.triangles.clone()).collect();
     let (out, _) = host_sim::gltf::write(&file, &results, true, "").expect("writes what it read");
     let again = host_sim::gltf::parse(&out, None).expect("reads what it wrote");
     assert_eq!(again.primitives.len(), file.primitives.len());

@@ -21,17 +21,10 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(d) = host_sim::pm::decode_with(bytes, piece, None, &[0.1, 0.5]) {
         let n = d.positions.len();
-        assert!(
-            6 * n <= bytes.len(),
-            "{n} vertices from {} bytes",
-            bytes.len()
-        );
+        assert!(6 * n <= bytes.len(), "{n} vertices from {} bytes", bytes.len());
         let levels = d.levels.iter().flat_map(|(_, l)| l);
         for t in d.triangles.iter().chain(levels) {
-            assert!(
-                t.iter().all(|&i| (i as usize) < n),
-                "{t:?} past {n} vertices"
-            );
+            assert!(t.iter().all(|&i| (i as usize) < n), "{t:?} past {n} vertices");
         }
     }
 });
