@@ -1,7 +1,7 @@
-//! Plane quadrics (Garland and Heckbert 1997; Cheng, Pan and Shi 1998 §2.3): a symmetric 4×4
-//! matrix `Q` stored as its upper triangle, 10 floats, whose form `vᵀ Q v` at `v = (p, 1)` is
-//! the (weighted) sum of squared distances from `p` to the planes it was built from. Shared by
-//! the stored-quadric cost and the clustering's quadric representative.
+//! Plane quadrics (Garland's quadric error metric, as Cheng, Pan and Shi 1998 use it, §2.3): a
+//! symmetric 4×4 matrix `Q` stored as its upper triangle, 10 floats, whose form `vᵀ Q v` at
+//! `v = (p, 1)` is the (weighted) sum of squared distances from `p` to the planes it was built
+//! from. Shared by the stored-quadric cost and the clustering's quadric representative.
 
 use crate::math::V3;
 
