@@ -35,6 +35,8 @@ use tinydecimate::{
 
 use crate::simplify::HostWorkspace;
 
+pub mod stream;
+
 /// The case list inside the golden directory.
 pub const MANIFEST: &str = "cases.toml";
 
@@ -283,7 +285,7 @@ struct Manifest {
     case: Vec<CaseSpec>,
     /// Progressive-stream cases (host-sim/src/streamcase.rs).
     #[serde(default)]
-    stream: Vec<crate::streamcase::StreamSpec>,
+    stream: Vec<stream::StreamSpec>,
 }
 
 /// The mesh of a case: a generator spec of [`meshfmt::golden`] or a file under `tests/`.
@@ -423,7 +425,7 @@ pub fn load_specs(dir: &Path) -> Result<Vec<CaseSpec>> {
 }
 
 /// Reads the manifest `dir/cases.toml`: its progressive-stream cases.
-pub fn load_stream_specs(dir: &Path) -> Result<Vec<crate::streamcase::StreamSpec>> {
+pub fn load_stream_specs(dir: &Path) -> Result<Vec<stream::StreamSpec>> {
     Ok(manifest(dir)?.stream)
 }
 
@@ -948,7 +950,7 @@ pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
     let cases = load_cases(dir)?;
     let streams = load_stream_specs(dir)?;
     // The clustering cases (`cluster.toml`, `host-sim qemu --cluster`) share the directories.
-    let clusters = crate::qemu_cluster::load_specs(dir)?;
+    let clusters = crate::qemu::cluster::load_specs(dir)?;
     let mut lines = Vec::new();
     for case in &cases {
         let new = Golden::of(case, backend, &reference(case)?)?;
@@ -1028,7 +1030,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         for l in bless(&a.dir, backend)? {
             crate::outln!("  {l}");
         }
-        for l in crate::streamcase::bless(&a.dir, backend)? {
+        for l in stream::bless(&a.dir, backend)? {
             crate::outln!("  {l}");
         }
         return Ok(ExitCode::SUCCESS);
@@ -1059,7 +1061,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         }
         failed += usize::from(v.is_failure());
     }
-    let streams = crate::streamcase::check_host(&a.dir, backend)?;
+    let streams = stream::check_host(&a.dir, backend)?;
     for (case, v) in &streams {
         crate::outln!(
             "  {:<28} {:>4} V {:>5} T tdpm  {}",

@@ -44,7 +44,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::{IndexType, Status};
 
 use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
-use crate::streamcase::StreamCase;
+use crate::golden::stream::StreamCase;
+
+pub mod cluster;
 
 /// An emulated board.
 #[derive(Clone, Copy, Debug)]
@@ -877,14 +879,14 @@ pub fn check(
     // Stream cases: golden files only.
     let mut stream_expect: Vec<Option<Golden>> = Vec::new();
     for sc in streams {
-        let now = crate::streamcase::reference(sc);
+        let now = crate::golden::stream::reference(sc);
         let dir = match expected {
             Expected::Golden(dir) => dir,
             Expected::Host => bail!("stream cases are checked against golden files only"),
         };
         match Golden::load(dir, backend, sc.name())? {
             Some(g) => {
-                host.push(crate::streamcase::judge(sc, backend, &g, &now));
+                host.push(crate::golden::stream::judge(sc, backend, &g, &now));
                 stream_expect.push(Some(g));
             }
             None => {
@@ -942,7 +944,7 @@ pub fn check(
                         if verbose {
                             crate::outln!("{} / {}: {}", b.name, sc.name(), run.describe());
                         }
-                        crate::streamcase::judge(sc, backend, g, out)
+                        crate::golden::stream::judge(sc, backend, g, out)
                     }
                     _ => Verdict::Failed(format!("no result: {}", run.describe())),
                 },
@@ -1399,11 +1401,11 @@ pub fn measure(
     let mut streams = Vec::new();
     for sc in stream_cases {
         let expected =
-            crate::streamcase::golden_of(sc, backend, &crate::streamcase::reference(sc))?;
+            crate::golden::stream::golden_of(sc, backend, &crate::golden::stream::reference(sc))?;
         let run = run_stream_bytes(board, &elf, &sc.stream, timeout)?;
         let (verdict, summary) = match (&run.result, run.ok()) {
             (Some(o), true) => (
-                crate::streamcase::judge(sc, backend, &expected, o).cell(),
+                crate::golden::stream::judge(sc, backend, &expected, o).cell(),
                 meshfmt::pm::parse(o).map(|(_, s)| s),
             ),
             _ => ("FAILED", None),
@@ -1718,10 +1720,10 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     let timeout = Duration::from_secs(a.timeout);
     let mut failed = 0usize;
     if a.cluster {
-        failed = crate::qemu_cluster::check(&boards, backend, &a.dir, a.bless, timeout, a.verbose)?;
+        failed = cluster::check(&boards, backend, &a.dir, a.bless, timeout, a.verbose)?;
     } else if a.measure {
         let cases = golden::load_cases(&a.dir)?;
-        let streams = crate::streamcase::load(&a.dir)?;
+        let streams = crate::golden::stream::load(&a.dir)?;
         let mut all = Vec::new();
         for b in &boards {
             let m = measure(b, backend, &cases, &streams, timeout)?;
@@ -1804,7 +1806,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         };
         // Stream cases only against the golden files (with --mesh there are none).
         let streams = match (&a.mesh, &expected) {
-            (None, _) => crate::streamcase::load(&a.dir)?,
+            (None, _) => crate::golden::stream::load(&a.dir)?,
             (Some(_), _) => Vec::new(),
         };
         failed = check(
@@ -1878,7 +1880,7 @@ mod tests {
             ("riscv32imac-virt-32k", 500, 1_000, 2, 0),
         ];
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
-        let streams = crate::streamcase::load(&golden::default_dir()).unwrap();
+        let streams = crate::golden::stream::load(&golden::default_dir()).unwrap();
         for (board, v, t, link, qv) in caps {
             let too_big: Vec<&str> = cases
                 .iter()

@@ -1,0 +1,5 @@
+//! The subcommands of the `host-sim` binary: each file holds one command's arguments and its
+//! `run`.
+
+pub mod bound_table;
+pub mod demo;
