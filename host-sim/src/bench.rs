@@ -15,7 +15,7 @@
 //! median wall time of the simplifier call alone is reported. The result of the last repetition
 //! (every simplifier is deterministic) is checked with [`crate::check::compare`] and measured
 //! with [`crate::metro::metro`]. Scratch memory per input triangle is, for tinydecimate, the
-//! exact right-sized workspace ([`crate::simplify::workspace_bytes`]); for meshoptimizer, the
+//! exact right-sized workspace ([`crate::workspace::workspace_bytes`]); for meshoptimizer, the
 //! peak of the bytes live in its temporary allocator during the call, counted through
 //! `meshopt_setAllocator`. The output index buffer the `meshopt` wrapper allocates is not
 //! counted (tinydecimate writes its result over its input instead).
@@ -44,7 +44,8 @@ use tinydecimate::{Config, CostKind, Rejections, Report};
 use crate::check::{compare, Validity};
 use crate::io::MeshData;
 use crate::metro::{metro, MetroOptions};
-use crate::simplify::{simplify, workspace_bytes};
+use crate::simplify::simplify;
+use crate::workspace::workspace_bytes;
 
 /// The meshoptimizer version that `meshopt` [`MESHOPT_CRATE_VERSION`] bundles
 /// (`MESHOPTIMIZER_VERSION 1030` in its `vendor/src/meshoptimizer.h`).
@@ -758,7 +759,7 @@ fn run_method(
                     false,
                     false,
                 )?;
-                let bytes = workspace_bytes(v, t).0 + v * crate::simplify::QUADRIC_BYTES;
+                let bytes = workspace_bytes(v, t).0 + v * crate::workspace::QUADRIC_BYTES;
                 (out, elapsed, bytes, Some(report))
             }
             (Some(config), None) => {

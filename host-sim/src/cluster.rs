@@ -139,7 +139,7 @@ fn then_collapse(
     let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
     let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
     let n = mesh.triangles.len().max(1);
-    let mut ws = crate::simplify::HostWorkspace::new(n, n);
+    let mut ws = crate::workspace::HostWorkspace::new(n, n);
     let mut out = vec![[0u32; 3]; n];
     let mut vertices = vec![0u32; n];
     let mut positions = vec![[0.0f32; 3]; n];

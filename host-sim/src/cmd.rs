@@ -3,3 +3,7 @@
 
 pub mod bound_table;
 pub mod demo;
+pub mod simplify;
+pub mod check;
+pub mod metro;
+pub mod render;

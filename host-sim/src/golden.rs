@@ -33,7 +33,7 @@ use tinydecimate::{
     Builtin, Config, FeatureMode, NoBound, Placement, Positions, Schedule, StoredQuadric,
 };
 
-use crate::simplify::HostWorkspace;
+use crate::workspace::HostWorkspace;
 
 pub mod stream;
 

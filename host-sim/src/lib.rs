@@ -60,7 +60,7 @@ pub mod progress;
 pub mod qemu;
 pub mod render;
 pub mod simplify;
-pub mod textured;
+pub mod workspace;
 
 /// The glTF reader and writer (`io::gltf`), also at the crate's root.
 pub use io::gltf;

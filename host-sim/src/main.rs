@@ -7,8 +7,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cmd::{bound_table, demo};
-use host_sim::{bench, check, cluster, golden, metro, pm, qemu, render, simplify};
+use host_sim::cmd::{bound_table, check, demo, metro, render, simplify};
+use host_sim::{bench, cluster, golden, pm, qemu};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]

@@ -15,7 +15,7 @@ use tinydecimate::{Config, Progressive};
 
 use crate::io::{self, MeshData};
 use crate::metro::{metro, MetroOptions};
-use crate::simplify::HostWorkspace;
+use crate::workspace::HostWorkspace;
 
 /// `host-sim pm …`
 #[derive(Clone, Debug, clap::Args)]

@@ -18,7 +18,7 @@ use anyhow::{anyhow, bail, Result};
 use tinydecimate::{Config, Report};
 
 use crate::io::MeshData;
-use crate::simplify::{Args, PlacementArg, QuadricArg};
+use super::{Args, PlacementArg, QuadricArg};
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
