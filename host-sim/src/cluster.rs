@@ -24,6 +24,15 @@ pub const CELLS: usize = 1 << 20;
 static TABLE: Mutex<Clusterer<CELLS>> = Mutex::new(Clusterer::new());
 static QUADS: Mutex<Quadrics<CELLS>> = Mutex::new(Quadrics::new());
 
+/// Lends the harness's one cell table and quadric table to `f` (one caller at a time). A call
+/// uses the first `ClusterConfig::table_cells` cells (all of them when 0), and gives the same
+/// bytes as a table of that size: the golden clustering cases run here as on a board.
+pub fn with_tables<R>(f: impl FnOnce(&mut Clusterer<CELLS>, &mut Quadrics<CELLS>) -> R) -> R {
+    let mut table = TABLE.lock().unwrap_or_else(|p| p.into_inner());
+    let mut quads = QUADS.lock().unwrap_or_else(|p| p.into_inner());
+    f(&mut table, &mut quads)
+}
+
 /// `host-sim cluster IN OUT (--target-triangles N | --cell SIZE) [--then-collapse N]`
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("grid").required(true))]

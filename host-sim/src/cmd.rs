@@ -7,3 +7,4 @@ pub mod simplify;
 pub mod check;
 pub mod metro;
 pub mod render;
+pub mod golden;

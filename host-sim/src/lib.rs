@@ -48,6 +48,7 @@ pub fn exit_code_for_io(e: &std::io::Error) -> i32 {
     }
 }
 
+pub mod backend;
 pub mod bench;
 pub mod check;
 pub mod cluster;
@@ -61,6 +62,14 @@ pub mod qemu;
 pub mod render;
 pub mod simplify;
 pub mod workspace;
+
+/// The repository root (the parent of host-sim).
+pub fn repo_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host-sim lives inside the repository")
+        .to_path_buf()
+}
 
 /// The glTF reader and writer (`io::gltf`), also at the crate's root.
 pub use io::gltf;

@@ -7,8 +7,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cmd::{bound_table, check, demo, metro, render, simplify};
-use host_sim::{bench, cluster, golden, pm, qemu};
+use host_sim::cmd::{bound_table, check, demo, golden, metro, render, simplify};
+use host_sim::{bench, cluster, pm, qemu};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]

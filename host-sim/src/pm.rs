@@ -51,8 +51,8 @@ pub struct StreamArgs {
     #[arg(long, default_value = "mps2-an386")]
     pub board: String,
     /// Math backend of the firmware (the decoder's output does not depend on it).
-    #[arg(long, value_enum, default_value_t = crate::golden::Backend::compiled())]
-    pub backend: crate::golden::Backend,
+    #[arg(long, value_enum, default_value_t = crate::backend::Backend::compiled())]
+    pub backend: crate::backend::Backend,
     /// Kill QEMU after this many seconds.
     #[arg(long, default_value_t = 600)]
     pub timeout: u64,

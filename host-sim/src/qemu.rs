@@ -43,7 +43,8 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::{IndexType, Status};
 
-use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
+use crate::backend::Backend;
+use crate::golden::{self, Case, Golden, Outcome, Verdict};
 use crate::golden::stream::StreamCase;
 
 pub mod cluster;
@@ -872,7 +873,7 @@ pub fn check(
             },
             Expected::Host => {
                 host.push(Verdict::Identical);
-                expect.push(Some(Golden::of(case, backend, &now)?));
+                expect.push(Some(Golden::from_outcome(case, backend, &now)?));
             }
         }
     }
@@ -1344,7 +1345,7 @@ pub fn measure(
     let mut out = Vec::new();
     let (mut workspace_bytes, mut capacity) = (0, (0, 0, 0));
     for case in cases {
-        let expected = Golden::of(case, backend, &golden::reference(case)?)?;
+        let expected = Golden::from_outcome(case, backend, &golden::reference(case)?)?;
         let (outcome, run) = run_case(board, &elf, case, timeout)?;
         let Some(o) = outcome else {
             out.push(CaseMeasurement {
@@ -1401,7 +1402,7 @@ pub fn measure(
     let mut streams = Vec::new();
     for sc in stream_cases {
         let expected =
-            crate::golden::stream::golden_of(sc, backend, &crate::golden::stream::reference(sc))?;
+            crate::golden::stream::golden_from_output(sc, backend, &crate::golden::stream::reference(sc))?;
         let run = run_stream_bytes(board, &elf, &sc.stream, timeout)?;
         let (verdict, summary) = match (&run.result, run.ok()) {
             (Some(o), true) => (
@@ -1711,7 +1712,7 @@ pub fn select_boards(names: &[String]) -> Result<Vec<&'static Board>> {
 pub fn run(a: &Args) -> Result<ExitCode> {
     let backend = a.backend.unwrap_or(Backend::compiled());
     if backend != Backend::compiled() {
-        return golden::reinvoke(backend);
+        return crate::backend::reinvoke(backend);
     }
     let boards = select_boards(&a.boards)?;
     if let Some(code) = preflight(&boards)? {

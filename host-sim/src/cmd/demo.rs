@@ -16,7 +16,8 @@ use anyhow::Result;
 use meshfmt::{IndexType, Status};
 use tinydecimate::Config;
 
-use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
+use crate::backend::Backend;
+use crate::golden::{self, Case, Golden, Outcome, Verdict};
 use crate::qemu;
 
 /// `host-sim demo`.
@@ -132,7 +133,7 @@ fn thousands(n: u64) -> String {
 pub fn run(a: &Args) -> Result<ExitCode> {
     let backend = a.backend.unwrap_or(Backend::compiled());
     if backend != Backend::compiled() {
-        return golden::reinvoke(backend);
+        return crate::backend::reinvoke(backend);
     }
     let board = qemu::board(&a.board)?;
     if let Some(code) = qemu::preflight(&[board])? {
@@ -141,7 +142,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     let path = a
         .mesh
         .clone()
-        .unwrap_or_else(|| golden::repo_root().join("tests/fixtures/cow.obj"));
+        .unwrap_or_else(|| crate::repo_root().join("tests/fixtures/cow.obj"));
     let m = crate::io::load(&path)?;
     let index_type = if a.u32 || m.positions.len() > usize::from(u16::MAX) {
         IndexType::U32
@@ -308,8 +309,8 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         ),
     );
     let (gh, gd) = (
-        Golden::of(&case, backend, &host)?,
-        Golden::of(&case, backend, &device)?,
+        Golden::from_outcome(&case, backend, &host)?,
+        Golden::from_outcome(&case, backend, &device)?,
     );
     row(
         "output sha256",
