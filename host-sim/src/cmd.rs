@@ -8,3 +8,5 @@ pub mod check;
 pub mod metro;
 pub mod render;
 pub mod golden;
+pub mod qemu;
+pub mod run_elf;

@@ -7,8 +7,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cmd::{bound_table, check, demo, golden, metro, render, simplify};
-use host_sim::{bench, cluster, pm, qemu};
+use host_sim::cmd::{bound_table, check, demo, golden, metro, qemu, render, run_elf, simplify};
+use host_sim::{bench, cluster, pm};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]
@@ -49,7 +49,7 @@ enum Command {
     BoundTable(bound_table::Args),
     /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
     /// examples/cortex-m4f (`cargo run --example … --target thumbv7em-none-eabihf`).
-    RunElf(qemu::RunElfArgs),
+    RunElf(run_elf::Args),
 }
 
 fn main() -> ExitCode {
@@ -65,7 +65,7 @@ fn main() -> ExitCode {
         Command::Golden(a) => golden::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Pm(a) => pm::run(a),
-        Command::RunElf(a) => qemu::run_elf(a),
+        Command::RunElf(a) => run_elf::run(a),
         Command::BoundTable(a) => bound_table::run(a),
     };
     result.unwrap_or_else(|e| {

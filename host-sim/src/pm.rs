@@ -625,40 +625,6 @@ fn levels(a: &LevelsArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// What a board's streaming firmware holds (host-sim/firmware/src/board.rs): `PM_VERTICES`
-/// vertices, the triangle buffer less the list heads, halved between triangles and their
-/// links, and a `PM_BUFFER`-byte chunk buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StreamCapacity {
-    /// Vertices of the full mesh.
-    pub vertices: usize,
-    /// Triangles of the full mesh.
-    pub triangles: usize,
-    /// Chunk buffer bytes (largest payload plus `CHUNK_OVERHEAD`).
-    pub buffer: usize,
-}
-
-impl StreamCapacity {
-    /// The capacity of the firmware for the board `name`.
-    pub fn of(name: &str) -> Option<StreamCapacity> {
-        // (MAX_TRIANGLES, link bytes, PM_VERTICES, PM_BUFFER) of board.rs.
-        let (max_triangles, link, vertices, buffer) = match name {
-            "microbit" => (432, 2, 44, 80),
-            "lm3s6965evb" => (2_400, 2, 100, 272),
-            "mps2-an386" | "mps2-an500" | "mps2-an505" => (106_000, 4, 3_000, 4_096),
-            "riscv32imc-virt-400k" => (13_000, 2, 3_000, 4_096),
-            "riscv32imac-virt-32k" => (1_000, 2, 100, 272),
-            _ => return None,
-        };
-        let heads = (vertices * link + 3) & !3;
-        Some(StreamCapacity {
-            vertices,
-            triangles: (max_triangles * 3 * link - heads) / (6 * link),
-            buffer,
-        })
-    }
-}
-
 /// `host-sim pm stream`: the streaming demo on an emulated board.
 fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     use crate::qemu;
@@ -670,7 +636,7 @@ fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     let h = extent(&bytes)
         .with_context(|| a.input.display().to_string())?
         .header;
-    let cap = StreamCapacity::of(board.name)
+    let cap = crate::qemu::StreamCapacity::of(board.name)
         .ok_or_else(|| anyhow!("{}: no streaming firmware for this board", board.name))?;
     let buffer = usize::from(h.max_payload) + stream::CHUNK_OVERHEAD;
     if h.vertices as usize > cap.vertices
@@ -812,60 +778,3 @@ fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
     })
 }
 
-#[cfg(test)]
-mod capacity_tests {
-    use super::StreamCapacity;
-
-    /// The value of `pub const NAME...: ... = VALUE;` in one board's block of board.rs.
-    fn constant(block: &str, name: &str) -> usize {
-        let line = block
-            .lines()
-            .find(|l| l.trim_start().starts_with(&format!("pub const {name}:")))
-            .unwrap_or_else(|| panic!("no {name} in {block}"));
-        let v = line.split('=').nth(1).unwrap().trim().trim_end_matches(';');
-        v.replace('_', "").parse().unwrap()
-    }
-
-    /// `StreamCapacity::of` is a copy of the firmware's constants: it must agree with
-    /// host-sim/firmware/src/board.rs for every board there.
-    #[test]
-    fn stream_capacity_agrees_with_the_firmware() {
-        let src = include_str!("../firmware/src/board.rs");
-        let blocks: Vec<&str> = src.split("mod sel {").skip(1).collect();
-        let mut boards = 0;
-        for block in blocks {
-            let block = &block[..block.find("\n}").unwrap_or(block.len())];
-            let names: Vec<&str> = block
-                .lines()
-                .filter(|l| l.contains("pub const NAME: &str ="))
-                .map(|l| l.split('"').nth(1).unwrap())
-                .collect();
-            let link = if block.contains("pub type Link = u32;") {
-                4
-            } else {
-                2
-            };
-            let (t, v, b) = (
-                constant(block, "MAX_TRIANGLES"),
-                constant(block, "PM_VERTICES"),
-                constant(block, "PM_BUFFER"),
-            );
-            let heads = (v * link + 3) & !3;
-            for name in names {
-                boards += 1;
-                let c = StreamCapacity::of(name)
-                    .unwrap_or_else(|| panic!("StreamCapacity::of({name}) is missing"));
-                assert_eq!(
-                    c,
-                    StreamCapacity {
-                        vertices: v,
-                        triangles: (t * 3 * link - heads) / (6 * link),
-                        buffer: b,
-                    },
-                    "{name}"
-                );
-            }
-        }
-        assert_eq!(boards, crate::qemu::BOARDS.len(), "boards in board.rs");
-    }
-}

@@ -29,13 +29,13 @@ pub fn build(board: &Board, backend: Backend) -> Result<PathBuf> {
         features.push_str(",micromath");
     }
     let mut cmd = Command::new(cargo);
-    cmd.current_dir(qemu::firmware_dir())
+    cmd.current_dir(qemu::build::firmware_dir())
         .args(["build", "--release", "--target", board.target])
         .args(["--bin", "tinydecimate-cluster", "--features", &features])
         .arg("--target-dir")
-        .arg(qemu::firmware_target_dir())
+        .arg(qemu::build::firmware_target_dir())
         .env("DEFMT_LOG", "info");
-    qemu::isolate(&mut cmd);
+    qemu::build::isolate(&mut cmd);
     let status = cmd
         .status()
         .context("running cargo for the cluster firmware")?;
@@ -45,11 +45,11 @@ pub fn build(board: &Board, backend: Backend) -> Result<PathBuf> {
             board.name
         );
     }
-    let built = qemu::firmware_target_dir()
+    let built = qemu::build::firmware_target_dir()
         .join(board.target)
         .join("release")
         .join("tinydecimate-cluster");
-    let elf = qemu::firmware_target_dir()
+    let elf = qemu::build::firmware_target_dir()
         .join("images")
         .join(format!("{}-{backend}-cluster.elf", board.name));
     std::fs::create_dir_all(elf.parent().expect("has a parent"))?;
