@@ -7,8 +7,9 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cmd::{bound_table, check, demo, golden, metro, qemu, render, run_elf, simplify};
-use host_sim::{bench, cluster, pm};
+use host_sim::cmd::{
+    bench, bound_table, check, cluster, demo, golden, metro, pm, qemu, render, run_elf, simplify,
+};
 
 #[derive(Parser)]
 #[command(name = "host-sim", version, about = "Host harness for tinydecimate")]

@@ -307,9 +307,9 @@ pub fn select_boards(names: &[String]) -> Result<Vec<&'static Board>> {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use super::build::flash_crate_dir;
     use super::run::qemu_command;
+    use super::*;
     use crate::golden;
     use std::path::Path;
 

@@ -209,4 +209,3 @@ pub fn check(
     crate::outln!("{backend}: clustering, {failed} DIFF or FAILED");
     Ok(failed)
 }
-

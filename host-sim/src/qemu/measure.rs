@@ -397,8 +397,11 @@ pub fn measure(
     }
     let mut streams = Vec::new();
     for sc in stream_cases {
-        let expected =
-            crate::golden::stream::golden_from_output(sc, backend, &crate::golden::stream::reference(sc))?;
+        let expected = crate::golden::stream::golden_from_output(
+            sc,
+            backend,
+            &crate::golden::stream::reference(sc),
+        )?;
         let run = run_stream_bytes(board, &elf, &sc.stream, timeout)?;
         let (verdict, summary) = match (&run.result, run.ok()) {
             (Some(o), true) => (

@@ -17,8 +17,8 @@ use std::process::ExitCode;
 use anyhow::{anyhow, bail, Result};
 use tinydecimate::{Config, Report};
 
-use crate::io::MeshData;
 use super::{Args, PlacementArg, QuadricArg};
+use crate::io::MeshData;
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
