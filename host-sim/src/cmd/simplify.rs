@@ -9,12 +9,13 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use tinydecimate::cost::Placement;
-use tinydecimate::{Config, CostKind, FeatureMode, Schedule, Storage};
+use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Storage};
 
-use crate::io::Format;
+use crate::io::{Format, MeshData};
 use crate::simplify::{format_report, report_json, simplify_with};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
@@ -356,8 +357,7 @@ impl Args {
 
 /// `host-sim simplify`. Exit code 1 if the measured result is not a valid simplification.
 pub fn run(args: &Args) -> Result<ExitCode> {
-    use std::fmt::Write as _;
-    // Everything that can be refused is refused before the long work.
+    // 1. Everything that can be refused is refused before the long work.
     let to_stdout = crate::io::is_std(&args.output);
     if to_stdout && args.json {
         bail!("--json and an output of `-` would both write standard output: give an output file");
@@ -374,6 +374,49 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             args.output.display()
         );
     }
+    // 2. The run, and the file it writes.
+    let run = simplify_file(args, out_format)?;
+    // 3. What was done and the memory it takes, then the check and the error.
+    let say = |text: &str| {
+        if to_stdout {
+            eprint!("{text}");
+        } else if !args.json {
+            crate::out!("{text}");
+        }
+    };
+    say(&run_text(args, &run));
+    let mut json = run_json(args, &run);
+    let mut valid = true;
+    if !args.no_measure {
+        valid = measure(args, &run, &say, &mut json)?;
+    }
+    json["valid"] = serde_json::Value::Bool(valid);
+    if args.json {
+        crate::outln!("{}", serde_json::to_string_pretty(&json)?);
+    }
+    Ok(if valid {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// One `simplify` run: the input, the result, what was written and how.
+struct Run {
+    mesh: MeshData,
+    config: Config,
+    out: MeshData,
+    written: MeshData,
+    out_format: Format,
+    report: Report,
+    elapsed: Duration,
+    stored: bool,
+    moved: bool,
+    keep_numbering: bool,
+}
+
+/// Loads the input, runs the library as `args` ask and writes the output file.
+fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     let mesh = crate::io::load_noting(&args.input)?;
     let mut config = args.config();
     if let Some(e) = args.max_error {
@@ -404,7 +447,34 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         crate::io::compact(&out).0
     };
     crate::io::save_as(&args.output, out_format, &written)?;
+    Ok(Run {
+        mesh,
+        config,
+        out,
+        written,
+        out_format,
+        report,
+        elapsed,
+        stored,
+        moved,
+        keep_numbering,
+    })
+}
 
+/// The run in words: files, modes, the library's report and the memory figures.
+fn run_text(args: &Args, run: &Run) -> String {
+    use std::fmt::Write as _;
+    let Run {
+        mesh,
+        config,
+        written,
+        out_format,
+        report,
+        elapsed,
+        stored,
+        moved,
+        ..
+    } = run;
     let mut text = String::new();
     let _ = writeln!(
         text,
@@ -415,13 +485,13 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         written.positions.len(),
         if args.keep_numbering {
             ", input numbering kept"
-        } else if moved {
+        } else if *moved {
             ", input numbering kept: vertices moved"
         } else {
             ", unreferenced dropped"
         }
     );
-    if stored {
+    if *stored {
         let _ = writeln!(
             text,
             "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
@@ -485,7 +555,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             per_tri(b32)
         );
     }
-    if stored {
+    if *stored {
         let _ = writeln!(
             text,
             "  stored quadrics        {} bytes ({QUADRIC_BYTES} per vertex); with the workspace \
@@ -494,22 +564,19 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             per_tri(need + v * QUADRIC_BYTES)
         );
     }
-    let say = |text: &str| {
-        if to_stdout {
-            eprint!("{text}");
-        } else if !args.json {
-            crate::out!("{text}");
-        }
-    };
-    say(&text);
-    text.clear();
+    text
+}
 
-    let mut json = serde_json::json!({
+/// The JSON object of `--json`, before the check and the error are added.
+fn run_json(args: &Args, run: &Run) -> serde_json::Value {
+    let (v, t) = (run.mesh.positions.len(), run.mesh.triangles.len());
+    let config = &run.config;
+    serde_json::json!({
         "input": args.input.display().to_string(),
         "output": args.output.display().to_string(),
-        "output_format": format!("{out_format:?}"),
-        "output_vertices": written.positions.len(),
-        "keep_numbering": keep_numbering,
+        "output_format": format!("{:?}", run.out_format),
+        "output_vertices": run.written.positions.len(),
+        "keep_numbering": run.keep_numbering,
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
         "operator": format!("{:?}", config.operator),
@@ -517,78 +584,90 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         "placement": format!("{:?}", args.placement),
         "max_error": args.max_error.map(|e| e.to_string()),
         "d_hold": if config.max_error.is_finite() { Some(config.max_error) } else { None },
-        "report": report_json(&report),
-        "library_ms": elapsed.as_secs_f64() * 1e3,
-        "workspace_bytes": need,
-    });
-    let mut valid = true;
-    if !args.no_measure {
-        // The library drops degenerate and duplicate triangles before it starts; the check
-        // compares the output with the input as the library saw it (`meshcheck::clean`).
-        // One checker, one verdict: what `host-sim check` says of the file, as written and
-        // read back (an STL welded by position, a compact file matched back by position).
-        let ext = format!("{out_format:?}");
-        let as_read = crate::io::encode(out_format, &written)
-            .map_err(|e| anyhow!("{e}"))
-            .and_then(|b| crate::io::parse_bytes(&b, &ext))
-            .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
-        let (_, note, validity) = crate::check::verdict(&mesh, &as_read, moved)?;
-        valid = validity.is_valid();
+        "report": report_json(&run.report),
+        "library_ms": run.elapsed.as_secs_f64() * 1e3,
+        "workspace_bytes": workspace_bytes(v, t).0,
+    })
+}
+
+/// The check of the file as written and read back, and the Metro error (and the bound's
+/// figures): said with `say`, added to `json`. Whether the result is valid.
+fn measure(
+    args: &Args,
+    run: &Run,
+    say: &dyn Fn(&str),
+    json: &mut serde_json::Value,
+) -> Result<bool> {
+    use std::fmt::Write as _;
+    let Run {
+        mesh,
+        config,
+        out,
+        written,
+        out_format,
+        report,
+        moved,
+        ..
+    } = run;
+    let out_format = *out_format;
+    let mut text = String::new();
+    // The library drops degenerate and duplicate triangles before it starts; the check
+    // compares the output with the input as the library saw it (`meshcheck::clean`).
+    // One checker, one verdict: what `host-sim check` says of the file, as written and
+    // read back (an STL welded by position, a compact file matched back by position).
+    let ext = format!("{out_format:?}");
+    let as_read = crate::io::encode(out_format, written)
+        .map_err(|e| anyhow!("{e}"))
+        .and_then(|b| crate::io::parse_bytes(&b, &ext))
+        .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
+    let (_, note, validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    let valid = validity.is_valid();
+    let _ = writeln!(
+        text,
+        "check (output vs the cleaned input: the input less its {} degenerate and {} \
+         duplicate triangles, as the library dropped them):",
+        report.degenerate_dropped, report.duplicates_dropped
+    );
+    if let Some(n) = &note {
+        let _ = writeln!(text, "note: {n}");
+    }
+    let _ = writeln!(text, "{validity}");
+    let opts = crate::metro::MetroOptions {
+        samples_per_triangle: args.samples_per_triangle,
+        progress: true,
+        ..Default::default()
+    };
+    let m = crate::metro::metro(mesh, out, &opts);
+    let _ = writeln!(text, "metro (input vs output):");
+    let _ = writeln!(text, "{m}");
+    if let (Some(emax), Some(emean)) = (report.max_error, report.mean_error) {
+        let pct = |x: f64| 100.0 * x / m.diagonal.max(f64::MIN_POSITIVE);
         let _ = writeln!(
             text,
-            "check (output vs the cleaned input: the input less its {} degenerate and {} \
-             duplicate triangles, as the library dropped them):",
-            report.degenerate_dropped, report.duplicates_dropped
+            "error bound (input units; % of the diagonal):\n\
+             \x20 d_hold                   {:.6e} = {:.5} %\n\
+             \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
+             \x20 E_mean (eq. 5)           {:.6e} = {:.5} %\n\
+             \x20 Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
+            config.max_error,
+            pct(f64::from(config.max_error)),
+            emax,
+            pct(f64::from(emax)),
+            emean,
+            pct(f64::from(emean)),
+            m.a_to_b.max,
+            m.a_to_b.max_pct,
         );
-        if let Some(n) = &note {
-            let _ = writeln!(text, "note: {n}");
-        }
-        let _ = writeln!(text, "{validity}");
-        let opts = crate::metro::MetroOptions {
-            samples_per_triangle: args.samples_per_triangle,
-            progress: true,
-            ..Default::default()
-        };
-        let m = crate::metro::metro(&mesh, &out, &opts);
-        let _ = writeln!(text, "metro (input vs output):");
-        let _ = writeln!(text, "{m}");
-        if let (Some(emax), Some(emean)) = (report.max_error, report.mean_error) {
-            let pct = |x: f64| 100.0 * x / m.diagonal.max(f64::MIN_POSITIVE);
-            let _ = writeln!(
-                text,
-                "error bound (input units; % of the diagonal):\n\
-                 \x20 d_hold                   {:.6e} = {:.5} %\n\
-                 \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
-                 \x20 E_mean (eq. 5)           {:.6e} = {:.5} %\n\
-                 \x20 Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
-                config.max_error,
-                pct(f64::from(config.max_error)),
-                emax,
-                pct(f64::from(emax)),
-                emean,
-                pct(f64::from(emean)),
-                m.a_to_b.max,
-                m.a_to_b.max_pct,
-            );
-        }
-        say(&text);
-        json["check"] = serde_json::json!({
-            "against": "cleaned input",
-            "validity": validity,
-            "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
-            "valid": valid,
-        });
-        json["metro"] = serde_json::to_value(&m)?;
     }
-    json["valid"] = serde_json::Value::Bool(valid);
-    if args.json {
-        crate::outln!("{}", serde_json::to_string_pretty(&json)?);
-    }
-    Ok(if valid {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
+    say(&text);
+    json["check"] = serde_json::json!({
+        "against": "cleaned input",
+        "validity": validity,
+        "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
+        "valid": valid,
+    });
+    json["metro"] = serde_json::to_value(&m)?;
+    Ok(valid)
 }
 
 #[cfg(test)]
