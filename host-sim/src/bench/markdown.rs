@@ -105,6 +105,15 @@ fn mesh_names(r: &Results) -> Vec<&str> {
 /// table per mesh.
 pub fn markdown(r: &Results) -> String {
     let mut s = String::new();
+    header(&mut s, r);
+    summary(&mut s, r);
+    stopped_short(&mut s, r);
+    per_mesh(&mut s, r);
+    s
+}
+
+/// The title, the command, the machine, the modes and how they were measured.
+fn header(s: &mut String, r: &Results) {
     let _ = writeln!(s, "# tinydecimate vs meshoptimizer\n");
     let _ = writeln!(s, "Written by `host-sim bench` (host-sim/src/bench.rs).\n");
     let _ = writeln!(s, "* Command: `{}`", r.command);
@@ -146,8 +155,10 @@ pub fn markdown(r: &Results) -> String {
          triangle count we reached as its target, and that mode's error ratios (marked †) are \
          taken against this run, not against meshoptimizer at the original target."
     );
+}
 
-    // Summary.
+/// The summary: per mode against meshoptimizer, time and error, and the invalid outputs.
+fn summary(s: &mut String, r: &Results) {
     let time_ratios: Vec<String> = r.summary.time_ratios.iter().map(|x| fmt_pct(*x)).collect();
     let _ = writeln!(s, "\n## Summary\n");
     let _ = writeln!(
@@ -235,8 +246,10 @@ pub fn markdown(r: &Results) -> String {
     if !invalid.is_empty() {
         let _ = writeln!(s, "\nInvalid results: {}.", invalid.join("; "));
     }
+}
 
-    // Where the library stopped short.
+/// The runs where the library stopped above its target, compared at the same count.
+fn stopped_short(s: &mut String, r: &Results) {
     let short: Vec<&Row> = r.rows.iter().filter(|x| x.same_count.is_some()).collect();
     let _ = writeln!(s, "\n## Stopped short\n");
     if short.is_empty() {
@@ -285,8 +298,10 @@ pub fn markdown(r: &Results) -> String {
             );
         }
     }
+}
 
-    // Per mesh.
+/// One table per mesh: every mode at every ratio.
+fn per_mesh(s: &mut String, r: &Results) {
     let _ = writeln!(
         s,
         "\nPer mesh: **tris** triangles reached (target ⌊ratio·T⌋; *short* if above it); **ms** \
@@ -355,5 +370,4 @@ pub fn markdown(r: &Results) -> String {
             }
         }
     }
-    s
 }
