@@ -1,7 +1,7 @@
 //! `host-sim qemu [--check]`: every case and progressive stream on the host and on each board,
 //! compared with the golden files or a fresh host run, printed as a table cases x boards.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
@@ -36,6 +36,51 @@ pub fn check_boards(
     timeout: Duration,
     verbose: bool,
 ) -> Result<usize> {
+    // 1. The host: its verdicts and what every board is compared with.
+    let (host, expect, stream_expect) = expectations(backend, cases, streams, expected)?;
+    let names: Vec<&str> = cases
+        .iter()
+        .map(|c| c.name.as_str())
+        .chain(streams.iter().map(|c| c.name()))
+        .collect();
+    let mut columns: Vec<(String, Vec<Verdict>)> = vec![("host".into(), host)];
+    // 2. One column per board.
+    for b in boards {
+        let t0 = Instant::now();
+        // A failed build fails this board's column, not the whole check.
+        let col = match build(b, backend, true) {
+            Ok(elf) => board_column(
+                b,
+                &elf,
+                t0,
+                backend,
+                cases,
+                streams,
+                (&expect, &stream_expect),
+                timeout,
+                verbose,
+            )?,
+            Err(e) => {
+                let why = format!("firmware build failed: {e:#}");
+                eprintln!("{:<20} {why}", b.name);
+                names.iter().map(|_| Verdict::Failed(why.clone())).collect()
+            }
+        };
+        columns.push((b.name.to_string(), col));
+    }
+    // 3. The table and a line for every cell that is not identical.
+    print_table(backend, expected, &names, &columns)
+}
+
+/// The goldens a run is compared with (`None`: no golden file), per case and per stream, and
+/// the host's own verdicts.
+#[allow(clippy::type_complexity)]
+fn expectations(
+    backend: Backend,
+    cases: &[Case],
+    streams: &[StreamCase],
+    expected: &Expected,
+) -> Result<(Vec<Verdict>, Vec<Option<Golden>>, Vec<Option<Golden>>)> {
     let mut expect: Vec<Option<Golden>> = Vec::new();
     let mut host = Vec::new();
     for case in cases {
@@ -84,69 +129,73 @@ pub fn check_boards(
             }
         }
     }
-    let names: Vec<&str> = cases
-        .iter()
-        .map(|c| c.name.as_str())
-        .chain(streams.iter().map(|c| c.name()))
-        .collect();
-    let mut columns: Vec<(String, Vec<Verdict>)> = vec![("host".into(), host)];
-    for b in boards {
-        let t0 = Instant::now();
-        // A failed build or QEMU start fails this board's column, not the whole check.
-        let elf = match build(b, backend, true) {
-            Ok(elf) => elf,
-            Err(e) => {
-                let why = format!("firmware build failed: {e:#}");
-                eprintln!("{:<20} {why}", b.name);
-                columns.push((
-                    b.name.to_string(),
-                    names.iter().map(|_| Verdict::Failed(why.clone())).collect(),
-                ));
-                continue;
-            }
-        };
-        let built = t0.elapsed();
-        let mut col = Vec::new();
-        for (case, exp) in cases.iter().zip(&expect) {
-            let v = match (run_case(b, &elf, case, timeout), exp) {
-                (Err(e), _) => Verdict::Failed(format!("{e:#}")),
-                (Ok((None, run)), _) => Verdict::Failed(format!("no result: {}", run.describe())),
-                (Ok((Some(o), run)), Some(g)) => {
-                    if verbose {
-                        crate::outln!("{} / {}: {}", b.name, case.name, run.describe());
-                    }
-                    golden::judge(case, backend, g, &o)?
-                }
-                (Ok(_), None) => Verdict::Failed("no golden files".into()),
-            };
-            col.push(against_expected_skips(b.name, &case.name, v));
-        }
-        for (sc, exp) in streams.iter().zip(&stream_expect) {
-            let v = match (run_stream_bytes(b, &elf, &sc.stream, timeout), exp) {
-                (Err(e), _) => Verdict::Failed(format!("{e:#}")),
-                (Ok(run), Some(g)) => match (&run.result, run.ok()) {
-                    (Some(out), true) => {
-                        if verbose {
-                            crate::outln!("{} / {}: {}", b.name, sc.name(), run.describe());
-                        }
-                        crate::golden::stream::judge(sc, backend, g, out)
-                    }
-                    _ => Verdict::Failed(format!("no result: {}", run.describe())),
-                },
-                (Ok(_), None) => Verdict::Failed("no golden files".into()),
-            };
-            col.push(against_expected_skips(b.name, sc.name(), v));
-        }
-        eprintln!(
-            "{:<20} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
-            b.name,
-            built.as_secs_f64(),
-            names.len(),
-            (t0.elapsed() - built).as_secs_f64()
-        );
-        columns.push((b.name.to_string(), col));
-    }
+    Ok((host, expect, stream_expect))
+}
 
+/// One board's column: every case and stream run on it (the image `elf`, built since `t0`),
+/// judged.
+#[allow(clippy::too_many_arguments)]
+fn board_column(
+    b: &'static Board,
+    elf: &Path,
+    t0: Instant,
+    backend: Backend,
+    cases: &[Case],
+    streams: &[StreamCase],
+    (expect, stream_expect): (&[Option<Golden>], &[Option<Golden>]),
+    timeout: Duration,
+    verbose: bool,
+) -> Result<Vec<Verdict>> {
+    let built = t0.elapsed();
+    let mut col = Vec::new();
+    for (case, exp) in cases.iter().zip(expect) {
+        let v = match (run_case(b, elf, case, timeout), exp) {
+            (Err(e), _) => Verdict::Failed(format!("{e:#}")),
+            (Ok((None, run)), _) => Verdict::Failed(format!("no result: {}", run.describe())),
+            (Ok((Some(o), run)), Some(g)) => {
+                if verbose {
+                    crate::outln!("{} / {}: {}", b.name, case.name, run.describe());
+                }
+                golden::judge(case, backend, g, &o)?
+            }
+            (Ok(_), None) => Verdict::Failed("no golden files".into()),
+        };
+        col.push(against_expected_skips(b.name, &case.name, v));
+    }
+    for (sc, exp) in streams.iter().zip(stream_expect) {
+        let v = match (run_stream_bytes(b, elf, &sc.stream, timeout), exp) {
+            (Err(e), _) => Verdict::Failed(format!("{e:#}")),
+            (Ok(run), Some(g)) => match (&run.result, run.ok()) {
+                (Some(out), true) => {
+                    if verbose {
+                        crate::outln!("{} / {}: {}", b.name, sc.name(), run.describe());
+                    }
+                    crate::golden::stream::judge(sc, backend, g, out)
+                }
+                _ => Verdict::Failed(format!("no result: {}", run.describe())),
+            },
+            (Ok(_), None) => Verdict::Failed("no golden files".into()),
+        };
+        col.push(against_expected_skips(b.name, sc.name(), v));
+    }
+    eprintln!(
+        "{:<20} firmware ({backend}) built in {:.1} s, {} cases run in {:.1} s",
+        b.name,
+        built.as_secs_f64(),
+        cases.len() + streams.len(),
+        (t0.elapsed() - built).as_secs_f64()
+    );
+    Ok(col)
+}
+
+/// Prints the table cases x columns, then the cells that are not identical, then the counts.
+/// Returns how many cells are DIFF or FAILED.
+fn print_table(
+    backend: Backend,
+    expected: &Expected,
+    names: &[&str],
+    columns: &[(String, Vec<Verdict>)],
+) -> Result<usize> {
     let what = match expected {
         Expected::Golden(dir) => format!("golden files {}/{backend}", dir.display()),
         Expected::Host => format!("the library on the host ({backend})"),
@@ -168,7 +217,7 @@ pub fn check_boards(
     }
     let (mut same, mut skipped, mut failed) = (0, 0, 0);
     let mut details = Vec::new();
-    for (n, col) in &columns {
+    for (n, col) in columns {
         for (case, v) in names.iter().zip(col) {
             match v {
                 Verdict::Identical => same += 1,
