@@ -153,7 +153,7 @@ impl CaseSpec {
 #[serde(deny_unknown_fields)]
 struct Manifest {
     case: Vec<CaseSpec>,
-    /// Progressive-stream cases (host-sim/src/streamcase.rs).
+    /// Progressive-stream cases (host-sim/src/golden/stream.rs).
     #[serde(default)]
     stream: Vec<super::stream::StreamSpec>,
 }

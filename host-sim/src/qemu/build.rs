@@ -47,7 +47,7 @@ pub fn build(board: &Board, backend: Backend, with_library: bool) -> Result<Path
     let mut cmd = Command::new(cargo);
     cmd.current_dir(firmware_dir())
         .args(["build", "--release", "--target", board.target])
-        // Only the collapse image (the clustering one is `qemu_cluster::build`'s).
+        // Only the collapse image (the clustering one is `qemu::cluster::build`'s).
         .args(["--bin", "tinydecimate-firmware", "--features", &features])
         .arg("--target-dir")
         .arg(firmware_target_dir())
