@@ -277,7 +277,7 @@ fn side_by_side(
     let dev_col = format!("{} ({}, QEMU)", board.name, board.core);
     row("", host_col, dev_col);
     let status = |o: &Outcome| status_text(&o.header);
-    row("status", status(&host), status(&device));
+    row("status", status(host), status(device));
     row("target", target_text(h), target_text(d));
     row(
         "stop",

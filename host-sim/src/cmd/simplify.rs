@@ -512,7 +512,7 @@ fn run_text(args: &Args, run: &Run) -> String {
             config.max_error, config.control_angle_deg
         );
     }
-    let _ = writeln!(text, "{}", format_report(&report));
+    let _ = writeln!(text, "{}", format_report(report));
     let _ = writeln!(
         text,
         "  library call           {:.3} ms",
