@@ -33,6 +33,10 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 
+pub mod gltf;
+pub mod objattr;
+pub mod plyattr;
+
 /// A triangle mesh: positions and 0-based vertex indices.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {

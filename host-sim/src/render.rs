@@ -274,24 +274,6 @@ pub fn render_compare(original: &MeshData, simplified: &MeshData) -> (RgbImage, 
     (out, top)
 }
 
-/// `host-sim render MESH OUT.png [--compare ORIGINAL]`
-#[derive(Clone, Debug, clap::Args)]
-pub struct Args {
-    /// The mesh to draw.
-    pub mesh: std::path::PathBuf,
-    /// Output PNG.
-    pub out: std::path::PathBuf,
-    /// Draw original | MESH | MESH coloured by its distance to ORIGINAL, side by side.
-    #[arg(long, value_name = "ORIGINAL")]
-    pub compare: Option<std::path::PathBuf>,
-}
-
-/// `host-sim render`.
-pub fn run(args: &Args) -> Result<std::process::ExitCode> {
-    draw(&args.mesh, &args.out, args.compare.as_deref())?;
-    Ok(std::process::ExitCode::SUCCESS)
-}
-
 /// Draws `mesh` (or the comparison with `compare`) into the PNG file `out`.
 pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
     let m = crate::io::load_noting(mesh)?;

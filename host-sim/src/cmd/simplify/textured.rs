@@ -1,6 +1,6 @@
-//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::gltf`]), OBJ
-//! with `vt`/`vn` ([`crate::objattr`]) and PLY with vertex properties besides x, y, z
-//! ([`crate::plyattr`]).
+//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::io::gltf`]), OBJ
+//! with `vt`/`vn` ([`crate::io::objattr`]) and PLY with vertex properties besides x, y, z
+//! ([`crate::io::plyattr`]).
 //!
 //! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
 //! the same configuration; `--target-triangles N` is shared among the parts in proportion to
@@ -17,8 +17,8 @@ use std::process::ExitCode;
 use anyhow::{anyhow, bail, Result};
 use tinydecimate::{Config, Report, Target};
 
+use super::{Args, PlacementArg, QuadricArg};
 use crate::io::MeshData;
-use crate::simplify::{Args, PlacementArg, QuadricArg};
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
@@ -40,8 +40,8 @@ fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u3
 /// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
 pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     let (i, o) = (&args.input, &args.output);
-    let gi = crate::gltf::is_gltf_path(i);
-    let go = crate::gltf::is_gltf_path(o);
+    let gi = crate::io::gltf::is_gltf_path(i);
+    let go = crate::io::gltf::is_gltf_path(o);
     if gi || go {
         if !(gi && go) {
             bail!(
@@ -74,7 +74,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && !args.keep_numbering
     {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
-        if crate::objattr::has_attributes(&bytes) {
+        if crate::io::objattr::has_attributes(&bytes) {
             refuse_optimal(args)?;
             return run_obj(args, &bytes).map(Some);
         }
@@ -91,7 +91,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && !args.keep_numbering
     {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
-        let extra = crate::plyattr::extra_properties(&bytes);
+        let extra = crate::io::plyattr::extra_properties(&bytes);
         if !extra.is_empty() {
             refuse_optimal(args)?;
             return run_ply(args, &bytes, &extra).map(Some);
@@ -102,10 +102,10 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
 
 fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
     let file =
-        crate::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+        crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
     let parts = vec![("vertex element".to_string(), file.mesh.clone())];
     let done = simplify_parts(args, &parts)?;
-    let out = crate::plyattr::write(&file, &done[0].triangles)
+    let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
     std::fs::write(&args.output, out)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
@@ -244,7 +244,7 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
 }
 
 fn run_gltf(args: &Args) -> Result<ExitCode> {
-    let file = crate::gltf::load(&args.input)?;
+    let file = crate::io::gltf::load(&args.input)?;
     for p in &file.passed_through {
         eprintln!(
             "note: {}: {p} is not triangles: passed through unsimplified",
@@ -256,7 +256,7 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         .iter()
         .map(|p| {
             (
-                crate::gltf::label(p),
+                crate::io::gltf::label(p),
                 MeshData {
                     positions: p.positions.clone(),
                     triangles: p.triangles.clone(),
@@ -266,7 +266,7 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         .collect();
     let done = simplify_parts(args, &parts)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
-    crate::gltf::save(&args.output, &file, &results)?;
+    crate::io::gltf::save(&args.output, &file, &results)?;
     let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
@@ -275,14 +275,14 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         args.input.display(),
         args.output.display(),
         parts.len(),
-        crate::gltf::attribute_summary(&file)
+        crate::io::gltf::attribute_summary(&file)
     );
     finish(args, head, &done)
 }
 
 fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
     let file =
-        crate::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+        crate::io::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
     let parts: Vec<(String, MeshData)> = (0..file.groups.len())
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| {
@@ -304,7 +304,7 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
             k += 1;
         }
     }
-    let text = crate::objattr::write(&file, &results);
+    let text = crate::io::objattr::write(&file, &results);
     std::fs::write(&args.output, text)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
     let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
