@@ -66,4 +66,6 @@ pub mod qemu_cluster;
 pub mod render;
 pub mod simplify;
 pub mod streamcase;
+pub mod texrender;
 pub mod textured;
+pub mod uvstretch;
