@@ -61,6 +61,8 @@ pub mod progress;
 pub mod qemu;
 pub mod render;
 pub mod simplify;
+pub mod texrender;
+pub mod uvstretch;
 pub mod workspace;
 
 /// The repository root (the parent of host-sim).

@@ -103,7 +103,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
 fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
     let file =
         crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
-    let parts = vec![("vertex element".to_string(), file.mesh.clone())];
+    let parts = vec![("vertex element".to_string(), file.mesh.clone(), None)];
     let done = simplify_parts(args, &parts)?;
     let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
@@ -139,11 +139,15 @@ struct Part {
     json: serde_json::Value,
 }
 
+/// One part to simplify: its label, its mesh and, when it has them, the texture coordinates
+/// its material reads (one per vertex), for the UV stretch figure.
+type Input = (String, MeshData, Option<Vec<[f32; 2]>>);
+
 /// Simplifies each mesh of `parts` with `args`' configuration.
-fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>> {
-    let total: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
+    let total: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let mut out = Vec::new();
-    for (label, mesh) in parts {
+    for (label, mesh, uvs) in parts {
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
@@ -203,6 +207,9 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
             json["defects"] =
                 serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
             json["metro"] = serde_json::to_value(&m)?;
+            if let Some(uvs) = uvs {
+                let _ = write!(line, "{}", uv_stretch(mesh, uvs, &result, &mut json));
+            }
         }
         out.push(Part {
             triangles: tris,
@@ -212,6 +219,51 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
         });
     }
     Ok(out)
+}
+
+/// The UV stretch of the input, the result and meshoptimizer's `simplify` at the result's
+/// triangle count (see [`crate::uvstretch`]), as text for the part's line and into `json`.
+fn uv_stretch(
+    mesh: &MeshData,
+    uvs: &[[f32; 2]],
+    result: &MeshData,
+    json: &mut serde_json::Value,
+) -> String {
+    let stretch = |t: &[[u32; 3]]| crate::uvstretch::l2_stretch(&mesh.positions, uvs, t);
+    let (Some(input), Some(ours)) = (stretch(&mesh.triangles), stretch(&result.triangles)) else {
+        return String::new();
+    };
+    let (anchor, _, _) = crate::bench::meshopt::meshopt_simplify(mesh, result.triangles.len());
+    let theirs = stretch(&anchor.triangles);
+    let diag = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+    let deviation = |t: &[[u32; 3]]| {
+        crate::uvstretch::texture_deviation(&mesh.positions, uvs, &mesh.triangles, t)
+            .map(|(mean, max, lost)| (100.0 * mean / diag, 100.0 * max / diag, lost))
+    };
+    let (dev_ours, dev_theirs) = (deviation(&result.triangles), deviation(&anchor.triangles));
+    json["uv_stretch"] = serde_json::json!({
+        "input": input,
+        "result": ours,
+        "meshopt": theirs,
+        "meshopt_triangles": anchor.triangles.len(),
+        "texture_deviation_pct": dev_ours.map(|d| [d.0, d.1]),
+        "texture_samples_lost": dev_ours.map(|d| d.2),
+        "meshopt_texture_deviation_pct": dev_theirs.map(|d| [d.0, d.1]),
+        "meshopt_texture_samples_lost": dev_theirs.map(|d| d.2),
+    });
+    let dev = |d: Option<(f64, f64, usize)>| {
+        d.map_or(String::new(), |(mean, max, lost)| {
+            format!(", texture deviation mean {mean:.4} % max {max:.4} %, {lost} samples lost")
+        })
+    };
+    format!(
+        "\n    UV stretch {ours:.4} (input {input:.4}){}\n    meshoptimizer at {} triangles: UV \
+         stretch {}{}",
+        dev(dev_ours),
+        anchor.triangles.len(),
+        theirs.map_or("-".into(), |t| format!("{t:.4}")),
+        dev(dev_theirs)
+    )
 }
 
 fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
@@ -251,7 +303,7 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
             args.input.display()
         );
     }
-    let parts: Vec<(String, MeshData)> = file
+    let parts: Vec<Input> = file
         .primitives
         .iter()
         .map(|p| {
@@ -261,13 +313,14 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
                     positions: p.positions.clone(),
                     triangles: p.triangles.clone(),
                 },
+                texture_coordinates(&file, p),
             )
         })
         .collect();
     let done = simplify_parts(args, &parts)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
     crate::io::gltf::save(&args.output, &file, &results)?;
-    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (glTF, {} triangle primitive(s), attributes {} kept per vertex): \
@@ -280,17 +333,52 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
     finish(args, head, &done)
 }
 
+/// The texture coordinates primitive `p`'s material reads (`TEXCOORD_n` of its
+/// `baseColorTexture`, else `TEXCOORD_0`), one per vertex.
+fn texture_coordinates(
+    file: &crate::io::gltf::GltfFile,
+    p: &crate::io::gltf::Primitive,
+) -> Option<Vec<[f32; 2]>> {
+    let material = &file.json["meshes"][p.mesh]["primitives"][p.index]["material"];
+    let n = material
+        .as_u64()
+        .and_then(|m| {
+            file.json["materials"][m as usize]["pbrMetallicRoughness"]["baseColorTexture"]
+                ["texCoord"]
+                .as_u64()
+        })
+        .unwrap_or(0);
+    let name = format!("TEXCOORD_{n}");
+    let stream = p.attributes.iter().find(|s| s.semantic == name)?;
+    (0..p.positions.len())
+        .map(|i| crate::texrender::uv_of(stream, i).map(|uv| uv.map(|c| c as f32)))
+        .collect()
+}
+
+/// Group `g`'s texture coordinates, one per vertex, when every vertex has one.
+fn obj_texture_coordinates(file: &crate::io::objattr::ObjFile, g: usize) -> Option<Vec<[f32; 2]>> {
+    file.groups[g]
+        .vertices
+        .iter()
+        .map(|c| {
+            let text = file.vt_text.get(c.1? as usize)?;
+            let mut it = text.split_whitespace().map(str::parse::<f32>);
+            Some([it.next()?.ok()?, it.next().unwrap_or(Ok(0.0)).ok()?])
+        })
+        .collect()
+}
+
 fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
     let file =
         crate::io::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
-    let parts: Vec<(String, MeshData)> = (0..file.groups.len())
+    let parts: Vec<Input> = (0..file.groups.len())
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| {
             let name = file.groups[g]
                 .material
                 .as_deref()
                 .map_or("no material".to_string(), |m| format!("material {m}"));
-            (name, file.mesh(g))
+            (name, file.mesh(g), obj_texture_coordinates(&file, g))
         })
         .collect();
     let done = simplify_parts(args, &parts)?;
@@ -307,7 +395,7 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
     let text = crate::io::objattr::write(&file, &results);
     std::fs::write(&args.output, text)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
-    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (OBJ with {} texture coordinates, {} normals kept per vertex, {} \
