@@ -152,45 +152,31 @@ pub fn reference(case: &Case) -> Result<(ClusterResult, Vec<u8>)> {
         let q = if h.quadric { Some(&mut *quads) } else { None };
         let mut src = SliceSource::new(&case.positions, &case.triangles);
         let n = h.output_slots as usize;
+        // One call per index type: the same library call, the triangles as little-endian bytes.
+        macro_rules! run {
+            ($index:ty) => {{
+                let mut out = vec![[<$index>::default(); 3]; n];
+                let r = table.cluster(
+                    &mut src,
+                    &config,
+                    &mut out,
+                    Scratch {
+                        quadrics: q,
+                        ..Scratch::new()
+                    },
+                );
+                let k = r.as_ref().map_or(0, |r| r.triangles_out);
+                let b: Vec<u8> = out[..k]
+                    .iter()
+                    .flatten()
+                    .flat_map(|v| v.to_le_bytes())
+                    .collect();
+                (r, b)
+            }};
+        }
         let (outcome, bytes): (Result<ClusterReport, _>, Vec<u8>) = match h.index_type {
-            IndexType::U16 => {
-                let mut out = vec![[0u16; 3]; n];
-                let r = table.cluster(
-                    &mut src,
-                    &config,
-                    &mut out,
-                    Scratch {
-                        quadrics: q,
-                        ..Scratch::new()
-                    },
-                );
-                let k = r.as_ref().map_or(0, |r| r.triangles_out);
-                let b = out[..k]
-                    .iter()
-                    .flatten()
-                    .flat_map(|v| v.to_le_bytes())
-                    .collect();
-                (r, b)
-            }
-            IndexType::U32 => {
-                let mut out = vec![[0u32; 3]; n];
-                let r = table.cluster(
-                    &mut src,
-                    &config,
-                    &mut out,
-                    Scratch {
-                        quadrics: q,
-                        ..Scratch::new()
-                    },
-                );
-                let k = r.as_ref().map_or(0, |r| r.triangles_out);
-                let b = out[..k]
-                    .iter()
-                    .flatten()
-                    .flat_map(|v| v.to_le_bytes())
-                    .collect();
-                (r, b)
-            }
+            IndexType::U16 => run!(u16),
+            IndexType::U32 => run!(u32),
         };
         Ok((
             meshfmt::cluster::lib::result(h.index_type, &outcome, BoardId::Host),
