@@ -33,7 +33,8 @@ impl core::fmt::Display for Capacity {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[allow(missing_docs)]
 pub enum ConfigField {
-    TargetRatio,
+    /// [`Target::Ratio`](crate::Target::Ratio) outside `[0, 1]`.
+    Target,
     MaxCost,
     MaxPasses,
     Lambda,
@@ -42,6 +43,7 @@ pub enum ConfigField {
     BoundaryWeight,
     MaxError,
     ControlAngle,
+    /// [`TriangleCollapse`](crate::TriangleCollapse) with another schedule than greedy.
     Operator,
     /// The schedule cannot run this cost ([`StoredQuadric`](crate::StoredQuadric): greedy only).
     Schedule,

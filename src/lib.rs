@@ -18,7 +18,7 @@
 //! A guaranteed error bound (Zhu, Wang and Meng 2007, §2-§4) is a policy of the same engine:
 //! [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control
 //! points (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
-//! paper's own operator, triangle collapse, is [`Operator::Triangle`] (see [`triangle`]).
+//! paper's own operator, triangle collapse, is [`TriangleCollapse`] (see [`operator`]).
 //!
 //! Data flows one way:
 //!
@@ -66,10 +66,11 @@
 //! assert!(report.triangles_out < 32);
 //! assert_eq!(simplified.len(), report.triangles_out);
 //!
-//! // Any other choice goes through `start`, with the cost (and its placement) and the error
-//! // bound as values, each on the caller's storage and checked when the run starts: here
-//! // stored quadrics under a guaranteed bound of 0.05 (`run` to the end, or `step`).
-//! use tinydecimate::{bound, Controls, Placement, Positions, StoredQuadric};
+//! // Any other choice goes through `start`, with the cost (and its placement), the error
+//! // bound and the operator as values, each on the caller's storage and checked when the run
+//! // starts: here stored quadrics under a guaranteed bound of 0.05, edge collapse (`run` to
+//! // the end, or `step`).
+//! use tinydecimate::{bound, Controls, EdgeCollapse, Placement, Positions, StoredQuadric};
 //! let (original, mut triangles) = (grid, grid);
 //! let mut quadrics = [[0.0f32; 10]; 25];
 //! let mut links = [0u16; bound::control_len(32, 25)];
@@ -80,6 +81,7 @@
 //!         &Config::stored().with_ratio(0.25).with_max_error(0.05),
 //!         StoredQuadric::new(&mut quadrics, Placement::Subset),
 //!         Controls::new(&original, &mut links),
+//!         EdgeCollapse,
 //!     )?
 //!     .run();
 //! assert!(report.max_error.unwrap() <= 0.05);
@@ -96,6 +98,7 @@ mod error;
 mod index;
 mod math;
 mod mesh;
+pub mod operator;
 mod policy;
 pub mod progressive;
 mod quadric;
@@ -106,17 +109,17 @@ pub mod seam;
 mod tri;
 mod workspace;
 
-pub use engine::triangle;
 pub use policy::{bound, cost, legality};
 pub use progressive::stream;
 
 pub use bound::{Controls, NoBound};
-pub use config::{Config, CostKind, FeatureMode, Operator, Schedule};
+pub use config::{Config, CostKind, FeatureMode, Schedule, Target};
 pub use cost::{Builtin, Placement, StoredQuadric};
 pub use engine::Simplifier;
 pub use error::{Capacity, ConfigField, Error};
 pub use index::Index;
 pub use legality::{Reject, RULES};
+pub use operator::{EdgeCollapse, TriangleCollapse};
 pub use progressive::Progressive;
 pub use report::{Rejections, Report, Stop, PASS_LOG};
 pub use workspace::{Positions, Storage, Workspace};

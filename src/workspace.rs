@@ -28,9 +28,10 @@ use crate::engine::heap::Heap;
 use crate::engine::Simplifier;
 use crate::index::Index;
 use crate::mesh::Mesh;
+use crate::operator::{EdgeCollapse, Operator};
 use crate::policy::bound::{Bound, NoBound};
 use crate::policy::cost::{Builtin, Cost, Placement};
-use crate::{Capacity, Config, ConfigField, Error, Report};
+use crate::{Capacity, Config, ConfigField, Error, Report, Schedule};
 
 pub use crate::mesh::Positions;
 
@@ -130,6 +131,7 @@ impl<'a, L: Index> Storage<'a, L> {
             config,
             Builtin::new(),
             NoBound,
+            EdgeCollapse,
         )?;
         while !s.step(u32::MAX) {}
         Ok(s.finish())
@@ -145,20 +147,23 @@ impl<'a, L: Index> Storage<'a, L> {
     ///   [`Cost`], e.g. [`StoredQuadric`](crate::cost::StoredQuadric).
     /// * `bound`: [`NoBound`], or the guaranteed error bound [`Config::max_error`] with
     ///   [`Controls`](crate::bound::Controls) (Zhu, Wang and Meng 2007; see [`crate::bound`]).
+    /// * `operator`: [`EdgeCollapse`], or [`TriangleCollapse`](crate::TriangleCollapse) (greedy
+    ///   schedule only).
     ///
     /// Errors, all returned before the triangle buffer (or the positions) is touched:
     /// [`Error::InvalidConfig`] (a field out of range, or a policy that cannot run with it),
     /// [`Error::OriginalMismatch`], [`Error::Capacity`], [`Error::IndexOutOfRange`],
     /// [`Error::NonFinitePosition`].
     #[inline(always)]
-    pub fn start<I: Index, C: Cost, B: Bound<'a, I>>(
+    pub fn start<I: Index, C: Cost, B: Bound<'a, I>, O: Operator>(
         self,
         positions: Positions<'a>,
         triangles: &'a mut [[I; 3]],
         config: &Config,
         mut cost: C,
         mut bound: B,
-    ) -> Result<Simplifier<'a, L, I, C, B>, Error> {
+        operator: O,
+    ) -> Result<Simplifier<'a, L, I, C, B, O>, Error> {
         let nv = positions.len();
         let nt = triangles.len();
         if B::ON {
@@ -166,6 +171,11 @@ impl<'a, L: Index> Storage<'a, L> {
             bound.prepare(triangles, nv, config)?;
         }
         config.validate()?;
+        if O::TRIANGLE && config.schedule != Schedule::Greedy {
+            return Err(Error::InvalidConfig {
+                field: ConfigField::Operator,
+            });
+        }
         if !B::ON {
             bound.prepare(triangles, nv, config)?;
         }
@@ -230,6 +240,7 @@ impl<'a, L: Index> Storage<'a, L> {
             *config,
             cost,
             bound,
+            operator,
         ))
     }
 }
@@ -302,16 +313,17 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
     }
 
     /// [`Storage::start`] on this workspace.
-    pub fn start<'a, I: Index, C: Cost, B: Bound<'a, I>>(
+    pub fn start<'a, I: Index, C: Cost, B: Bound<'a, I>, O: Operator>(
         &'a mut self,
         positions: Positions<'a>,
         triangles: &'a mut [[I; 3]],
         config: &Config,
         cost: C,
         bound: B,
-    ) -> Result<Simplifier<'a, L, I, C, B>, Error> {
+        operator: O,
+    ) -> Result<Simplifier<'a, L, I, C, B, O>, Error> {
         self.as_storage()
-            .start(positions, triangles, config, cost, bound)
+            .start(positions, triangles, config, cost, bound, operator)
     }
 }
 

@@ -23,10 +23,12 @@ mod common;
 use common::{cube, fin_and_pinch, grid, icosphere, jitter, MeshData, Tri};
 use std::collections::HashMap;
 use tinydecimate::bound::control_len;
+use tinydecimate::operator::Operator;
 use tinydecimate::{
     Builtin, Capacity, Config, ConfigField, Controls, Error, Placement, Positions, Reject, Report,
     StoredQuadric,
 };
+use tinydecimate::{EdgeCollapse, NoBound, TriangleCollapse};
 
 type P = [f64; 3];
 
@@ -40,13 +42,18 @@ fn fixture(name: &str) -> MeshData {
 
 /// Runs the library with control points (u32 links, the big shared workspace).
 fn bounded(m: &MeshData, config: &Config) -> (MeshData, Report) {
+    bounded_with(m, config, EdgeCollapse)
+}
+
+/// [`bounded`] with `operator`.
+fn bounded_with<O: Operator>(m: &MeshData, config: &Config, operator: O) -> (MeshData, Report) {
     let mut tris = m.triangles.clone();
     let mut links = vec![0u32; control_len(tris.len(), m.positions.len())];
     let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
     let bound = Controls::new(&m.triangles, &mut links);
     let p = Positions::Read(&m.positions);
     let r = ws
-        .start(p, &mut tris, config, Builtin::new(), bound)
+        .start(p, &mut tris, config, Builtin::new(), bound, operator)
         .expect("start")
         .run();
     tris.truncate(r.triangles_out);
@@ -225,6 +232,17 @@ fn max_distance(input: &MeshData, output: &MeshData, angle_deg: f64, reach: f64)
 /// Simplifies `m` as far as it goes under each bound (a fraction of the diagonal) and checks
 /// every control point against the output; returns the triangle counts.
 fn check(name: &str, m: &MeshData, fractions: &[f32], base: Config) -> Vec<usize> {
+    check_with(name, m, fractions, base, EdgeCollapse)
+}
+
+/// [`check`] with `operator`.
+fn check_with<O: Operator>(
+    name: &str,
+    m: &MeshData,
+    fractions: &[f32],
+    base: Config,
+    operator: O,
+) -> Vec<usize> {
     let diag = diagonal(m);
     let mut counts = Vec::new();
     for &f in fractions {
@@ -234,7 +252,7 @@ fn check(name: &str, m: &MeshData, fractions: &[f32], base: Config) -> Vec<usize
             (bound - f as f64 * diag).abs() <= 1e-5 * diag,
             "{name}: diagonal"
         );
-        let (out, r) = bounded(m, &config);
+        let (out, r) = bounded_with(m, &config, operator);
         common::assert_valid(name, m, &out, &r);
         let tol = 1e-5 * diag;
         let worst = max_distance(m, &out, config.control_angle_deg as f64, bound + 2.0 * tol);
@@ -344,7 +362,7 @@ fn stepping_gives_the_one_shot_bytes() {
     let bound = Controls::new(&m.triangles, &mut links);
     let p = Positions::Read(&m.positions);
     let mut s = ws
-        .start(p, &mut tris, &config, Builtin::new(), bound)
+        .start(p, &mut tris, &config, Builtin::new(), bound, EdgeCollapse)
         .expect("start");
     while !s.step(7) {}
     let r2 = s.finish();
@@ -393,6 +411,7 @@ fn bad_input_is_refused() {
             &Config::stored().with_max_error(0.1),
             StoredQuadric::new(&mut q, Placement::Optimal),
             Controls::new(&m.triangles, &mut links),
+            EdgeCollapse,
         )
         .map(|s| s.run());
     assert_eq!(
@@ -472,11 +491,10 @@ fn bad_input_is_refused() {
     assert_eq!(r.triangles_out, 80);
 }
 
-#[cfg(feature = "triangle")]
 #[test]
 fn triangle_collapse_honours_the_bound() {
     // Zhu, Wang and Meng's own operator (§3): eq. 3 order, penalty re-insertion, loop/flip/bound tests.
-    let tri = unlimited().with_operator(tinydecimate::Operator::Triangle);
+    let tri = unlimited();
     for (name, m) in [
         ("icosphere4", icosphere(4)),
         ("wavy grid", grid(40, 30, 0.3)),
@@ -484,28 +502,53 @@ fn triangle_collapse_honours_the_bound() {
         ("cow", fixture("cow.obj")),
         ("plate_holes", fixture("plate_holes.obj")),
     ] {
-        let counts = check(&format!("triangle {name}"), &m, &[0.002, 0.01], tri);
+        let counts = check_with(
+            &format!("triangle {name}"),
+            &m,
+            &[0.002, 0.01],
+            tri,
+            TriangleCollapse,
+        );
         assert!(counts[1] < counts[0], "{name}: {counts:?}");
         assert!(counts[0] < m.triangles.len(), "{name}: {counts:?}");
     }
     // Without a bound, to a triangle target.
     let m = fixture("cow.obj");
-    let (out, r) = common::simplify(
-        &m,
-        &Config::new().with_operator(tinydecimate::Operator::Triangle),
-    );
+    let mut tris = m.triangles.clone();
+    let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let p = Positions::Read(&m.positions);
+    let r = ws
+        .start(
+            p,
+            &mut tris,
+            &Config::new(),
+            Builtin::new(),
+            NoBound,
+            TriangleCollapse,
+        )
+        .expect("start")
+        .run();
+    tris.truncate(r.triangles_out);
+    let out = MeshData {
+        positions: m.positions.clone(),
+        triangles: tris,
+    };
     common::assert_valid("triangle cow 10 %", &m, &out, &r);
     assert!(r.target_reached, "{r:?}");
     // Passes and triangle collapse do not mix.
     let mut tris = m.triangles.clone();
-    let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let p = Positions::Read(&m.positions);
     assert_eq!(
-        ws.simplify(
-            &m.positions,
+        ws.start(
+            p,
             &mut tris,
-            &Config::paper().with_operator(tinydecimate::Operator::Triangle)
-        ),
-        Err(Error::InvalidConfig {
+            &Config::paper(),
+            Builtin::new(),
+            NoBound,
+            TriangleCollapse
+        )
+        .err(),
+        Some(Error::InvalidConfig {
             field: ConfigField::Operator
         })
     );
@@ -524,14 +567,12 @@ fn all_shared_meshes_stay_within_the_bound() {
     for name in &names {
         let m = common::load_obj(name);
         check(name, &m, &[0.005], unlimited());
-        if !cfg!(feature = "triangle") {
-            continue;
-        }
-        check(
+        check_with(
             &format!("triangle {name}"),
             &m,
             &[0.005],
-            unlimited().with_operator(tinydecimate::Operator::Triangle),
+            unlimited(),
+            TriangleCollapse,
         );
     }
 }
@@ -544,26 +585,21 @@ fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
     // re-keys the fans it touched (about 12 vertices). So pops ≤ 4·(V + 12·collapses) and
     // sweeps ≤ 3·V per round plus V per halving.
     let m = fixture("cow.obj");
+    operations_stay_bounded(&m, EdgeCollapse);
+    operations_stay_bounded(&m, TriangleCollapse);
+}
+
+fn operations_stay_bounded<O: Operator + std::fmt::Debug>(m: &MeshData, op: O) {
     let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
-    let ops: &[tinydecimate::Operator] = if cfg!(feature = "triangle") {
-        &[
-            tinydecimate::Operator::Edge,
-            tinydecimate::Operator::Triangle,
-        ]
-    } else {
-        &[tinydecimate::Operator::Edge]
-    };
-    for &op in ops {
-        let config = unlimited()
-            .with_operator(op)
-            .with_relative_max_error(0.005, &m.positions);
+    {
+        let config = unlimited().with_relative_max_error(0.005, &m.positions);
         let mut tris = m.triangles.clone();
         let mut links = vec![0u32; control_len(tris.len(), m.positions.len())];
         let mut ws = common::BIG.lock().unwrap_or_else(|e| e.into_inner());
         let bound = Controls::new(&m.triangles, &mut links);
         let p = Positions::Read(&m.positions);
         let mut s = ws
-            .start(p, &mut tris, &config, Builtin::new(), bound)
+            .start(p, &mut tris, &config, Builtin::new(), bound, op)
             .expect("start");
         let mut ops = 0u64;
         while !s.step(1) {
@@ -586,7 +622,7 @@ fn operations_stay_bounded_with_the_bound_and_the_triangle_operator() {
 mod property {
     use super::*;
     use proptest::prelude::*;
-    use tinydecimate::{Operator, Schedule};
+    use tinydecimate::Schedule;
 
     fn mesh(kind: u8, n: u32, jitter_seed: u64) -> MeshData {
         let m = match kind % 4 {
@@ -613,30 +649,17 @@ mod property {
             passes in any::<bool>(),
             triangle in any::<bool>(),
         ) {
-            let triangle = triangle && cfg!(feature = "triangle");
             let m = mesh(kind, n, seed);
             let base = if passes && !triangle { Config::paper() } else { Config::new() };
-            let base = base.with_ratio(ratio).with_operator(if triangle {
-                Operator::Triangle
-            } else {
-                Operator::Edge
-            });
+            let base = base.with_ratio(ratio);
             prop_assume!(base.schedule == Schedule::Greedy || !triangle);
-            check("property", &m, &[fraction], base);
+            if triangle {
+                check_with("property", &m, &[fraction], base, TriangleCollapse);
+            } else {
+                check("property", &m, &[fraction], base);
+            }
         }
     }
-}
-
-#[cfg(not(feature = "triangle"))]
-#[test]
-fn triangle_collapse_needs_its_feature() {
-    let config = Config::new().with_operator(tinydecimate::Operator::Triangle);
-    assert_eq!(
-        config.validate(),
-        Err(Error::InvalidConfig {
-            field: ConfigField::Operator
-        })
-    );
 }
 
 /// One bounded run on `ws` with the built-in cost.
@@ -650,5 +673,7 @@ fn run_bounded(
 ) -> Result<Report, Error> {
     let bound = Controls::new(original, links);
     let p = Positions::Read(positions);
-    Ok(ws.start(p, triangles, config, Builtin::new(), bound)?.run())
+    Ok(ws
+        .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
+        .run())
 }

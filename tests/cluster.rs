@@ -547,7 +547,7 @@ proptest! {
 #[test]
 fn cluster_then_collapse_fits_a_small_workspace() {
     use tinydecimate::cluster::cluster_then_collapse;
-    use tinydecimate::{Config, Workspace};
+    use tinydecimate::{Config, Target, Workspace};
     let m = load_obj("stanford_bunny.obj");
     let mut table = Box::new(Clusterer::<4096>::new());
     let mut ws = Box::new(Workspace::<u16, 2048, 4096>::new());
@@ -564,7 +564,7 @@ fn cluster_then_collapse_fits_a_small_workspace() {
         &mut table,
         &mut src,
         &ClusterConfig::target(usize::MAX),
-        &Config::new().with_target_triangles(600),
+        &Config::new().with_target(Target::Triangles(600)),
         &mut out,
         ws.as_storage(),
         scratch,

@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use tinydecimate::{Capacity, Config, ConfigField, Error, Schedule, Stop, Workspace};
+use tinydecimate::{Capacity, Config, ConfigField, Error, Schedule, Stop, Target, Workspace};
 
 fn sphere() -> MeshData {
     icosphere(2) // 162 vertices, 320 triangles
@@ -95,8 +95,8 @@ fn bad_configuration_is_refused() {
     let m = sphere();
     let mut ws = Workspace::<u32, 256, 512>::new();
     let cases: [(Config, ConfigField); 6] = [
-        (Config::new().with_ratio(1.5), ConfigField::TargetRatio),
-        (Config::new().with_ratio(f32::NAN), ConfigField::TargetRatio),
+        (Config::new().with_ratio(1.5), ConfigField::Target),
+        (Config::new().with_ratio(f32::NAN), ConfigField::Target),
         (Config::new().with_lambda(-1.0), ConfigField::Lambda),
         (Config::new().with_max_passes(0), ConfigField::MaxPasses),
         (Config::new().with_max_cost(f32::NAN), ConfigField::MaxCost),
@@ -273,10 +273,7 @@ fn target_of_zero_or_above_input() {
         (320, 0, Stop::Target)
     );
     assert_eq!(out.triangles, m.triangles);
-    let (_, r) = simplify(
-        &m,
-        &Config::new().with_target_triangles(10_000).with_ratio(0.0),
-    );
+    let (_, r) = simplify(&m, &Config::new().with_target(Target::Triangles(10_000)));
     assert_eq!((r.triangles_out, r.stop), (320, Stop::Target));
     let (out, r) = simplify(&m, &Config::new().with_ratio(0.0));
     assert!(!r.target_reached);

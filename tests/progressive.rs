@@ -4,7 +4,8 @@
 mod common;
 use common::*;
 use tinydecimate::progressive::{ProgressiveError, Split, Storage};
-use tinydecimate::{Config, Progressive, Stop};
+use tinydecimate::EdgeCollapse;
+use tinydecimate::{Config, Progressive, Stop, Target};
 
 /// Triangles in input numbering, each rotated to start at its smallest index (winding kept),
 /// sorted: the mesh as a set.
@@ -46,6 +47,7 @@ fn simplify_logged(m: &MeshData, config: &Config) -> (Vec<[u32; 2]>, Vec<Tri>, S
             config,
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .unwrap()
         .record_into(&mut log);
@@ -137,7 +139,7 @@ fn levels_match(name: &str, m: &MeshData, config: Config) {
             continue;
         }
         pm.set_level(n);
-        let (out, r) = simplify(m, &config.with_target_triangles(n).with_ratio(0.0));
+        let (out, r) = simplify(m, &config.with_target(Target::Triangles(n)));
         assert_eq!(r.triangles_out, pm.triangles().len(), "{name} at {n}");
         same(
             canonical(pm.triangles(), Some(&order)),
@@ -206,6 +208,7 @@ fn a_full_log_stops_the_run_with_a_valid_mesh() {
             &Config::new().with_ratio(0.1),
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .unwrap()
         .record_into(&mut log);

@@ -4,7 +4,8 @@
 mod common;
 use common::*;
 use proptest::prelude::*;
-use tinydecimate::{Config, FeatureMode, Schedule, Workspace};
+use tinydecimate::EdgeCollapse;
+use tinydecimate::{Config, FeatureMode, Schedule, Target, Workspace};
 
 #[derive(Clone, Debug)]
 enum Kind {
@@ -101,8 +102,10 @@ proptest! {
         // ratio, or the triangle count if higher), and whether the triangles actually handed
         // back reach it: neither is read off the report it is checked against.
         let valid_in = report.triangles_in - report.degenerate_dropped - report.duplicates_dropped;
-        let by_ratio = (config.target_ratio * valid_in as f32) as usize;
-        let target = config.target_triangles.max(by_ratio);
+        let target = match config.target {
+            Target::Ratio(r) => (r * valid_in as f32) as usize,
+            Target::Triangles(n) => n,
+        };
         prop_assert_eq!(report.target_triangles, target);
         prop_assert_eq!(report.target_reached, output.triangles.len() <= target);
     }
@@ -114,7 +117,7 @@ proptest! {
         let input = build(&kind, jitter);
         let mut tris = input.triangles.clone();
         let mut ws = Workspace::<u16, 2048, 2048>::new();
-        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut tris, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut tris, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound, EdgeCollapse).unwrap();
         let mut guard = 0;
         loop {
             let before: Vec<[u32; 3]> = s.buffer().to_vec();
@@ -151,7 +154,7 @@ proptest! {
         let mut ws = Workspace::<u32, 2048, 2048>::new();
         let r1 = ws.simplify(&input.positions, &mut one, &config).unwrap();
         let mut stepped = input.triangles.clone();
-        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut stepped, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound).unwrap();
+        let mut s = ws.start(tinydecimate::Positions::Read(&input.positions), &mut stepped, &config, tinydecimate::Builtin::new(), tinydecimate::NoBound, EdgeCollapse).unwrap();
         let mut i = 0;
         while !s.step(budgets[i % budgets.len()]) {
             i += 1;

@@ -21,6 +21,7 @@ mod common;
 use std::collections::BTreeSet;
 
 use common::*;
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, Reject, Report, Schedule, RULES};
 
 /// A mesh of `tests/fixtures`.
@@ -59,6 +60,7 @@ fn step_by_step(m: &MeshData, config: &Config) -> (MeshData, Report, Steps) {
             config,
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .expect("start");
     let mut steps = Steps::default();

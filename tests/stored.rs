@@ -11,6 +11,7 @@ mod common;
 use common::{cube, fin_and_pinch, grid, icosphere, jitter, MeshData};
 use std::sync::Mutex;
 use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Capacity, Config, Error, Report, Workspace};
 
 type Ws = Workspace<u32, 8_192, 16_384>;
@@ -38,6 +39,7 @@ fn stored(m: &MeshData, config: &Config, placement: Placement) -> (MeshData, Rep
                 config,
                 tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Subset),
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run()),
         Placement::Optimal => ws
@@ -47,6 +49,7 @@ fn stored(m: &MeshData, config: &Config, placement: Placement) -> (MeshData, Rep
                 config,
                 tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run()),
     }
@@ -252,6 +255,7 @@ fn runs_are_exactly_repeatable_and_stepping_gives_the_same_bytes() {
                         &config,
                         cost,
                         tinydecimate::NoBound,
+                        EdgeCollapse,
                     )
                     .unwrap();
                 while !s.step(7) {}
@@ -265,6 +269,7 @@ fn runs_are_exactly_repeatable_and_stepping_gives_the_same_bytes() {
                         &config,
                         cost,
                         tinydecimate::NoBound,
+                        EdgeCollapse,
                     )
                     .unwrap();
                 while !s.step(7) {}
@@ -294,6 +299,7 @@ fn bad_input_is_refused_before_anything_is_written() {
                 &config,
                 tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run())
         } else {
@@ -303,6 +309,7 @@ fn bad_input_is_refused_before_anything_is_written() {
                 &config,
                 tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Subset),
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run())
         };
@@ -327,6 +334,7 @@ fn bad_input_is_refused_before_anything_is_written() {
             &config,
             tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .map(|s| s.run());
     assert_eq!(r, Err(Error::NonFinitePosition { vertex: 3 }));
@@ -341,6 +349,7 @@ fn bad_input_is_refused_before_anything_is_written() {
             &config,
             tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .map(|s| s.run());
     assert_eq!(
@@ -360,6 +369,7 @@ fn bad_input_is_refused_before_anything_is_written() {
             &config.with_ratio(2.0),
             tinydecimate::StoredQuadric::new(&mut q, tinydecimate::Placement::Optimal),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .map(|s| s.run());
     assert!(matches!(r, Err(Error::InvalidConfig { .. })));
@@ -384,6 +394,7 @@ fn feature_vertices_are_never_removed_nor_moved_while_they_are_features() {
                 &config,
                 cost,
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .unwrap();
         let (mut checked, mut moved) = (0usize, 0usize);

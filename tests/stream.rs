@@ -6,6 +6,7 @@ mod common;
 use common::*;
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder, StreamError, HEADER};
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, Progressive};
 
 struct Store {
@@ -47,6 +48,7 @@ fn collapse_log(m: &MeshData, ratio: f32) -> Vec<[u32; 2]> {
                 &Config::new().with_ratio(ratio),
                 tinydecimate::Builtin::new(),
                 tinydecimate::NoBound,
+                EdgeCollapse,
             )
             .unwrap()
             .record_into(&mut log);

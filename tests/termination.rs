@@ -11,6 +11,7 @@
 
 mod common;
 use common::*;
+use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, Schedule, Workspace};
 
 fn operations(m: &MeshData, config: &Config) -> (u64, usize, u32) {
@@ -23,6 +24,7 @@ fn operations(m: &MeshData, config: &Config) -> (u64, usize, u32) {
             config,
             tinydecimate::Builtin::new(),
             tinydecimate::NoBound,
+            EdgeCollapse,
         )
         .unwrap();
     let mut ops = 0u64;
@@ -121,6 +123,7 @@ fn stored_operations_are_bounded_by_the_mesh_size() {
                     &config,
                     cost,
                     tinydecimate::NoBound,
+                    EdgeCollapse,
                 ),
                 Placement::Optimal => ws.start(
                     tinydecimate::Positions::Write(&mut pos),
@@ -128,6 +131,7 @@ fn stored_operations_are_bounded_by_the_mesh_size() {
                     &config,
                     cost,
                     tinydecimate::NoBound,
+                    EdgeCollapse,
                 ),
             }
             .unwrap();

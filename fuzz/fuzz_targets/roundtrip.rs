@@ -9,7 +9,7 @@
 use host_sim::pm::Store;
 use libfuzzer_sys::fuzz_target;
 use tinydecimate::stream::{self, Decoder};
-use tinydecimate::{Progressive, Workspace};
+use tinydecimate::{EdgeCollapse, Progressive, Workspace};
 
 type Ws = Workspace<u32, 1024, 2048>;
 
@@ -37,6 +37,7 @@ fuzz_target!(|data: &[u8]| {
         &case.config,
         tinydecimate::Builtin::new(),
         tinydecimate::NoBound,
+        EdgeCollapse,
     ) else {
         return;
     };

@@ -6,7 +6,9 @@ use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
 use tinydecimate::cost::{NormalVariation, Quadric};
-use tinydecimate::{Config, Error, FeatureMode, Index, Report, Schedule, Stop, Workspace};
+use tinydecimate::{
+    Config, EdgeCollapse, Error, FeatureMode, Index, Report, Schedule, Stop, Target, Workspace,
+};
 use tinydecimate::{NoBound, Positions};
 
 /// The caller's index type: `u16` or `u32`, converted from the generator's `u32` by truncation
@@ -125,12 +127,11 @@ fn config(u: &mut Unstructured) -> Result<Config> {
     } else {
         Schedule::Greedy
     };
-    c.target_triangles = match u.int_in_range(0..=3u8)? {
-        0 => 0,
-        1 | 2 => u.int_in_range(0..=1200)?,
-        _ => u.arbitrary::<u64>()? as usize,
+    c.target = match u.int_in_range(0..=3u8)? {
+        0 => Target::Ratio(float(u, 0.0, 1.0)?),
+        1 | 2 => Target::Triangles(u.int_in_range(0..=1200)?),
+        _ => Target::Triangles(u.arbitrary::<u64>()? as usize),
     };
-    c.target_ratio = float(u, 0.0, 1.0)?;
     c.max_cost = match u.int_in_range(0..=3u8)? {
         0 | 1 => f32::INFINITY,
         2 => float(u, 0.0, 0.05)?,
@@ -629,21 +630,24 @@ fn stepped<L: Index, I: Idx, const V: usize, const T: usize>(
             tris,
             &case.config,
             tinydecimate::Builtin::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
         CostKind::Plane => drive!(ws.start(
             Positions::Read(&case.positions),
             tris,
             &case.config,
             Quadric::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
         CostKind::Normal => drive!(ws.start(
             Positions::Read(&case.positions),
             tris,
             &case.config,
             NormalVariation::new(),
-            NoBound
+            NoBound,
+            EdgeCollapse,
         )),
     }
 }

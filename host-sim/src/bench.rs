@@ -15,7 +15,7 @@
 //! median wall time of the simplifier call alone is reported. The result of the last repetition
 //! (every simplifier is deterministic) is checked with [`crate::check::compare`] and measured
 //! with [`crate::metro::metro`]. Scratch memory per input triangle is, for tinydecimate, the
-//! exact right-sized workspace ([`crate::simplify::workspace_bytes`]); for meshoptimizer, the
+//! exact right-sized workspace ([`crate::workspace::workspace_bytes`]); for meshoptimizer, the
 //! peak of the bytes live in its temporary allocator during the call, counted through
 //! `meshopt_setAllocator`. The output index buffer the `meshopt` wrapper allocates is not
 //! counted (tinydecimate writes its result over its input instead).
@@ -29,12 +29,9 @@
 //!
 //! A benchmark reports: nothing here asserts timings or validity.
 
-use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -44,7 +41,12 @@ use tinydecimate::{Config, CostKind, Rejections, Report};
 use crate::check::{compare, Validity};
 use crate::io::MeshData;
 use crate::metro::{metro, MetroOptions};
-use crate::simplify::workspace_bytes;
+use crate::workspace::workspace_bytes;
+use meshopt::{meshopt_simplify, meshopt_simplify_with_update};
+
+pub mod cluster;
+pub mod markdown;
+pub mod meshopt;
 
 /// The meshoptimizer version that `meshopt` [`MESHOPT_CRATE_VERSION`] bundles
 /// (`MESHOPTIMIZER_VERSION 1030` in its `vendor/src/meshoptimizer.h`).
@@ -82,7 +84,7 @@ pub fn is_real_world(mesh: &str) -> bool {
 pub const TIME_RATIOS: [f32; 2] = [0.5, 0.1];
 
 /// `../shared/meshes` beside the checkout (the default mesh directory).
-fn default_meshes() -> PathBuf {
+pub fn default_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes")
 }
 
@@ -90,41 +92,6 @@ fn default_meshes() -> PathBuf {
 /// without the shared meshes (in CI).
 pub fn fixture_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures")
-}
-
-/// `host-sim bench ...`
-#[derive(Clone, Debug, clap::Args)]
-pub struct Args {
-    /// Directory of meshes (.obj, .ply, .stl); every mesh in it runs, smallest first. Default:
-    /// `../shared/meshes` beside the checkout (with --quick: the repository's tests/fixtures).
-    #[arg(long)]
-    pub meshes: Option<PathBuf>,
-    /// Only these files of the mesh directory, comma separated (e.g. `--only cow.obj`).
-    #[arg(long, value_delimiter = ',')]
-    pub only: Option<Vec<String>>,
-    /// Target ratios, comma separated (default 0.5,0.25,0.1; with --quick 0.5,0.1).
-    #[arg(long, value_delimiter = ',')]
-    pub ratios: Option<Vec<f32>>,
-    /// Repetitions per run; the median wall time is reported (default 5; with --quick 1).
-    #[arg(long)]
-    pub reps: Option<usize>,
-    /// Markdown output (default bench/RESULTS.md; with --quick or --only none).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// JSON output (default bench/results.json; with --quick or --only none).
-    #[arg(long)]
-    pub json: Option<PathBuf>,
-    /// Smoke run for CI: only cow and plate_holes, at 0.5 and 0.1, 1 repetition, no files
-    /// written unless --out/--json are given.
-    #[arg(long)]
-    pub quick: bool,
-    /// Metro face samples per triangle of the larger mesh.
-    #[arg(long, default_value_t = 10.0)]
-    pub samples_per_triangle: f64,
-    /// Streaming vertex clustering (`tinydecimate::cluster`, quadric representative) against
-    /// meshoptimizer's `simplifySloppy` instead (table to --out only; default ratios 0.2,0.05).
-    #[arg(long)]
-    pub cluster: bool,
 }
 
 /// What one benchmark run does (the resolved [`Args`]).
@@ -142,44 +109,6 @@ pub struct Options {
     pub samples_per_triangle: f64,
     /// Show a progress bar (only if stderr is a terminal).
     pub progress: bool,
-}
-
-impl Args {
-    /// The options these arguments ask for, and the Markdown and JSON paths. A partial run
-    /// (`--quick` or `--only`) writes no file unless asked to, so it cannot overwrite the full
-    /// results by accident.
-    pub fn options(&self) -> (Options, Option<PathBuf>, Option<PathBuf>) {
-        let (meshes, only, ratios, reps) = if self.quick {
-            (
-                self.meshes.clone().unwrap_or_else(fixture_meshes),
-                Some(QUICK_MESHES.iter().map(|s| s.to_string()).collect()),
-                QUICK_RATIOS.to_vec(),
-                1,
-            )
-        } else {
-            (
-                self.meshes.clone().unwrap_or_else(default_meshes),
-                None,
-                vec![0.5, 0.25, 0.1],
-                5,
-            )
-        };
-        let opts = Options {
-            meshes,
-            only: self.only.clone().or(only),
-            ratios: self.ratios.clone().unwrap_or(ratios),
-            reps: self.reps.unwrap_or(reps),
-            samples_per_triangle: self.samples_per_triangle,
-            progress: true,
-        };
-        let partial = self.quick || self.only.is_some();
-        let default = |p: &str| (!partial).then(|| PathBuf::from(p));
-        (
-            opts,
-            self.out.clone().or_else(|| default("bench/RESULTS.md")),
-            self.json.clone().or_else(|| default("bench/results.json")),
-        )
-    }
 }
 
 /// One simplifier.
@@ -537,143 +466,10 @@ pub struct Results {
 }
 
 // ---------------------------------------------------------------------------------------------
-// meshoptimizer with counted scratch memory
-
-/// Counts the bytes meshoptimizer holds in its temporary allocator (`meshopt_setAllocator`).
-mod counted {
-    use std::alloc::{GlobalAlloc, Layout, System};
-    use std::ffi::c_void;
-    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
-    use std::sync::Once;
-
-    /// Bytes before each block holding its size (16 keeps the C++ alignment guarantee).
-    const HEADER: usize = 16;
-    static LIVE: AtomicUsize = AtomicUsize::new(0);
-    static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-    unsafe extern "C" fn allocate(size: usize) -> *mut c_void {
-        let Some(layout) = size
-            .checked_add(HEADER)
-            .and_then(|n| Layout::from_size_align(n, HEADER).ok())
-        else {
-            return std::ptr::null_mut();
-        };
-        // SAFETY: `layout` has a non-zero size.
-        let p = unsafe { System.alloc(layout) };
-        if p.is_null() {
-            return p.cast();
-        }
-        // SAFETY: the block is at least HEADER bytes and 16-aligned.
-        unsafe { p.cast::<usize>().write(size) };
-        let live = LIVE.fetch_add(size, Relaxed) + size;
-        PEAK.fetch_max(live, Relaxed);
-        // SAFETY: within the block.
-        unsafe { p.add(HEADER).cast() }
-    }
-
-    unsafe extern "C" fn deallocate(ptr: *mut c_void) {
-        if ptr.is_null() {
-            return;
-        }
-        // SAFETY: `ptr` came from `allocate`, so its block starts HEADER bytes before it, with
-        // the size written there, and was allocated with this layout.
-        unsafe {
-            let p = ptr.cast::<u8>().sub(HEADER);
-            let size = p.cast::<usize>().read();
-            LIVE.fetch_sub(size, Relaxed);
-            System.dealloc(p, Layout::from_size_align_unchecked(size + HEADER, HEADER));
-        }
-    }
-
-    /// Runs `f` (which calls meshoptimizer; the caller serialises such calls) and returns the
-    /// peak of the bytes meshoptimizer had allocated at once during it.
-    pub fn peak_during<R>(f: impl FnOnce() -> R) -> (R, usize) {
-        static INSTALL: Once = Once::new();
-        // SAFETY: done once, before any other meshopt call of this process (every one goes
-        // through here, under the caller's lock).
-        INSTALL.call_once(|| unsafe {
-            meshopt::ffi::meshopt_setAllocator(Some(allocate), Some(deallocate))
-        });
-        let base = LIVE.load(Relaxed);
-        PEAK.store(base, Relaxed);
-        let r = f();
-        (r, PEAK.load(Relaxed) - base)
-    }
-}
-
-/// meshoptimizer is not to be called concurrently while its allocator is (re)set, and the
-/// counters are global: one call at a time.
-static MESHOPT: Mutex<()> = Mutex::new(());
-
-/// `meshopt::simplify` on `mesh` down to `target_triangles`: result, wall time of the call and
-/// peak scratch bytes.
-pub fn meshopt_simplify(mesh: &MeshData, target_triangles: usize) -> (MeshData, Duration, usize) {
-    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-    let bytes = meshopt::utilities::typed_to_bytes(&mesh.positions);
-    let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<[f32; 3]>(), 0)
-        .expect("12-byte vertices");
-    let _lock = MESHOPT.lock().unwrap_or_else(|p| p.into_inner());
-    let ((out, elapsed), peak) = counted::peak_during(|| {
-        let start = Instant::now();
-        let out = meshopt::simplify(
-            &indices,
-            &adapter,
-            3 * target_triangles,
-            1.0,
-            meshopt::SimplifyOptions::None,
-            None,
-        );
-        (out, start.elapsed())
-    });
-    let triangles = out.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let result = MeshData {
-        positions: mesh.positions.clone(),
-        triangles,
-    };
-    (result, elapsed, peak)
-}
-
-/// `meshopt::simplify_with_update` (positions only, no attributes) on `mesh` down to
-/// `target_triangles`: result (with the moved positions), wall time and peak scratch bytes.
-pub fn meshopt_simplify_with_update(
-    mesh: &MeshData,
-    target_triangles: usize,
-) -> (MeshData, Duration, usize) {
-    let mut indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-    let mut positions = mesh.positions.clone();
-    let _lock = MESHOPT.lock().unwrap_or_else(|p| p.into_inner());
-    let ((n, elapsed), peak) = counted::peak_during(|| {
-        let start = Instant::now();
-        let n = meshopt::simplify_with_update(
-            &mut indices,
-            &mut positions,
-            &mut [],
-            &[],
-            0,
-            None,
-            3 * target_triangles,
-            1.0,
-            meshopt::SimplifyOptions::None,
-            None,
-        );
-        (n, start.elapsed())
-    });
-    indices.truncate(n);
-    let triangles = indices
-        .chunks_exact(3)
-        .map(|c| [c[0], c[1], c[2]])
-        .collect();
-    let result = MeshData {
-        positions,
-        triangles,
-    };
-    (result, elapsed, peak)
-}
-
-// ---------------------------------------------------------------------------------------------
 // The benchmark
 
-fn median(xs: &[f64]) -> f64 {
+/// The median of `xs` (the mean of the middle two of an even count; NaN when empty).
+pub fn median(xs: &[f64]) -> f64 {
     let mut v = xs.to_vec();
     v.sort_by(f64::total_cmp);
     match v.len() {
@@ -768,13 +564,14 @@ fn run_method(
                 let (out, report, elapsed) = crate::simplify::simplify_seams(
                     mesh,
                     &config.with_ratio(ratio),
+                    crate::simplify::OperatorArg::Edge,
                     placement,
                     false,
                     false,
                     true,
                 )?;
                 let quadrics = if placement.is_some() {
-                    v * crate::simplify::QUADRIC_BYTES
+                    v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
                 };
@@ -1034,409 +831,11 @@ pub fn summarise(rows: &[Row], ratios: &[f32]) -> Summary {
 // ---------------------------------------------------------------------------------------------
 // Output
 
-/// Time in ms with 3 significant-ish digits.
-fn fmt_ms(x: f64) -> String {
-    if x >= 100.0 {
-        format!("{x:.0}")
-    } else if x >= 10.0 {
-        format!("{x:.1}")
-    } else if x >= 1.0 {
-        format!("{x:.2}")
-    } else {
-        format!("{x:.3}")
-    }
-}
-
-/// A ratio such as `0.74x` (`—` if it is not a number).
-fn fmt_x(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x:.2}x")
-    } else if x.is_nan() {
-        "—".into()
-    } else {
-        "∞".into()
-    }
-}
-
-/// A ratio as a percentage: `50 %`.
-fn fmt_pct(r: f32) -> String {
-    format!("{} %", (r as f64 * 100.0 * 1e3).round() / 1e3)
-}
-
-/// Short names of the checker's fields in the tables (anything else by its own name).
-fn short_name(field: &str) -> String {
-    match field {
-        "new_non_manifold_edges" => "NM".into(),
-        "duplicate_triangles" => "dup".into(),
-        "degenerate_triangles" => "deg".into(),
-        "new_folded_pairs" => "fold".into(),
-        "out_of_range_triangles" => "range".into(),
-        "boundary_loops" => "loops".into(),
-        "euler" => "χ".into(),
-        "new_pinched_vertices" => "pinch".into(),
-        "new_zero_area_triangles" => "zero-area".into(),
-        "new_vertices" => "new vertices".into(),
-        "new_boundary_vertices" => "new boundary vertices".into(),
-        other => other.replace('_', " "),
-    }
-}
-
-/// The checker's verdict in one cell: `yes`, or `**NO**` and what differs: every non-zero
-/// count and every changed before/after pair of [`Validity`], read through its serialised
-/// form, so that new checks show up here without changes. The topology pairs (boundary loops,
-/// Euler characteristic) are left out when the checker says it did not compare them
-/// (`topology_compared: false`, a non-manifold input).
-pub fn verdict(v: &Validity) -> String {
-    if v.is_valid() {
-        return "yes".into();
-    }
-    let mut parts = Vec::new();
-    if let Ok(serde_json::Value::Object(map)) = serde_json::to_value(v) {
-        let compared = map
-            .get("topology_compared")
-            .and_then(serde_json::Value::as_bool)
-            .unwrap_or(true);
-        for (k, x) in &map {
-            match x {
-                serde_json::Value::Number(n) if n.as_f64() != Some(0.0) => {
-                    parts.push(format!("{} {n}", short_name(k)))
-                }
-                serde_json::Value::Array(a)
-                    if a.len() == 2
-                        && a[0] != a[1]
-                        && (compared || !matches!(k.as_str(), "boundary_loops" | "euler")) =>
-                {
-                    parts.push(format!("{} {}→{}", short_name(k), a[0], a[1]))
-                }
-                _ => {}
-            }
-        }
-    }
-    if parts.is_empty() {
-        "**NO**".into()
-    } else {
-        format!("**NO** ({})", parts.join(", "))
-    }
-}
-
-/// Mesh names in first-appearance order.
-fn mesh_names(r: &Results) -> Vec<&str> {
-    let mut names: Vec<&str> = Vec::new();
-    for row in &r.rows {
-        if !names.contains(&row.mesh.as_str()) {
-            names.push(&row.mesh);
-        }
-    }
-    names
-}
-
-/// The results as Markdown: a header, the summary, where the library stopped short, then one
-/// table per mesh.
-pub fn markdown(r: &Results) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# tinydecimate vs meshoptimizer\n");
-    let _ = writeln!(s, "Written by `host-sim bench` (host-sim/src/bench.rs).\n");
-    let _ = writeln!(s, "* Command: `{}`", r.command);
-    let _ = writeln!(
-        s,
-        "* Machine: {}; shared with other jobs, so the timings are indicative only.",
-        r.machine
-    );
-    let _ = writeln!(
-        s,
-        "* meshoptimizer {} (bundled by the `meshopt` crate {}): `meshopt::simplify`, target \
-         index count 3·⌊ratio·T⌋, target error 1.0 (no limit), default options.",
-        r.meshoptimizer_version, r.meshopt_crate_version
-    );
-    let modes: Vec<String> = Method::ALL
-        .iter()
-        .filter(|m| m.is_ours())
-        .map(|m| format!("{} = {}", m.label(), m.config_text()))
-        .collect();
-    let _ = writeln!(
-        s,
-        "* tinydecimate modes, each `.with_ratio(ratio)`: {}.",
-        modes.join("; ")
-    );
-    let ratios: Vec<String> = r.ratios.iter().map(|x| fmt_pct(*x)).collect();
-    let _ = writeln!(
-        s,
-        "* Meshes: `{}`; ratios {}; {} repetition(s) per run, each on a fresh copy of the \
-         input; Metro with {} face samples per triangle.",
-        r.meshes,
-        ratios.join(", "),
-        r.reps,
-        r.samples_per_triangle
-    );
-    let _ = writeln!(
-        s,
-        "* **Same triangle count.** When a mode of ours stops above its target (no legal \
-         collapse left, e.g. on locked non-manifold parts), meshoptimizer runs again with the \
-         triangle count we reached as its target, and that mode's error ratios (marked †) are \
-         taken against this run, not against meshoptimizer at the original target."
-    );
-
-    // Summary.
-    let time_ratios: Vec<String> = r.summary.time_ratios.iter().map(|x| fmt_pct(*x)).collect();
-    let _ = writeln!(s, "\n## Summary\n");
-    let _ = writeln!(
-        s,
-        "| mode | valid | target reached | time × mopt (geo. mean, {}) | scratch B/tri |",
-        time_ratios.join(" & ")
-    );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|");
-    for m in &r.summary.modes {
-        let (lo, hi) = m.scratch_bytes_per_triangle;
-        let bpt = if (hi - lo).abs() < 0.05 {
-            format!("{hi:.1}")
-        } else {
-            format!("{lo:.1}-{hi:.1}")
-        };
-        let _ = writeln!(
-            s,
-            "| {} | {}/{} | {}/{} | {} | {bpt} |",
-            m.method.label(),
-            m.valid,
-            m.runs,
-            m.target_reached,
-            m.runs,
-            fmt_x(m.time_vs_meshopt_geomean),
-        );
-    }
-    if r.summary.same_count_runs > 0 {
-        let _ = writeln!(
-            s,
-            "| meshoptimizer at our reached counts | {}/{} | | | |",
-            r.summary.same_count_valid, r.summary.same_count_runs
-        );
-    }
-    let messy: Vec<&str> = MESSY_MESHES
-        .iter()
-        .map(|m| m.trim_end_matches(".obj"))
-        .collect();
-    let real: Vec<&str> = REAL_WORLD_MESHES
-        .iter()
-        .map(|m| m.trim_end_matches(".obj"))
-        .collect();
-    let _ = writeln!(
-        s,
-        "\nWorst error ratio vs meshoptimizer over the meshes, per mode and ratio, and the mesh \
-         it is on; † at the same triangle count (the mode stopped short there). Clean meshes: \
-         all but the messy multi-part ones ({}) and the real-world ones ({}); the targets are \
-         ≤ 0.8x mean and ≤ 1.0x max of the default there (paper passes: ≤ 2.0x mean), ≤ 1.5x \
-         at the same count on the messy ones and ≤ 1.0x on the real-world ones.\n",
-        messy.join(", "),
-        real.join(", ")
-    );
-    let _ = writeln!(
-        s,
-        "| mode | ratio | mean × mopt, clean | max × mopt, clean | mean × mopt, messy | max × mopt, messy | mean × mopt, real-world | max × mopt, real-world |"
-    );
-    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|");
-    let cell = |x: f64, dag: bool, mesh: &str| {
-        format!(
-            "{}{} ({})",
-            fmt_x(x),
-            if dag { "†" } else { "" },
-            mesh.trim_end_matches(".obj")
-        )
-    };
-    for m in &r.summary.modes {
-        for w in &m.worst {
-            let pair = |p: &Option<WorstPair>| match p {
-                Some(p) => (
-                    cell(p.mean_vs_meshopt, p.mean_same_count, &p.mean_mesh),
-                    cell(p.max_vs_meshopt, p.max_same_count, &p.max_mesh),
-                ),
-                None => ("—".into(), "—".into()),
-            };
-            let (cm, cx) = pair(&w.clean);
-            let (mm, mx) = pair(&w.messy);
-            let (rm, rx) = pair(&w.real_world);
-            let _ = writeln!(
-                s,
-                "| {} | {} | {cm} | {cx} | {mm} | {mx} | {rm} | {rx} |",
-                m.method.label(),
-                fmt_pct(w.ratio),
-            );
-        }
-    }
-    let invalid: Vec<String> = r
-        .rows
-        .iter()
-        .filter(|x| !x.valid)
-        .map(|x| format!("{} {} @ {}", x.method.label(), x.mesh, fmt_pct(x.ratio)))
-        .collect();
-    if !invalid.is_empty() {
-        let _ = writeln!(s, "\nInvalid results: {}.", invalid.join("; "));
-    }
-
-    // Where the library stopped short.
-    let short: Vec<&Row> = r.rows.iter().filter(|x| x.same_count.is_some()).collect();
-    let _ = writeln!(s, "\n## Stopped short\n");
-    if short.is_empty() {
-        let _ = writeln!(s, "Every mode reached every target.");
-    } else {
-        let _ = writeln!(
-            s,
-            "Runs of ours that stopped above the target, why (the report's `stop`, locked \
-             vertices and refused candidates by reason, counted once per evaluation), and \
-             meshoptimizer at the count we reached.\n"
-        );
-        let _ = writeln!(
-            s,
-            "| mesh | ratio | mode | target | reached | stop | locked vertices | rejected | \
-             mopt tris | mean % | mopt mean % | × | max % | mopt max % | × | mopt valid |"
-        );
-        let _ = writeln!(
-            s,
-            "|---|---:|---|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|"
-        );
-        for x in short {
-            let (Some(c), Some(rep)) = (&x.same_count, &x.report) else {
-                continue;
-            };
-            let _ = writeln!(
-                s,
-                "| {} | {} | {} | {} | {} ({:.1} %) | {} | {} | {} | {} | {:.4} | {:.4} | {} | \
-                 {:.3} | {:.3} | {} | {} |",
-                x.mesh,
-                fmt_pct(x.ratio),
-                x.method.label(),
-                x.target_triangles,
-                x.triangles_out,
-                100.0 * x.triangles_out as f64 / x.triangles_in.max(1) as f64,
-                rep.stop,
-                rep.locked_vertices,
-                rep.rejected.text(),
-                c.triangles_out,
-                x.metro_mean_pct,
-                c.metro_mean_pct,
-                fmt_x(c.mean_vs_meshopt),
-                x.metro_max_pct,
-                c.metro_max_pct,
-                fmt_x(c.max_vs_meshopt),
-                verdict(&c.validity),
-            );
-        }
-    }
-
-    // Per mesh.
-    let _ = writeln!(
-        s,
-        "\nPer mesh: **tris** triangles reached (target ⌊ratio·T⌋; *short* if above it); **ms** \
-         median wall time of the simplifier call, **× mopt** over meshoptimizer's; **B/tri** \
-         scratch bytes per input triangle (tinydecimate: exact right-sized `Workspace`, from \
-         `Workspace::BYTES`; meshoptimizer: peak of its temporary allocations, counted with \
-         `meshopt_setAllocator`, output index buffer not counted); **mean %** / **max %** \
-         Metro symmetric mean and Hausdorff distance in % of the input's bbox diagonal, each \
-         followed by its ratio to meshoptimizer's († at the same triangle count: see the \
-         *meshoptimizer at N* row below it); **valid** the shared checker's verdict \
-         (`host-sim check`; NM new non-manifold edges, dup duplicate and deg degenerate \
-         triangles, fold new folded pairs, loops boundary loops and χ Euler characteristic \
-         before→after); **stop** the library's `Report::stop`."
-    );
-    for name in mesh_names(r) {
-        let rows: Vec<&Row> = r.rows.iter().filter(|x| x.mesh == name).collect();
-        let _ = writeln!(
-            s,
-            "\n## {name} (V = {}, T = {})\n",
-            rows[0].vertices, rows[0].triangles_in
-        );
-        let _ = writeln!(
-            s,
-            "| ratio | mode | tris | ms | × mopt | B/tri | mean % | × mopt | max % | × mopt | valid | stop |"
-        );
-        let _ = writeln!(
-            s,
-            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---|"
-        );
-        for x in rows {
-            let dag = if x.same_count.is_some() { "†" } else { "" };
-            let _ = writeln!(
-                s,
-                "| {} | {} | {}{} | {} | {} | {:.1} | {:.4} | {}{dag} | {:.3} | {}{dag} | {} | {} |",
-                fmt_pct(x.ratio),
-                x.method.label(),
-                x.triangles_out,
-                if x.target_reached {
-                    String::new()
-                } else {
-                    format!(" (short; target {})", x.target_triangles)
-                },
-                fmt_ms(x.median_ms),
-                fmt_x(x.time_vs_meshopt),
-                x.scratch_bytes_per_triangle,
-                x.metro_mean_pct,
-                fmt_x(x.fair_mean_vs_meshopt()),
-                x.metro_max_pct,
-                fmt_x(x.fair_max_vs_meshopt()),
-                verdict(&x.validity),
-                x.stop.as_deref().unwrap_or("—"),
-            );
-            if let Some(c) = &x.same_count {
-                let _ = writeln!(
-                    s,
-                    "| {} | meshoptimizer at {} | {} | {} | | | {:.4} | | {:.3} | | {} | same count as {} |",
-                    fmt_pct(x.ratio),
-                    c.target_triangles,
-                    c.triangles_out,
-                    fmt_ms(c.median_ms),
-                    c.metro_mean_pct,
-                    c.metro_max_pct,
-                    verdict(&c.validity),
-                    x.method.label(),
-                );
-            }
-        }
-    }
-    s
-}
-
-fn write_file(path: &Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create", dir.display()))?;
-    }
-    std::fs::write(path, text).with_context(|| format!("{}: cannot write", path.display()))
-}
-
-/// The command line as typed, with the program shown as `host-sim`.
-fn command_line() -> String {
-    let mut args: Vec<String> = std::env::args().collect();
-    if let Some(a) = args.first_mut() {
-        *a = "host-sim".into();
-    }
-    args.join(" ")
-}
-
-/// `host-sim bench`. Always exit code 0 when it ran: a benchmark reports, it does not judge.
-pub fn run(args: &Args) -> Result<ExitCode> {
-    if args.cluster {
-        let (mut opts, _, _) = args.options();
-        if args.ratios.is_none() {
-            opts.ratios = vec![0.2, 0.05];
-        }
-        return crate::cluster::bench_run(&opts, args.out.as_deref());
-    }
-    let (opts, out, json) = args.options();
-    let results = bench(&opts, &command_line())?;
-    let md = markdown(&results);
-    crate::out!("{md}");
-    if let Some(p) = &out {
-        write_file(p, &md)?;
-        eprintln!("wrote {}", p.display());
-    }
-    if let Some(p) = &json {
-        write_file(p, &(serde_json::to_string_pretty(&results)? + "\n"))?;
-        eprintln!("wrote {}", p.display());
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::markdown::{markdown, verdict};
     use super::*;
+    use crate::cmd::bench::Args;
     use clap::Parser;
 
     #[derive(Parser)]

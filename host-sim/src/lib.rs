@@ -48,22 +48,30 @@ pub fn exit_code_for_io(e: &std::io::Error) -> i32 {
     }
 }
 
+pub mod backend;
 pub mod bench;
-pub mod boundtable;
 pub mod check;
 pub mod cluster;
-pub mod demo;
-pub mod gltf;
+pub mod cmd;
 pub mod golden;
 pub mod io;
 pub mod metro;
-pub mod objattr;
-pub mod plyattr;
 pub mod pm;
 pub mod progress;
 pub mod qemu;
-pub mod qemu_cluster;
 pub mod render;
 pub mod simplify;
-pub mod streamcase;
-pub mod textured;
+pub mod texrender;
+pub mod uvstretch;
+pub mod workspace;
+
+/// The repository root (the parent of host-sim).
+pub fn repo_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host-sim lives inside the repository")
+        .to_path_buf()
+}
+
+/// The glTF reader and writer (`io::gltf`), also at the crate's root.
+pub use io::gltf;

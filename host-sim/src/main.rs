@@ -7,8 +7,8 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::{
-    bench, boundtable, check, cluster, demo, golden, metro, pm, qemu, render, simplify,
+use host_sim::cmd::{
+    bench, bound_table, check, cluster, demo, golden, metro, pm, qemu, render, run_elf, simplify,
 };
 
 #[derive(Parser)]
@@ -47,10 +47,10 @@ enum Command {
     Pm(pm::Args),
     /// The error-bound figures: triangles under a guaranteed bound (control points, Zhu, Wang and Meng 2007)
     /// next to meshoptimizer at the same target_error, with E_max, E_mean and Metro.
-    BoundTable(boundtable::Args),
+    BoundTable(bound_table::Args),
     /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
     /// examples/cortex-m4f (`cargo run --example … --target thumbv7em-none-eabihf`).
-    RunElf(qemu::RunElfArgs),
+    RunElf(run_elf::Args),
 }
 
 fn main() -> ExitCode {
@@ -66,8 +66,8 @@ fn main() -> ExitCode {
         Command::Golden(a) => golden::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Pm(a) => pm::run(a),
-        Command::RunElf(a) => qemu::run_elf(a),
-        Command::BoundTable(a) => boundtable::run(a),
+        Command::RunElf(a) => run_elf::run(a),
+        Command::BoundTable(a) => bound_table::run(a),
     };
     result.unwrap_or_else(|e| {
         // A reader that closed the pipe early wants no more: end quietly, as `out!` does.

@@ -102,8 +102,13 @@ impl View {
         }
     }
 
+    /// Direction towards the light (unit length).
+    pub fn light(&self) -> V3 {
+        self.light
+    }
+
     /// Pixel coordinates (x right, y down) and depth (larger is farther) of a point.
-    fn project(&self, p: V3) -> V3 {
+    pub fn project(&self, p: V3) -> V3 {
         let d = [0, 1, 2].map(|k| p[k] - self.centre[k]);
         let half = f64::from(SIZE) / 2.0;
         [
@@ -274,26 +279,11 @@ pub fn render_compare(original: &MeshData, simplified: &MeshData) -> (RgbImage, 
     (out, top)
 }
 
-/// `host-sim render MESH OUT.png [--compare ORIGINAL]`
-#[derive(Clone, Debug, clap::Args)]
-pub struct Args {
-    /// The mesh to draw.
-    pub mesh: std::path::PathBuf,
-    /// Output PNG.
-    pub out: std::path::PathBuf,
-    /// Draw original | MESH | MESH coloured by its distance to ORIGINAL, side by side.
-    #[arg(long, value_name = "ORIGINAL")]
-    pub compare: Option<std::path::PathBuf>,
-}
-
-/// `host-sim render`.
-pub fn run(args: &Args) -> Result<std::process::ExitCode> {
-    draw(&args.mesh, &args.out, args.compare.as_deref())?;
-    Ok(std::process::ExitCode::SUCCESS)
-}
-
 /// Draws `mesh` (or the comparison with `compare`) into the PNG file `out`.
 pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
+    if crate::gltf::is_gltf_path(mesh) {
+        return crate::texrender::draw(mesh, out, compare);
+    }
     let m = crate::io::load_noting(mesh)?;
     let img = match compare {
         None => render(&m, &View::fit(&m)),

@@ -511,14 +511,7 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &mut [[I; 3]],
         scratch: Scratch<'_, CELLS>,
     ) -> Result<ClusterReport, ClusterError> {
-        let Scratch {
-            quadrics,
-            seen,
-            cache,
-            keys,
-            ..
-        } = scratch;
-        self.cluster_into(source, quadrics, config, out, None, seen, cache, keys)
+        self.cluster_into(source, config, out, scratch, None)
             .map(|(r, _)| r)
     }
 
@@ -534,30 +527,30 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         out: &mut [[I; 3]],
         vertices: &mut [u32],
     ) -> Result<(ClusterReport, usize), ClusterError> {
-        self.cluster_into(
-            source,
+        let scratch = Scratch {
             quadrics,
-            config,
-            out,
-            Some(vertices),
-            &mut [],
-            &mut [],
-            &mut [],
-        )
+            ..Scratch::new()
+        };
+        self.cluster_into(source, config, out, scratch, Some(vertices))
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// [`Clusterer::cluster`], with the compacted vertex numbers written to `vertices` if
+    /// given (then the second value is their count).
     fn cluster_into<S: Source, I: Index>(
         &mut self,
         source: &mut S,
-        quadrics: Option<&mut Quadrics<CELLS>>,
         config: &ClusterConfig,
         out: &mut [[I; 3]],
-        vertices: Option<&mut [u32]>,
-        seen: &mut [u32],
-        cache: &mut [u64],
-        keys: &mut [[u32; KEY_LANES]],
+        scratch: Scratch<'_, CELLS>,
+        mut vertices: Option<&mut [u32]>,
     ) -> Result<(ClusterReport, usize), ClusterError> {
+        let Scratch {
+            quadrics,
+            seen,
+            cache,
+            keys,
+            ..
+        } = scratch;
         // Quantised coordinates depend only on the bounding box, the same for every grid of
         // this run: the cache is filled once (from the first counting or clustering pass).
         for e in cache.iter_mut() {
@@ -570,32 +563,8 @@ impl<const CELLS: usize> Clusterer<CELLS> {
         for w in seen.iter_mut() {
             *w = 0;
         }
-        let mut passes = 0u32;
-        let (min, max, top) = match config.bbox {
-            Some(b) => (b.0, b.1, None),
-            None => {
-                passes += 1;
-                let (lo, hi, top) = bbox(source, seen, cache)?;
-                (lo, hi, Some(top))
-            }
-        };
-        let mut target = 0;
-        let grid = match config.grid {
-            GridChoice::CellSize(c) => Grid::with_cell_size(min, max, c)?,
-            GridChoice::Resolution(n) => Grid::with_resolution(min, max, n)?,
-            GridChoice::TargetTriangles(t) => {
-                target = t;
-                let (g, p) =
-                    Self::search(source, min, max, t, config.refine_passes, cache, keys, top)?;
-                passes += p;
-                g
-            }
-        };
-        if passes > 0 && !source.rewind() {
-            return Err(ClusterError::NotRereadable);
-        }
+        let (grid, target, mut passes) = Self::choose_grid(source, config, seen, cache, keys)?;
         let mut quad = quadrics.map(|q| &mut q.q[..]);
-        let mut vertices = vertices;
         // A target bounds the output (the counts bound it from above) and, loosely, the cells:
         // use a prefix of the table and of the buffer, and all of them if that fills.
         let (mut ac, mut ao) = if target > 0 {
@@ -633,41 +602,91 @@ impl<const CELLS: usize> Clusterer<CELLS> {
                 continue;
             }
             pass.check_full(Some(total))?;
-            if pass.quad.is_some() {
-                if !source.rewind() {
-                    return Err(ClusterError::NotRereadable);
-                }
-                pass.choose = true;
-                if !pass.cache.is_empty() && !pass.beyond {
-                    // Every vertex used is in the cache: no stream needed.
-                    choose_by_vertex(&mut pass, source)?;
-                } else if seen.is_empty() && pass.cache.is_empty() {
-                    pass.read = 0;
-                    run(&mut pass, source)?;
-                    // `collapsed` was counted twice.
-                    pass.collapsed /= 2;
-                } else {
-                    pass.read = 0;
-                    choose_once(&mut pass, source, seen)?;
-                }
-                passes += 1;
-            }
-            if config.cleanup {
-                if pass.quad.is_some() {
-                    if !source.rewind() {
-                        return Err(ClusterError::NotRereadable);
-                    }
-                    cell_normals(&mut pass, source)?;
-                    passes += 1;
-                }
-                pass.cleanup(source);
-            }
+            passes += after_first_pass(&mut pass, source, config, seen)?;
             return match vertices.as_deref_mut() {
                 Some(v) => finish_compact(&mut pass, passes, target, v),
                 None => finish_report(&mut pass, passes, target).map(|r| (r, 0)),
             };
         }
     }
+
+    /// The grid of a run: the bounding box (read from `source` unless the configuration gives
+    /// it), then the grid the configuration names or the search for its target. Returns the
+    /// grid, the target (0: none) and the passes read so far; `source` is rewound if any was.
+    fn choose_grid<S: Source>(
+        source: &mut S,
+        config: &ClusterConfig,
+        seen: &mut [u32],
+        cache: &mut [u64],
+        keys: &mut [[u32; KEY_LANES]],
+    ) -> Result<(Grid, usize, u32), ClusterError> {
+        let mut passes = 0u32;
+        let (min, max, top) = match config.bbox {
+            Some(b) => (b.0, b.1, None),
+            None => {
+                passes += 1;
+                let (lo, hi, top) = bbox(source, seen, cache)?;
+                (lo, hi, Some(top))
+            }
+        };
+        let mut target = 0;
+        let grid = match config.grid {
+            GridChoice::CellSize(c) => Grid::with_cell_size(min, max, c)?,
+            GridChoice::Resolution(n) => Grid::with_resolution(min, max, n)?,
+            GridChoice::TargetTriangles(t) => {
+                target = t;
+                let (g, p) =
+                    Self::search(source, min, max, t, config.refine_passes, cache, keys, top)?;
+                passes += p;
+                g
+            }
+        };
+        if passes > 0 && !source.rewind() {
+            return Err(ClusterError::NotRereadable);
+        }
+        Ok((grid, target, passes))
+    }
+}
+
+/// The passes after the first of a run: choosing the quadric representatives (with
+/// [`Quadrics`]), then the cleanup (if configured). Returns how many passes read the stream.
+fn after_first_pass<S: Source, I: Index>(
+    pass: &mut Pass<'_, I>,
+    source: &mut S,
+    config: &ClusterConfig,
+    seen: &mut [u32],
+) -> Result<u32, ClusterError> {
+    let mut passes = 0;
+    if pass.quad.is_some() {
+        if !source.rewind() {
+            return Err(ClusterError::NotRereadable);
+        }
+        pass.choose = true;
+        if !pass.cache.is_empty() && !pass.beyond {
+            // Every vertex used is in the cache: no stream needed.
+            choose_by_vertex(pass, source)?;
+        } else if seen.is_empty() && pass.cache.is_empty() {
+            pass.read = 0;
+            run(pass, source)?;
+            // `collapsed` was counted twice.
+            pass.collapsed /= 2;
+        } else {
+            pass.read = 0;
+            choose_once(pass, source, seen)?;
+        }
+        passes += 1;
+    }
+    if config.cleanup {
+        if pass.quad.is_some() {
+            if !source.rewind() {
+                return Err(ClusterError::NotRereadable);
+            }
+            cell_normals(pass, source)?;
+            passes += 1;
+        }
+        pass.cleanup(source);
+    }
+    Ok(passes)
 }
 
 #[cfg(test)]

@@ -90,24 +90,8 @@ pub(super) fn count<S: Source>(
     // triangles, as every pass assumes).
     let mut complete = top.is_some_and(|t| (t as usize) < cache.len().min(keys.len()));
     if let Some(g0) = &g0 {
-        for (v, (e, k)) in cache.iter_mut().zip(keys.iter_mut()).enumerate() {
-            if *e == NO_Q - 1 {
-                // Marked by the bounding-box pass, which checked its position. A source
-                // that now answers otherwise is left to the per-corner path (the same
-                // error, in stream order).
-                match source.position(v) {
-                    Some(p) if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() => {
-                        *e = pack_q(g0.quantise(p));
-                    }
-                    _ => {
-                        complete = false;
-                        continue;
-                    }
-                }
-            }
-            if *e >> 63 == 0 {
-                *k = entry(unpack_q(*e));
-            }
+        if !key_cached(source, g0, cache, keys, &entry) {
+            complete = false;
         }
     }
     let mut buf = [[0u32; 3]; CHUNK];
@@ -138,34 +122,7 @@ pub(super) fn count<S: Source>(
                     continue;
                 }
             }
-            let current = |keys: &[[u32; KEY_LANES]], v: u32| {
-                keys.get(v as usize)
-                    .filter(|k| k.get(STAMP) == Some(&stamp))
-                    .copied()
-            };
-            let k = match (
-                current(keys, t[0]),
-                current(keys, t[1]),
-                current(keys, t[2]),
-            ) {
-                (Some(a), Some(b), Some(c)) => [a, b, c],
-                _ => {
-                    let mut k = [[0u32; KEY_LANES]; 3];
-                    for (kc, &v) in k.iter_mut().zip(t) {
-                        if let Some(e) = current(keys, v) {
-                            *kc = e;
-                            continue;
-                        }
-                        let mut pos = SourcePositions(&mut *source);
-                        let q = quantised(cache, &mut pos, g0, v, index)?;
-                        *kc = entry(q);
-                        if let Some(e) = keys.get_mut(v as usize) {
-                            *e = *kc;
-                        }
-                    }
-                    k
-                }
-            };
+            let k = corner_keys(source, g0, cache, keys, *t, index, stamp, &entry)?;
             index += 1;
             let [a, b, c] = k;
             for i in 0..KEY_LANES {
@@ -178,6 +135,83 @@ pub(super) fn count<S: Source>(
         }
     }
     Ok(counts)
+}
+
+/// [`count`]'s key entries of every vertex the bounding-box pass marked in the cache, before
+/// the stream is read; `false` if a source now answers otherwise for one of them.
+fn key_cached<S: Source>(
+    source: &mut S,
+    g0: &Grid,
+    cache: &mut [u64],
+    keys: &mut [[u32; KEY_LANES]],
+    entry: &impl Fn([u32; 3]) -> [u32; KEY_LANES],
+) -> bool {
+    let mut complete = true;
+    for (v, (e, k)) in cache.iter_mut().zip(keys.iter_mut()).enumerate() {
+        if *e == NO_Q - 1 {
+            // Marked by the bounding-box pass, which checked its position. A source
+            // that now answers otherwise is left to the per-corner path (the same
+            // error, in stream order).
+            match source.position(v) {
+                Some(p) if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() => {
+                    *e = pack_q(g0.quantise(p));
+                }
+                _ => {
+                    complete = false;
+                    continue;
+                }
+            }
+        }
+        if *e >> 63 == 0 {
+            *k = entry(unpack_q(*e));
+        }
+    }
+    complete
+}
+
+/// The key entries of triangle `t`'s corners for counting pass `stamp`: the current ones, and
+/// for a corner without one, computed from its (cached or read) position and stored.
+#[allow(clippy::too_many_arguments)]
+fn corner_keys<S: Source>(
+    source: &mut S,
+    g0: &Grid,
+    cache: &mut [u64],
+    keys: &mut [[u32; KEY_LANES]],
+    t: [u32; 3],
+    index: usize,
+    stamp: u32,
+    entry: &impl Fn([u32; 3]) -> [u32; KEY_LANES],
+) -> Result<[[u32; KEY_LANES]; 3], ClusterError> {
+    let current = |keys: &[[u32; KEY_LANES]], v: u32| {
+        keys.get(v as usize)
+            .filter(|k| k.get(STAMP) == Some(&stamp))
+            .copied()
+    };
+    Ok(
+        match (
+            current(keys, t[0]),
+            current(keys, t[1]),
+            current(keys, t[2]),
+        ) {
+            (Some(a), Some(b), Some(c)) => [a, b, c],
+            _ => {
+                let mut k = [[0u32; KEY_LANES]; 3];
+                for (kc, &v) in k.iter_mut().zip(&t) {
+                    if let Some(e) = current(keys, v) {
+                        *kc = e;
+                        continue;
+                    }
+                    let mut pos = SourcePositions(&mut *source);
+                    let q = quantised(cache, &mut pos, g0, v, index)?;
+                    *kc = entry(q);
+                    if let Some(e) = keys.get_mut(v as usize) {
+                        *e = *kc;
+                    }
+                }
+                k
+            }
+        },
+    )
 }
 
 /// [`count`] without key entries: each corner quantised (or read from the cache) and its

@@ -27,8 +27,8 @@ impl core::fmt::Display for ThenCollapseError {
 /// `scratch.positions.len()` triangles; the grid is searched as for
 /// [`GridChoice::TargetTriangles`] unless `cluster_config` fixes it), copies the surviving
 /// vertices' positions into `scratch.positions` (RAM: 12 bytes per vertex), then runs the
-/// collapse engine with `config` (give it an absolute target with
-/// [`Config::with_target_triangles`](crate::Config::with_target_triangles)). On success the
+/// collapse engine with `config` (give it an absolute target,
+/// [`Target::Triangles`](crate::Target::Triangles)). On success the
 /// first `collapse.triangles_out` entries of `out` hold the result **in input vertex
 /// numbers**. A small device thus gets collapse quality from a mesh it could never hold.
 pub fn cluster_then_collapse<S: Source, I: Index, L: Index, const CELLS: usize>(

@@ -7,18 +7,18 @@ use super::{Phase, Simplifier};
 use crate::index::Index;
 use crate::math::V3;
 use crate::mesh::{flag, next3, prev3, NIL};
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::feature::Variation;
 use crate::policy::legality::on;
 use crate::report::Stop;
-use crate::Operator;
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// Greedy: re-classify `v` against the round's threshold and re-key it: the cheapest
     /// price among its candidates (a lower bound of its cheapest legal collapse).
     pub(super) fn rekey(&mut self, v: usize) {
-        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
+        if O::TRIANGLE {
             return self.rekey_triangles(v);
         }
         let f = self.mesh.flags(v);
@@ -85,7 +85,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
 
     /// Greedy: one pop of the queue.
     pub(super) fn pop(&mut self) {
-        if cfg!(feature = "triangle") && self.config.operator == Operator::Triangle {
+        if O::TRIANGLE {
             return self.pop_triangles();
         }
         let Some((v, key)) = self.top() else {
@@ -238,9 +238,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
 mod tests {
     use super::*;
     use crate::policy::cost::{Placement, StoredQuadric, VertexQuadric};
-    use crate::{Config, NoBound, Positions, Workspace};
+    use crate::{Config, EdgeCollapse, NoBound, Positions, Workspace};
 
-    impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+    impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
         /// The queue's promise: every queued key is at most its vertex's cheapest price now,
         /// or for a vertex raised past a refused candidate ([`flag::RAISED`]) at most its
         /// cheapest price the rules allow now. The first vertex that breaks it, with its key
@@ -312,7 +312,14 @@ mod tests {
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
         let cost = StoredQuadric::new(&mut q, Placement::Subset);
-        audit(ws.start(Positions::Read(&p), &mut t, &config, cost, NoBound)?);
+        audit(ws.start(
+            Positions::Read(&p),
+            &mut t,
+            &config,
+            cost,
+            NoBound,
+            EdgeCollapse,
+        )?);
         Ok(())
     }
 
@@ -327,7 +334,14 @@ mod tests {
         let mut ws = Workspace::<u16, 121, 200>::new();
         let config = Config::stored().with_ratio(0.1);
         let cost = StoredQuadric::new(&mut q, Placement::Optimal);
-        audit(ws.start(Positions::Write(&mut p), &mut t, &config, cost, NoBound)?);
+        audit(ws.start(
+            Positions::Write(&mut p),
+            &mut t,
+            &config,
+            cost,
+            NoBound,
+            EdgeCollapse,
+        )?);
         Ok(())
     }
 

@@ -2,11 +2,12 @@
 
 use super::Simplifier;
 use crate::index::Index;
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::report::Stop;
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// Welded seams ([`crate::seam`]): `wedges` holds each triangle's corners as the caller's
     /// vertices (filled by [`seam::weld`](crate::seam::weld), which also renumbered the
     /// triangles given to the run to one vertex per position). Call it before the first step.

@@ -26,9 +26,12 @@
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 
+use core::marker::PhantomData;
+
 use crate::index::Index;
 use crate::math::V3;
 use crate::mesh::{flag, Mesh, NIL};
+use crate::operator::{EdgeCollapse, Operator};
 use crate::policy::bound::{Bound, NoBound};
 use crate::policy::cost::Cost;
 use crate::policy::feature::Mean;
@@ -43,7 +46,7 @@ mod log;
 mod passes;
 mod price;
 mod report;
-pub mod triangle;
+mod triangle;
 mod walk;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,8 +74,16 @@ enum Phase {
 /// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
 ///
 /// `B` is the error bound: [`NoBound`] (none, the default) or
-/// [`Controls`](crate::bound::Controls).
-pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound> {
+/// [`Controls`](crate::bound::Controls). `O` is the operator: [`EdgeCollapse`] (the default)
+/// or [`TriangleCollapse`](crate::TriangleCollapse).
+pub struct Simplifier<
+    'a,
+    L: Index,
+    I: Index,
+    C: Cost,
+    B: Bound<'a, I> = NoBound,
+    O: Operator = EdgeCollapse,
+> {
     mesh: Mesh<'a, L, I>,
     heap: Heap<'a, L>,
     config: Config,
@@ -108,9 +119,11 @@ pub struct Simplifier<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I> = NoBound
     initialised: bool,
     /// The error bound (control points), if any.
     bound: B,
+    /// The operator (a type: no state).
+    operator: PhantomData<O>,
 }
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     #[inline(always)]
     pub(crate) fn new(
         mesh: Mesh<'a, L, I>,
@@ -118,14 +131,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
         config: Config,
         cost: C,
         bound: B,
+        _operator: O,
     ) -> Self {
-        // In f32, exact for counts below 2^24; the product is floored.
-        let by_ratio = (config.target_ratio * mesh.valid_in as f32) as usize;
-        let target = if config.target_triangles > by_ratio {
-            config.target_triangles
-        } else {
-            by_ratio
-        };
+        let target = config.target.triangles(mesh.valid_in);
         let (mut locked, mut used_in) = (0, 0);
         for v in 0..mesh.vertex_count() {
             locked += mesh.has(v, flag::LOCKED) as usize;
@@ -159,6 +167,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B
             logged: 0,
             initialised: false,
             bound,
+            operator: PhantomData,
         };
         if B::ON {
             s.enrol();

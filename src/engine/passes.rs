@@ -5,12 +5,13 @@ use super::walk::MAX_CANDIDATES;
 use super::{Phase, Simplifier};
 use crate::index::Index;
 use crate::mesh::{flag, NIL};
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::legality::on;
 use crate::report::Stop;
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// Passes: try to pair the vertex under the cursor (Lin 2007 Algorithm 3), or end the pass.
     pub(super) fn pair(&mut self) {
         if self.mesh.live <= self.target {

@@ -6,11 +6,12 @@ use super::Simplifier;
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::mesh::{flag, NIL};
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::{Cost, Move};
 use crate::policy::legality::{self, on};
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// The legality rules for `from -> to` (at `at` if the cost places the kept vertex), then
     /// the error bound's veto.
     #[inline(always)]

@@ -3,11 +3,12 @@
 use super::{Phase, Simplifier};
 use crate::index::Index;
 use crate::mesh::NIL;
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::report::{Report, Stop};
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// The report so far (`stop` is [`Stop::Running`] until the run is finished).
     pub fn report(&self) -> Report {
         let stop = match self.phase {

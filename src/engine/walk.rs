@@ -6,6 +6,7 @@ use super::Simplifier;
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::mesh::{flag, next3, prev3, NIL};
+use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::feature::Variation;
@@ -43,7 +44,7 @@ impl<F> FanSummary<F> {
     }
 }
 
-impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>> Simplifier<'a, L, I, C, B> {
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     /// Whether walks compute the fan's normals and areas: the cost or the feature rule reads
     /// them.
     pub(super) fn normals(&self) -> bool {

@@ -447,13 +447,13 @@ fn run_stored<I: tinydecimate::Index>(
     placement: tinydecimate::Placement,
     quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    use tinydecimate::{NoBound, Placement, Positions, StoredQuadric};
+    use tinydecimate::{EdgeCollapse, NoBound, Placement, Positions, StoredQuadric};
     let p = match placement {
         Placement::Subset => Positions::Read(positions),
         Placement::Optimal => Positions::Write(positions),
     };
     let cost = StoredQuadric::new(quadrics, placement);
-    Ok(ws.start(p, triangles, config, cost, NoBound)?.run())
+    Ok(ws.start(p, triangles, config, cost, NoBound, EdgeCollapse)?.run())
 }
 
 /// A bounded case (`Controls`). Never inlined: its locals would deepen
@@ -489,7 +489,7 @@ fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
         tinydecimate::Controls::new(orig, controls),
     );
     let cost = tinydecimate::Builtin::new();
-    Ok(ws.start(p, triangles, config, cost, bound)?.run())
+    Ok(ws.start(p, triangles, config, cost, bound, tinydecimate::EdgeCollapse)?.run())
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).

@@ -15,8 +15,8 @@
 //! |      7 | u8      | schedule: 0 = greedy, 1 = passes                             |
 //! |      8 | u32     | vertex count V                                               |
 //! |     12 | u32     | triangle count T                                             |
-//! |     16 | f32     | target ratio                                                 |
-//! |     20 | u32     | target triangle count (0: ratio only)                        |
+//! |     16 | f32     | target ratio (used when the count is 0)                      |
+//! |     20 | u32     | target triangle count (nonzero: the target; 0: the ratio)    |
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
@@ -629,7 +629,7 @@ pub mod pm;
 #[cfg(feature = "tinydecimate")]
 pub mod lib {
     use super::*;
-    use tinydecimate::{Config, CostKind, Error, FeatureMode, Report, Schedule, Stop};
+    use tinydecimate::{Config, CostKind, Error, FeatureMode, Report, Schedule, Stop, Target};
 
     // Every rule has its slot in a result file.
     const _: () = assert!(tinydecimate::RULES.len() <= REJECTION_SLOTS);
@@ -641,8 +641,7 @@ pub mod lib {
                 ScheduleCode::Greedy => Schedule::Greedy,
                 ScheduleCode::Passes => Schedule::Passes,
             })
-            .with_ratio(h.target_ratio)
-            .with_target_triangles(h.target_triangles as usize)
+            .with_target(target(h.target_ratio, h.target_triangles))
             .with_lambda(h.lambda)
             .with_max_passes(h.max_passes)
             .with_max_cost(h.max_cost)
@@ -670,6 +669,23 @@ pub mod lib {
         c
     }
 
+    /// The target of a case's two fields: a nonzero triangle count, else the ratio.
+    pub fn target(ratio: f32, triangles: u32) -> Target {
+        if triangles > 0 {
+            Target::Triangles(triangles as usize)
+        } else {
+            Target::Ratio(ratio)
+        }
+    }
+
+    /// A target as a case's two fields, `(target_ratio, target_triangles)`: the other one 0.
+    pub fn target_fields(target: Target) -> (f32, u32) {
+        match target {
+            Target::Ratio(r) => (r, 0),
+            Target::Triangles(n) => (0.0, narrow(n)),
+        }
+    }
+
     /// Whether a case asks for the guaranteed error bound (`Controls`).
     pub fn bounded(h: &CaseHeader) -> bool {
         h.bounded()
@@ -686,6 +702,7 @@ pub mod lib {
 
     /// A case header carrying `config` (vertex and triangle counts zero: `encode_case` sets them).
     pub fn case_header(config: &Config, index_type: IndexType) -> CaseHeader {
+        let (target_ratio, target_triangles) = target_fields(config.target);
         CaseHeader {
             index_type,
             schedule: match config.schedule {
@@ -698,8 +715,8 @@ pub mod lib {
             },
             vertices: 0,
             triangles: 0,
-            target_ratio: config.target_ratio,
-            target_triangles: narrow(config.target_triangles),
+            target_ratio,
+            target_triangles,
             lambda: config.lambda,
             feature_mode: match (config.features, config.feature_mode) {
                 (false, _) => FeatureCode::Off,

@@ -22,11 +22,12 @@ use tinydecimate::cluster::{
 use tinydecimate::cost::{
     error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
 };
+use tinydecimate::operator::Operator;
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, FeatureMode, Index, NoBound, Operator, Positions, Progressive, Report,
-    Schedule, Simplifier, Workspace,
+    Config, CostKind, EdgeCollapse, FeatureMode, Index, NoBound, Positions, Progressive, Report,
+    Schedule, Simplifier, Target, TriangleCollapse, Workspace,
 };
 
 #[panic_handler]
@@ -64,8 +65,11 @@ fn opaque_config() -> Config {
         } else {
             CostKind::NormalVariation
         },
-        target_triangles: input(1) as usize,
-        target_ratio: opaque_f32(2),
+        target: if input(6) & 16 == 0 {
+            Target::Ratio(opaque_f32(2))
+        } else {
+            Target::Triangles(input(1) as usize)
+        },
         max_cost: opaque_f32(3),
         max_passes: input(4),
         lambda: opaque_f32(5),
@@ -81,23 +85,17 @@ fn opaque_config() -> Config {
         boundary_weight: opaque_f32(9),
         max_error: opaque_f32(19),
         control_angle_deg: opaque_f32(20),
-        operator: if input(6) & 8 == 0 {
-            Operator::Edge
-        } else {
-            Operator::Triangle
-        },
     };
     // The builders too.
     let b = black_box(Config::paper())
         .with_schedule(c.schedule)
         .with_ratio(opaque_f32(10))
-        .with_target_triangles(input(11) as usize)
+        .with_target(Target::Triangles(input(11) as usize))
         .with_lambda(opaque_f32(12))
         .with_feature_mode(c.feature_mode)
         .with_max_passes(input(13))
         .with_max_cost(opaque_f32(14))
         .with_max_error(opaque_f32(21))
-        .with_operator(c.operator)
         .with_cost(c.cost);
     black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
@@ -146,7 +144,9 @@ fn use_report(r: &Report) {
     black_box(r);
 }
 
-fn drive<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>>(mut s: Simplifier<'a, L, I, C, B>) {
+fn drive<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator>(
+    mut s: Simplifier<'a, L, I, C, B, O>,
+) {
     let budget = input(0);
     loop {
         let done = s.step(budget);
@@ -185,17 +185,35 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         Ok(r) => use_report(&r),
         Err(e) => display(&e),
     }
-    match ws_default.start(Positions::Read(p), t, &config, Builtin::new(), NoBound) {
+    match ws_default.start(
+        Positions::Read(p),
+        t,
+        &config,
+        Builtin::new(),
+        NoBound,
+        EdgeCollapse,
+    ) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    match ws.start(
+        Positions::Read(p),
+        t,
+        &config,
+        Builtin::new(),
+        NoBound,
+        TriangleCollapse,
+    ) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
     let nv = NormalVariation::new();
-    match ws.start(Positions::Read(p), t, &config, nv, NoBound) {
+    match ws.start(Positions::Read(p), t, &config, nv, NoBound, EdgeCollapse) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
     let pd = Quadric::new();
-    match ws.start(Positions::Read(p), t, &config, pd, NoBound) {
+    match ws.start(Positions::Read(p), t, &config, pd, NoBound, EdgeCollapse) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
@@ -211,6 +229,7 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
                 &config,
                 StoredQuadric::new(q, Placement::Subset),
                 NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run())
         {
@@ -224,6 +243,7 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
                 &config,
                 StoredQuadric::new(q, Placement::Optimal),
                 NoBound,
+                EdgeCollapse,
             )
             .map(|s| s.run())
         {
@@ -241,7 +261,7 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
             tinydecimate::cost::Cost::placement(&sq),
             sq.quadric(input(14) as usize),
         ));
-        match ws.start(Positions::Write(mp), t, &config, sq, NoBound) {
+        match ws.start(Positions::Write(mp), t, &config, sq, NoBound, EdgeCollapse) {
             Ok(s) => {
                 black_box(s.position(input(15) as usize));
                 drive(s)
@@ -262,12 +282,26 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     ) {
         black_box(control_len(input(14) as usize, input(15) as usize));
         let bound = tinydecimate::Controls::new(o, l16);
-        match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound) {
+        match ws.start(
+            Positions::Read(p),
+            t,
+            &config,
+            Builtin::new(),
+            bound,
+            EdgeCollapse,
+        ) {
             Ok(s) => use_report(&s.run()),
             Err(e) => display(&e),
         }
         let bound = tinydecimate::Controls::new(o, l32);
-        match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound) {
+        match ws.start(
+            Positions::Read(p),
+            t,
+            &config,
+            Builtin::new(),
+            bound,
+            EdgeCollapse,
+        ) {
             Ok(s) => drive(s),
             Err(e) => display(&e),
         }
@@ -275,7 +309,7 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         if let Some(q) = quadrics.get_mut(..nq) {
             let bound = tinydecimate::Controls::new(o, l32);
             let cost = StoredQuadric::new(q, placement_of(input(16)));
-            match ws.start(Positions::Read(p), t, &config, cost, bound) {
+            match ws.start(Positions::Read(p), t, &config, cost, bound, EdgeCollapse) {
                 Ok(s) => drive(s),
                 Err(e) => display(&e),
             }
@@ -343,7 +377,14 @@ fn progressive<I: Index, const V: usize, const T: usize>() {
         return;
     };
     let config = opaque_config();
-    let logged = match ws.start(Positions::Read(p), t, &config, Builtin::new(), NoBound) {
+    let logged = match ws.start(
+        Positions::Read(p),
+        t,
+        &config,
+        Builtin::new(),
+        NoBound,
+        EdgeCollapse,
+    ) {
         Ok(s) => {
             let mut s = s.record_into(l);
             while !s.step(input(0)) {

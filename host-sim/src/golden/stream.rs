@@ -17,7 +17,8 @@ use meshfmt::pm::{self, Record, Summary, Tag};
 use serde::Deserialize;
 use tinydecimate::Config;
 
-use crate::golden::{self, sha256_hex, Backend, Golden, Verdict};
+use crate::backend::Backend;
+use crate::golden::{self, sha256_hex, Golden, Verdict};
 use crate::io::MeshData;
 
 /// One `[[stream]]` of the manifest.
@@ -116,7 +117,7 @@ impl StreamCase {
 
 /// Every `[[stream]]` of `dir/cases.toml`, encoded.
 pub fn load(dir: &Path) -> Result<Vec<StreamCase>> {
-    golden::load_stream_specs(dir)?
+    golden::case::load_stream_specs(dir)?
         .iter()
         .map(StreamCase::from_spec)
         .collect()
@@ -138,7 +139,7 @@ const TAGS: [(u32, &str); 7] = [
 ];
 
 /// The golden files of an output of `case`.
-pub fn golden_of(case: &StreamCase, backend: Backend, out: &[u8]) -> Result<Golden> {
+pub fn golden_from_output(case: &StreamCase, backend: Backend, out: &[u8]) -> Result<Golden> {
     let Some((records, s)) = pm::parse(out) else {
         bail!("stream case {}: malformed output", case.name());
     };
@@ -223,7 +224,7 @@ pub fn judge(case: &StreamCase, backend: Backend, expected: &Golden, out: &[u8])
             ));
         }
     }
-    let got = match golden_of(case, backend, out) {
+    let got = match golden_from_output(case, backend, out) {
         Ok(g) => g,
         Err(e) => return Verdict::Failed(format!("{e:#}")),
     };
@@ -281,7 +282,7 @@ pub fn check_host(dir: &Path, backend: Backend) -> Result<Vec<(StreamCase, Verdi
 pub fn bless(dir: &Path, backend: Backend) -> Result<Vec<String>> {
     let mut lines = Vec::new();
     for case in load(dir)? {
-        let new = golden_of(&case, backend, &reference(&case))?;
+        let new = golden_from_output(&case, backend, &reference(&case))?;
         let sha = &sha256_hex(&new.bin)[..16];
         let line = match Golden::load(dir, backend, case.name())? {
             None => format!("{:<28} new      sha256 {sha}", case.name()),

@@ -10,7 +10,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Result;
-use tinydecimate::{Config, Operator};
+use tinydecimate::Config;
+
+use crate::simplify::OperatorArg;
 
 use crate::io::MeshData;
 use crate::metro::{metro, MetroOptions};
@@ -116,7 +118,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             .with_ratio(0.0)
             .with_relative_max_error(f, &mesh.positions);
         let start = Instant::now();
-        let (ours, r, _) = crate::simplify::simplify_with(&mesh, &config, None, true, false)?;
+        let (ours, r, _) =
+            crate::simplify::simplify_with(&mesh, &config, OperatorArg::Edge, None, true, false)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let m = metro(&mesh, &ours, &opts);
         let emax = f64::from(r.max_error.unwrap_or(f32::NAN));
@@ -131,8 +134,14 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             m.a_to_b.max_pct,
         );
         if args.triangle {
-            let tc = config.with_operator(Operator::Triangle);
-            let (tri, rt, _) = crate::simplify::simplify_with(&mesh, &tc, None, true, false)?;
+            let (tri, rt, _) = crate::simplify::simplify_with(
+                &mesh,
+                &config,
+                OperatorArg::Triangle,
+                None,
+                true,
+                false,
+            )?;
             let mt = metro(&mesh, &tri, &opts);
             let e = f64::from(rt.max_error.unwrap_or(f32::NAN));
             ok &= e <= f64::from(config.max_error);

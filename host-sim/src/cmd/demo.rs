@@ -16,7 +16,8 @@ use anyhow::Result;
 use meshfmt::{IndexType, Status};
 use tinydecimate::Config;
 
-use crate::golden::{self, Backend, Case, Golden, Outcome, Verdict};
+use crate::backend::Backend;
+use crate::golden::{self, Case, Golden, Outcome, Verdict};
 use crate::qemu;
 
 /// `host-sim demo`.
@@ -132,16 +133,49 @@ fn thousands(n: u64) -> String {
 pub fn run(a: &Args) -> Result<ExitCode> {
     let backend = a.backend.unwrap_or(Backend::compiled());
     if backend != Backend::compiled() {
-        return golden::reinvoke(backend);
+        return crate::backend::reinvoke(backend);
     }
     let board = qemu::board(&a.board)?;
     if let Some(code) = qemu::preflight(&[board])? {
         return Ok(code);
     }
+    // 1. The case: the mesh, its index type and the configuration.
+    let mut case = demo_case(a)?;
+    // 2. The device's run (of the part of the mesh that fits it).
+    let (device, run) = run_on_board(a, board, backend, &mut case)?;
+    if a.verbose {
+        crate::outln!("{}", run.describe());
+    }
+    let Some(device) = device else {
+        crate::outln!(
+            "the firmware on {} gave no result: {}",
+            board.name,
+            run.describe()
+        );
+        return Ok(ExitCode::from(1));
+    };
+    // 3. The host's run, then both side by side and whether they are the same bytes.
+    let t0 = Instant::now();
+    let host = golden::reference(&case)?;
+    let host_wall = t0.elapsed();
+    side_by_side(
+        a,
+        board,
+        backend,
+        &case,
+        (&host, host_wall),
+        (&device, &run),
+    );
+    byte_identical(&case, backend, &host, &device)
+}
+
+/// The case `host-sim demo` runs: the mesh (the cow by default), `u32` triangles when asked
+/// or needed, and the configuration.
+fn demo_case(a: &Args) -> Result<Case> {
     let path = a
         .mesh
         .clone()
-        .unwrap_or_else(|| golden::repo_root().join("tests/fixtures/cow.obj"));
+        .unwrap_or_else(|| crate::repo_root().join("tests/fixtures/cow.obj"));
     let m = crate::io::load(&path)?;
     let index_type = if a.u32 || m.positions.len() > usize::from(u16::MAX) {
         IndexType::U32
@@ -156,7 +190,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     if let Some(r) = a.ratio {
         config = config.with_ratio(r);
     }
-    let mut case = Case {
+    Ok(Case {
         name: path
             .file_stem()
             .unwrap_or_default()
@@ -168,22 +202,31 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         index_type,
         config,
         stored: None,
-    };
-    let timeout = Duration::from_secs(a.timeout);
+    })
+}
 
+/// Builds the firmware and runs `case` on `board`; a mesh too big for the board is cut to
+/// the triangles that fit (`case` becomes that part) and run again.
+fn run_on_board(
+    a: &Args,
+    board: &'static qemu::Board,
+    backend: Backend,
+    case: &mut Case,
+) -> Result<(Option<Outcome>, qemu::Run)> {
+    let timeout = Duration::from_secs(a.timeout);
     eprintln!(
         "building the firmware for {} ({}, {backend}) ...",
         board.name, board.core
     );
     let elf = qemu::build(board, backend, true)?;
-    let mut ran = qemu::run_case(board, &elf, &case, timeout)?;
+    let mut ran = qemu::run_case(board, &elf, case, timeout)?;
     if let (Some(o), _) = &ran {
         if o.header.status == Status::TooBig {
             let (v, t) = (
                 o.header.capacity_vertices as usize,
                 o.header.capacity_triangles as usize,
             );
-            let sub = subset_that_fits(&case, v, t);
+            let sub = subset_that_fits(case, v, t);
             crate::outln!(
                 "{} has {} vertices / {} triangles; {} holds {v} / {t}: using its first {} triangles ({} vertices)",
                 case.mesh,
@@ -193,26 +236,23 @@ pub fn run(a: &Args) -> Result<ExitCode> {
                 sub.triangles.len(),
                 sub.positions.len()
             );
-            case = sub;
-            ran = qemu::run_case(board, &elf, &case, timeout)?;
+            *case = sub;
+            ran = qemu::run_case(board, &elf, case, timeout)?;
         }
     }
-    let (device, run) = ran;
-    if a.verbose {
-        crate::outln!("{}", run.describe());
-    }
-    let Some(device) = device else {
-        crate::outln!(
-            "the firmware on {} gave no result: {}",
-            board.name,
-            run.describe()
-        );
-        return Ok(ExitCode::from(1));
-    };
-    let t0 = Instant::now();
-    let host = golden::reference(&case)?;
-    let host_wall = t0.elapsed();
+    Ok(ran)
+}
 
+/// The host's and the device's runs side by side: report, instructions, time, memory.
+fn side_by_side(
+    a: &Args,
+    board: &qemu::Board,
+    backend: Backend,
+    case: &Case,
+    (host, host_wall): (&Outcome, Duration),
+    (device, run): (&Outcome, &qemu::Run),
+) {
+    let index_type = case.index_type;
     let (h, d) = (&host.header, &device.header);
     let it = if index_type == IndexType::U16 {
         "u16"
@@ -230,15 +270,14 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             "Config::new()"
         },
         case.config.schedule,
-        case.config.target_ratio,
+        meshfmt::lib::target_fields(case.config.target).0,
         case.config.lambda
     );
     let host_col = format!("host ({}, std)", std::env::consts::ARCH);
     let dev_col = format!("{} ({}, QEMU)", board.name, board.core);
-    let row = |k: &str, x: String, y: String| crate::outln!("{k:<22} {x:<46} {y}");
     row("", host_col, dev_col);
     let status = |o: &Outcome| status_text(&o.header);
-    row("status", status(&host), status(&device));
+    row("status", status(host), status(device));
     row("target", target_text(h), target_text(d));
     row(
         "stop",
@@ -307,9 +346,24 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             thousands(d.stack_bytes.into())
         ),
     );
+}
+
+/// One line of the side-by-side table.
+fn row(k: &str, x: String, y: String) {
+    crate::outln!("{k:<22} {x:<46} {y}");
+}
+
+/// Whether the host's and the device's outputs are the same bytes (exit code 1 if not).
+fn byte_identical(
+    case: &Case,
+    backend: Backend,
+    host: &Outcome,
+    device: &Outcome,
+) -> Result<ExitCode> {
+    let index_type = case.index_type;
     let (gh, gd) = (
-        Golden::of(&case, backend, &host)?,
-        Golden::of(&case, backend, &device)?,
+        Golden::from_outcome(case, backend, host)?,
+        Golden::from_outcome(case, backend, device)?,
     );
     row(
         "output sha256",

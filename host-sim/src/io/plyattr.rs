@@ -76,7 +76,7 @@ pub fn parse(bytes: &[u8]) -> Result<PlyFile, String> {
 
 /// Binary PLY of `triangles` (input numbering) with the kept vertices' properties.
 pub fn write(f: &PlyFile, triangles: &[[u32; 3]]) -> Result<Vec<u8>, String> {
-    let (tris, old) = crate::gltf::compact(triangles, f.vertices.len())?;
+    let (tris, old) = crate::io::gltf::compact(triangles, f.vertices.len())?;
     let mut ply = Ply::<DefaultElement>::new();
     ply.header.encoding = Encoding::BinaryLittleEndian;
     ply.header

@@ -1,6 +1,6 @@
-//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::gltf`]), OBJ
-//! with `vt`/`vn` ([`crate::objattr`]) and PLY with vertex properties besides x, y, z
-//! ([`crate::plyattr`]).
+//! `host-sim simplify` on meshes with vertex attributes: glTF/GLB ([`crate::io::gltf`]), OBJ
+//! with `vt`/`vn` ([`crate::io::objattr`]) and PLY with vertex properties besides x, y, z
+//! ([`crate::io::plyattr`]).
 //!
 //! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
 //! the same configuration; `--target-triangles N` is shared among the parts in proportion to
@@ -15,20 +15,21 @@ use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{anyhow, bail, Result};
-use tinydecimate::{Config, Report};
+use tinydecimate::{Config, Report, Target};
 
+use super::{Args, PlacementArg, QuadricArg};
 use crate::io::MeshData;
-use crate::simplify::{Args, PlacementArg, QuadricArg};
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
 fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
-    let weld = args.seams == crate::simplify::SeamsArg::Weld;
+    let weld = args.seams == super::SeamsArg::Weld;
     let (out, report, _) = crate::simplify::simplify_seams(
         mesh,
         config,
+        args.operator,
         placement,
         args.max_error.is_some(),
         false,
@@ -41,8 +42,8 @@ fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u3
 /// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
 pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     let (i, o) = (&args.input, &args.output);
-    let gi = crate::gltf::is_gltf_path(i);
-    let go = crate::gltf::is_gltf_path(o);
+    let gi = crate::io::gltf::is_gltf_path(i);
+    let go = crate::io::gltf::is_gltf_path(o);
     if gi || go {
         if !(gi && go) {
             bail!(
@@ -75,7 +76,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && !args.keep_numbering
     {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
-        if crate::objattr::has_attributes(&bytes) {
+        if crate::io::objattr::has_attributes(&bytes) {
             refuse_optimal(args)?;
             return run_obj(args, &bytes).map(Some);
         }
@@ -92,7 +93,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && !args.keep_numbering
     {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
-        let extra = crate::plyattr::extra_properties(&bytes);
+        let extra = crate::io::plyattr::extra_properties(&bytes);
         if !extra.is_empty() {
             refuse_optimal(args)?;
             return run_ply(args, &bytes, &extra).map(Some);
@@ -103,10 +104,10 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
 
 fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
     let file =
-        crate::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
-    let parts = vec![("vertex element".to_string(), file.mesh.clone())];
+        crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let parts = vec![("vertex element".to_string(), file.mesh.clone(), None)];
     let done = simplify_parts(args, &parts)?;
-    let out = crate::plyattr::write(&file, &done[0].triangles)
+    let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
     std::fs::write(&args.output, out)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
@@ -140,15 +141,19 @@ struct Part {
     json: serde_json::Value,
 }
 
+/// One part to simplify: its label, its mesh and, when it has them, the texture coordinates
+/// its material reads (one per vertex), for the UV stretch figure.
+type Input = (String, MeshData, Option<Vec<[f32; 2]>>);
+
 /// Simplifies each mesh of `parts` with `args`' configuration.
-fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>> {
-    let total: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
+    let total: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let mut out = Vec::new();
-    for (label, mesh) in parts {
+    for (label, mesh, uvs) in parts {
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
-            config = config.with_target_triangles(share as usize);
+            config = config.with_target(Target::Triangles(share as usize));
         }
         if let Some(e) = args.max_error {
             config = config.with_max_error(e.distance(&mesh.positions));
@@ -180,7 +185,7 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
             "report": crate::simplify::report_json(&report),
         });
         if !args.no_measure {
-            let weld = args.seams == crate::simplify::SeamsArg::Weld;
+            let weld = args.seams == super::SeamsArg::Weld;
             let v = crate::check::compare_opts(mesh, &result, false, weld);
             valid = v.is_valid();
             let opts = crate::metro::MetroOptions {
@@ -205,6 +210,9 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
             json["defects"] =
                 serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
             json["metro"] = serde_json::to_value(&m)?;
+            if let Some(uvs) = uvs {
+                let _ = write!(line, "{}", uv_stretch(mesh, uvs, &result, &mut json));
+            }
         }
         out.push(Part {
             triangles: tris,
@@ -214,6 +222,51 @@ fn simplify_parts(args: &Args, parts: &[(String, MeshData)]) -> Result<Vec<Part>
         });
     }
     Ok(out)
+}
+
+/// The UV stretch of the input, the result and meshoptimizer's `simplify` at the result's
+/// triangle count (see [`crate::uvstretch`]), as text for the part's line and into `json`.
+fn uv_stretch(
+    mesh: &MeshData,
+    uvs: &[[f32; 2]],
+    result: &MeshData,
+    json: &mut serde_json::Value,
+) -> String {
+    let stretch = |t: &[[u32; 3]]| crate::uvstretch::l2_stretch(&mesh.positions, uvs, t);
+    let (Some(input), Some(ours)) = (stretch(&mesh.triangles), stretch(&result.triangles)) else {
+        return String::new();
+    };
+    let (anchor, _, _) = crate::bench::meshopt::meshopt_simplify(mesh, result.triangles.len());
+    let theirs = stretch(&anchor.triangles);
+    let diag = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
+    let deviation = |t: &[[u32; 3]]| {
+        crate::uvstretch::texture_deviation(&mesh.positions, uvs, &mesh.triangles, t)
+            .map(|(mean, max, lost)| (100.0 * mean / diag, 100.0 * max / diag, lost))
+    };
+    let (dev_ours, dev_theirs) = (deviation(&result.triangles), deviation(&anchor.triangles));
+    json["uv_stretch"] = serde_json::json!({
+        "input": input,
+        "result": ours,
+        "meshopt": theirs,
+        "meshopt_triangles": anchor.triangles.len(),
+        "texture_deviation_pct": dev_ours.map(|d| [d.0, d.1]),
+        "texture_samples_lost": dev_ours.map(|d| d.2),
+        "meshopt_texture_deviation_pct": dev_theirs.map(|d| [d.0, d.1]),
+        "meshopt_texture_samples_lost": dev_theirs.map(|d| d.2),
+    });
+    let dev = |d: Option<(f64, f64, usize)>| {
+        d.map_or(String::new(), |(mean, max, lost)| {
+            format!(", texture deviation mean {mean:.4} % max {max:.4} %, {lost} samples lost")
+        })
+    };
+    format!(
+        "\n    UV stretch {ours:.4} (input {input:.4}){}\n    meshoptimizer at {} triangles: UV \
+         stretch {}{}",
+        dev(dev_ours),
+        anchor.triangles.len(),
+        theirs.map_or("-".into(), |t| format!("{t:.4}")),
+        dev(dev_theirs)
+    )
 }
 
 fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
@@ -246,30 +299,31 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
 }
 
 fn run_gltf(args: &Args) -> Result<ExitCode> {
-    let file = crate::gltf::load(&args.input)?;
+    let file = crate::io::gltf::load(&args.input)?;
     for p in &file.passed_through {
         eprintln!(
             "note: {}: {p} is not triangles: passed through unsimplified",
             args.input.display()
         );
     }
-    let parts: Vec<(String, MeshData)> = file
+    let parts: Vec<Input> = file
         .primitives
         .iter()
         .map(|p| {
             (
-                crate::gltf::label(p),
+                crate::io::gltf::label(p),
                 MeshData {
                     positions: p.positions.clone(),
                     triangles: p.triangles.clone(),
                 },
+                texture_coordinates(&file, p),
             )
         })
         .collect();
     let done = simplify_parts(args, &parts)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
-    crate::gltf::save(&args.output, &file, &results)?;
-    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    crate::io::gltf::save(&args.output, &file, &results)?;
+    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (glTF, {} triangle primitive(s), attributes {} kept per vertex): \
@@ -277,22 +331,57 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         args.input.display(),
         args.output.display(),
         parts.len(),
-        crate::gltf::attribute_summary(&file)
+        crate::io::gltf::attribute_summary(&file)
     );
     finish(args, head, &done)
 }
 
+/// The texture coordinates primitive `p`'s material reads (`TEXCOORD_n` of its
+/// `baseColorTexture`, else `TEXCOORD_0`), one per vertex.
+fn texture_coordinates(
+    file: &crate::io::gltf::GltfFile,
+    p: &crate::io::gltf::Primitive,
+) -> Option<Vec<[f32; 2]>> {
+    let material = &file.json["meshes"][p.mesh]["primitives"][p.index]["material"];
+    let n = material
+        .as_u64()
+        .and_then(|m| {
+            file.json["materials"][m as usize]["pbrMetallicRoughness"]["baseColorTexture"]
+                ["texCoord"]
+                .as_u64()
+        })
+        .unwrap_or(0);
+    let name = format!("TEXCOORD_{n}");
+    let stream = p.attributes.iter().find(|s| s.semantic == name)?;
+    (0..p.positions.len())
+        .map(|i| crate::texrender::uv_of(stream, i).map(|uv| uv.map(|c| c as f32)))
+        .collect()
+}
+
+/// Group `g`'s texture coordinates, one per vertex, when every vertex has one.
+fn obj_texture_coordinates(file: &crate::io::objattr::ObjFile, g: usize) -> Option<Vec<[f32; 2]>> {
+    file.groups[g]
+        .vertices
+        .iter()
+        .map(|c| {
+            let text = file.vt_text.get(c.1? as usize)?;
+            let mut it = text.split_whitespace().map(str::parse::<f32>);
+            Some([it.next()?.ok()?, it.next().unwrap_or(Ok(0.0)).ok()?])
+        })
+        .collect()
+}
+
 fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
     let file =
-        crate::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
-    let parts: Vec<(String, MeshData)> = (0..file.groups.len())
+        crate::io::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let parts: Vec<Input> = (0..file.groups.len())
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| {
             let name = file.groups[g]
                 .material
                 .as_deref()
                 .map_or("no material".to_string(), |m| format!("material {m}"));
-            (name, file.mesh(g))
+            (name, file.mesh(g), obj_texture_coordinates(&file, g))
         })
         .collect();
     let done = simplify_parts(args, &parts)?;
@@ -306,10 +395,10 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
             k += 1;
         }
     }
-    let text = crate::objattr::write(&file, &results);
+    let text = crate::io::objattr::write(&file, &results);
     std::fs::write(&args.output, text)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
-    let tin: usize = parts.iter().map(|(_, m)| m.triangles.len()).sum();
+    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (OBJ with {} texture coordinates, {} normals kept per vertex, {} \

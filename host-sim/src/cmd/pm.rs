@@ -1,0 +1,450 @@
+//! `host-sim pm`: progressive meshes. `encode` simplifies a mesh with a collapse log and writes
+//! the library's progressive stream; `decode` feeds a stream to the library's incremental
+//! decoder and writes a level; `levels` measures (and can draw) a ladder of levels; `stream`
+//! feeds a stream to an emulated board. The work is the library's, through [`crate::pm`]; this
+//! is only files and printing.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Context, Result};
+use tinydecimate::stream;
+use tinydecimate::{Config, Target};
+
+use crate::io::{self, MeshData};
+use crate::metro::{metro, MetroOptions};
+use crate::pm::{decode_bytes, decode_with, encode_mesh, extent, Extent};
+
+/// `host-sim pm …`
+#[derive(Clone, Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The `pm` subcommands.
+#[derive(Clone, Debug, clap::Subcommand)]
+pub enum Command {
+    /// Simplify with a collapse log and write the progressive stream (base mesh + vertex
+    /// splits); prints its size, bytes per vertex split and the base mesh's size.
+    Encode(EncodeArgs),
+    /// Decode a stream (fed to the decoder in small pieces, as from a radio) and write one
+    /// level of it.
+    Decode(DecodeArgs),
+    /// Metro error of a ladder of levels against the full mesh; optionally a picture strip.
+    Levels(LevelsArgs),
+    /// Stream a `.tdpm` into an emulated board through semihosting, in pieces of 1 to 128
+    /// bytes, as over a radio link: print the mesh the device shows as bytes arrive and its
+    /// Metro error, the emulated instructions per vertex split and per edge collapse, and
+    /// check that the device's bytes equal the host's.
+    Stream(StreamArgs),
+}
+
+/// `host-sim pm stream IN.tdpm`
+#[derive(Clone, Debug, clap::Args)]
+pub struct StreamArgs {
+    /// Input stream.
+    pub input: PathBuf,
+    /// QEMU board (machine).
+    #[arg(long, default_value = "mps2-an386")]
+    pub board: String,
+    /// Math backend of the firmware (the decoder's output does not depend on it).
+    #[arg(long, value_enum, default_value_t = crate::backend::Backend::compiled())]
+    pub backend: crate::backend::Backend,
+    /// Kill QEMU after this many seconds.
+    #[arg(long, default_value_t = 600)]
+    pub timeout: u64,
+}
+
+/// `host-sim pm encode IN OUT.tdpm`
+#[derive(Clone, Debug, clap::Args)]
+pub struct EncodeArgs {
+    /// Input mesh (OBJ, PLY or STL).
+    pub input: PathBuf,
+    /// Output stream.
+    pub output: PathBuf,
+    /// Triangles of the base mesh.
+    #[arg(long, conflicts_with = "base_ratio")]
+    pub base_triangles: Option<usize>,
+    /// Base mesh as a fraction of the input's triangles, in [0, 1].
+    #[arg(long, default_value_t = 0.02)]
+    pub base_ratio: f32,
+    /// Quantise positions to this many bits per coordinate (only 16 is supported).
+    #[arg(long)]
+    pub quantize: Option<u32>,
+    /// Largest chunk payload in bytes (each chunk costs 9 bytes of framing and checksum).
+    #[arg(long, default_value_t = 256)]
+    pub chunk: u16,
+}
+
+/// `host-sim pm decode IN.tdpm OUT`
+#[derive(Clone, Debug, clap::Args)]
+pub struct DecodeArgs {
+    /// Input stream.
+    pub input: PathBuf,
+    /// Output mesh (OBJ or PLY), in the stream's vertex numbering.
+    pub output: PathBuf,
+    /// Go to the finest level with at most this many triangles (default: full).
+    #[arg(long)]
+    pub triangles: Option<usize>,
+    /// Feed the decoder this many bytes at a time.
+    #[arg(long, default_value_t = 64)]
+    pub piece: usize,
+}
+
+/// `host-sim pm levels IN.tdpm`
+#[derive(Clone, Debug, clap::Args)]
+pub struct LevelsArgs {
+    /// Input stream.
+    pub input: PathBuf,
+    /// Fractions of the full mesh's triangles to measure (the base mesh is always first).
+    #[arg(long, value_delimiter = ',', default_value = "0.05,0.1,0.25,0.5,1")]
+    pub ladder: Vec<f64>,
+    /// Write a PNG strip of the levels, side by side.
+    #[arg(long)]
+    pub strip: Option<PathBuf>,
+}
+
+/// `host-sim pm`.
+pub fn run(args: &Args) -> Result<ExitCode> {
+    match &args.command {
+        Command::Encode(a) => encode(a),
+        Command::Decode(a) => decode(a).map(|_| ExitCode::SUCCESS),
+        Command::Levels(a) => levels(a),
+        Command::Stream(a) => stream_on_board(a),
+    }
+}
+
+fn encode(a: &EncodeArgs) -> Result<ExitCode> {
+    let quantised = match a.quantize {
+        None => false,
+        Some(16) => true,
+        Some(b) => bail!("--quantize {b}: only 16 bits per coordinate are supported"),
+    };
+    if !(0.0..=1.0).contains(&a.base_ratio) {
+        bail!("--base-ratio {}: must be in [0, 1]", a.base_ratio);
+    }
+    let mesh = io::load(&a.input)?;
+    let config = match a.base_triangles {
+        Some(n) => Config::new().with_target(Target::Triangles(n)),
+        None => Config::new().with_ratio(a.base_ratio),
+    };
+    let start = Instant::now();
+    let (bytes, e, order) = encode_mesh(&mesh, &config, quantised, a.chunk)?;
+    let took = start.elapsed();
+    std::fs::write(&a.output, &bytes).with_context(|| format!("writing {}", a.output.display()))?;
+    let d = decode_bytes(&bytes, bytes.len(), None)?;
+    let h = d.header;
+    crate::outln!(
+        "input            {} triangles, {} vertices",
+        mesh.triangles.len(),
+        mesh.positions.len()
+    );
+    crate::outln!(
+        "base mesh        {} triangles, {} vertices, {} bytes (header, positions, triangles, framing)",
+        h.base_triangles, h.base_vertices, e.base_bytes
+    );
+    crate::outln!("vertex splits    {}", e.splits);
+    let per = |bits: u64| bits as f64 / 8.0 / e.splits.max(1) as f64;
+    crate::outln!(
+        "per split        {:.2} B connectivity + {:.1} B position ({})",
+        per(e.split_connectivity_bits),
+        per(e.split_position_bits),
+        if quantised { "16-bit quantised" } else { "f32" }
+    );
+    crate::outln!(
+        "stream           {} bytes ({} in all)",
+        e.bytes,
+        a.output.display()
+    );
+    if quantised {
+        // Largest quantisation error, as a fraction of the diagonal.
+        let diag = mesh.bbox_diagonal();
+        let mut worst = 0f64;
+        for (p, &old) in d.positions.iter().zip(&order) {
+            let q = mesh.positions[old as usize];
+            let e = (0..3)
+                .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst = worst.max(e);
+        }
+        crate::outln!(
+            "quantisation     max {:.5} % of the diagonal",
+            100.0 * worst / diag
+        );
+    }
+    crate::outln!(
+        "time             {:.1} ms (simplify, build the splits, encode)",
+        took.as_secs_f64() * 1e3
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+fn decode(a: &DecodeArgs) -> Result<()> {
+    let bytes =
+        std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    let start = Instant::now();
+    let d = decode_bytes(&bytes, a.piece, a.triangles)?;
+    let took = start.elapsed();
+    io::save(
+        &a.output,
+        &MeshData {
+            positions: d.positions.clone(),
+            triangles: d.triangles.clone(),
+        },
+    )?;
+    crate::outln!(
+        "decoded {} bytes in {}-byte pieces: base {} triangles, full {} triangles, {} vertices",
+        bytes.len(),
+        a.piece,
+        d.header.base_triangles,
+        d.header.triangles,
+        d.header.vertices
+    );
+    if let Some(e) = &d.partial {
+        crate::outln!("{}", partial_line(e, d.finest_triangles));
+    }
+    crate::outln!(
+        "wrote {} triangles to {} ({:.1} ms)",
+        d.triangles.len(),
+        a.output.display(),
+        took.as_secs_f64() * 1e3
+    );
+    Ok(())
+}
+
+/// What a partial file decoded to, in one line.
+fn partial_line(e: &Extent, triangles: usize) -> String {
+    format!(
+        "PARTIAL stream: the full mesh has not arrived ({} bytes of whole chunks); finest \
+         complete level: {} of {} vertex splits ({triangles} of {} triangles, {} of {} vertices)",
+        e.bytes,
+        e.splits,
+        e.total_splits(),
+        e.header.triangles,
+        e.header.base_vertices as usize + e.splits,
+        e.header.vertices
+    )
+}
+
+fn levels(a: &LevelsArgs) -> Result<ExitCode> {
+    if let Some(f) = a.ladder.iter().find(|f| !(0.0..=1.0).contains(*f)) {
+        bail!("--ladder {f}: fractions must be in [0, 1]");
+    }
+    let bytes =
+        std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    // On a terminal, a bar once it takes over a second: decoding, then one Metro run per
+    // level; the table is printed after it.
+    let bar = crate::progress::Progress::new(
+        "levels {bar:40} {pos}/{len} levels measured ({elapsed})",
+        a.ladder.len() as u64 + 1,
+    );
+    bar.set(0);
+    let d = decode_with(&bytes, bytes.len(), None, &a.ladder)?;
+    bar.set_len(d.levels.len() as u64);
+    let full = MeshData {
+        positions: d.positions.clone(),
+        triangles: d.triangles.clone(),
+    };
+    let mut rows = Vec::new();
+    let mut meshes = Vec::new();
+    for (lvl, tris) in &d.levels {
+        let m = MeshData {
+            positions: d.positions.clone(),
+            triangles: tris.clone(),
+        };
+        let r = metro(&full, &m, &MetroOptions::default());
+        rows.push(format!(
+            "| {lvl} | {} | {:.4} | {:.4} |",
+            m.triangles.len(),
+            r.symmetric_mean_pct,
+            r.hausdorff_pct
+        ));
+        meshes.push(m);
+        bar.set(meshes.len() as u64);
+    }
+    bar.finish();
+    if let Some(e) = &d.partial {
+        crate::outln!(
+            "{} (errors below are against that level)",
+            partial_line(e, d.finest_triangles)
+        );
+    }
+    crate::outln!("| level (splits) | triangles | mean error (% diag) | Hausdorff (% diag) |");
+    crate::outln!("|---:|---:|---:|---:|");
+    for r in rows {
+        crate::outln!("{r}");
+    }
+    if let Some(path) = &a.strip {
+        let view = crate::render::View::fit(&full);
+        let images: Vec<_> = meshes
+            .iter()
+            .map(|m| crate::render::render(m, &view))
+            .collect();
+        let (w, h) = (images[0].width(), images[0].height());
+        let mut strip = image::RgbImage::new(w * images.len() as u32, h);
+        for (i, img) in images.iter().enumerate() {
+            image::imageops::replace(&mut strip, img, (i as u32 * w) as i64, 0);
+        }
+        strip
+            .save(path)
+            .with_context(|| format!("writing {}", path.display()))?;
+        crate::outln!("strip: {} ({} levels)", path.display(), images.len());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `host-sim pm stream`: the streaming demo on an emulated board.
+fn stream_on_board(a: &StreamArgs) -> Result<ExitCode> {
+    use crate::qemu;
+    use meshfmt::pm::{self, Tag};
+    let bytes =
+        std::fs::read(&a.input).with_context(|| format!("reading {}", a.input.display()))?;
+    let board = qemu::board(&a.board)?;
+    // Before any build or run: is it a stream, and does the board hold it?
+    let h = extent(&bytes)
+        .with_context(|| a.input.display().to_string())?
+        .header;
+    let cap = crate::qemu::StreamCapacity::of(board.name)
+        .ok_or_else(|| anyhow!("{}: no streaming firmware for this board", board.name))?;
+    let buffer = usize::from(h.max_payload) + stream::CHUNK_OVERHEAD;
+    if h.vertices as usize > cap.vertices
+        || h.triangles as usize > cap.triangles
+        || buffer > cap.buffer
+    {
+        bail!(
+            "{}: the stream's full mesh has {} vertices and {} triangles, in chunks of up to {} \
+             bytes; {} holds streams of up to {} vertices, {} triangles and chunks of up to {} \
+             bytes. Encode a mesh that fits (e.g. `host-sim simplify IN small.obj \
+             --target-triangles {}`, then `host-sim pm encode small.obj OUT.tdpm --chunk {}`){}",
+            a.input.display(),
+            h.vertices,
+            h.triangles,
+            h.max_payload,
+            board.name,
+            cap.vertices,
+            cap.triangles,
+            cap.buffer - stream::CHUNK_OVERHEAD,
+            // A closed mesh has about twice as many triangles as vertices: a margin below.
+            cap.triangles
+                .min(cap.vertices * 19 / 10)
+                .min(h.triangles as usize),
+            usize::from(h.max_payload).min(cap.buffer - stream::CHUNK_OVERHEAD),
+            if board.name.starts_with("mps2") {
+                ""
+            } else {
+                ", or a 4 MB board (--board mps2-an386)"
+            }
+        );
+    }
+    if let Some(code) = qemu::preflight(&[board])? {
+        return Ok(code);
+    }
+    let elf = qemu::build(board, a.backend, true)?;
+    let t0 = Instant::now();
+    let run = qemu::run_stream_bytes(
+        board,
+        &elf,
+        &bytes,
+        std::time::Duration::from_secs(a.timeout),
+    )?;
+    let took = t0.elapsed();
+    let out = match (&run.result, run.ok()) {
+        (Some(out), true) => out.clone(),
+        _ => bail!("{}: no output: {}", board.name, run.describe()),
+    };
+    let (records, s) =
+        pm::parse(&out).ok_or_else(|| anyhow!("{}: malformed output file", board.name))?;
+    // The host's run of the same code, and the full mesh to measure against.
+    let host = pm::run_in_memory(&bytes, 1 << 20, 1 << 21, 65_535 + stream::CHUNK_OVERHEAD);
+    let same = pm::compared(&host) == pm::compared(&out);
+    let full = decode_bytes(&bytes, bytes.len(), None).ok();
+    crate::outln!(
+        "{} ({}): {} bytes streamed in pieces of {:?} bytes, {:.1} s under QEMU",
+        board.name,
+        board.core,
+        s.bytes,
+        pm::FEED,
+        took.as_secs_f64()
+    );
+    crate::outln!();
+    crate::outln!("| bytes received | triangles shown | vertices | mean error (% diag) | Hausdorff (% diag) |");
+    crate::outln!("|---:|---:|---:|---:|---:|");
+    let positions = records
+        .iter()
+        .find(|r| r.tag == Tag::Positions as u32)
+        .map(|r| r.positions.clone())
+        .unwrap_or_default();
+    for r in records
+        .iter()
+        .filter(|r| r.tag == Tag::Arrived as u32 || r.tag == Tag::Final as u32)
+    {
+        let (mean, haus) = match &full {
+            Some(f) if !r.triangles.is_empty() => {
+                let full = MeshData {
+                    positions: f.positions.clone(),
+                    triangles: f.triangles.clone(),
+                };
+                let m = MeshData {
+                    positions: positions.clone(),
+                    triangles: r.triangles.clone(),
+                };
+                let e = metro(&full, &m, &MetroOptions::default());
+                (
+                    format!("{:.4}", e.symmetric_mean_pct),
+                    format!("{:.4}", e.hausdorff_pct),
+                )
+            }
+            _ => ("-".into(), "-".into()),
+        };
+        crate::outln!(
+            "| {}{} | {} | {} | {mean} | {haus} |",
+            r.bytes,
+            if r.tag == Tag::Final as u32 {
+                " (end)"
+            } else {
+                ""
+            },
+            r.triangles.len(),
+            r.vertices
+        );
+    }
+    crate::outln!();
+    match s.error {
+        None => crate::outln!(
+            "complete: {} triangles, {} vertices, {} vertex splits",
+            s.triangles,
+            s.vertices,
+            s.splits
+        ),
+        Some(e) => crate::outln!(
+            "stream error {} ({}, {}): the device kept {} triangles",
+            e.code,
+            e.a,
+            e.b,
+            s.triangles
+        ),
+    }
+    let per = |ticks: u64| board.instructions(ticks) as f64 / f64::from(s.splits.max(1));
+    crate::outln!(
+        "emulated instructions: {:.0} per vertex split while decoding (checksums and bit unpacking included), \
+         {:.0} per edge collapse and {:.0} per vertex split moving the slider (coarsen / refine all {} levels)",
+        per(s.decode_ticks),
+        per(s.coarsen_ticks),
+        per(s.refine_ticks),
+        s.splits
+    );
+    crate::outln!("stack of the decoder run: {} B", s.stack_bytes);
+    crate::outln!(
+        "device output {} the host's ({} bytes)",
+        if same { "identical to" } else { "DIFFERS from" },
+        out.len()
+    );
+    Ok(if same {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}

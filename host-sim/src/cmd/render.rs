@@ -1,0 +1,24 @@
+//! `host-sim render MESH OUT.png [--compare ORIGINAL]`: a flat-shaded picture of a mesh, or a
+//! comparison with an error heatmap ([`crate::render::draw`]).
+
+use anyhow::Result;
+
+use crate::render::draw;
+
+/// `host-sim render MESH OUT.png [--compare ORIGINAL]`
+#[derive(Clone, Debug, clap::Args)]
+pub struct Args {
+    /// The mesh to draw.
+    pub mesh: std::path::PathBuf,
+    /// Output PNG.
+    pub out: std::path::PathBuf,
+    /// Draw original | MESH | MESH coloured by its distance to ORIGINAL, side by side.
+    #[arg(long, value_name = "ORIGINAL")]
+    pub compare: Option<std::path::PathBuf>,
+}
+
+/// `host-sim render`.
+pub fn run(args: &Args) -> Result<std::process::ExitCode> {
+    draw(&args.mesh, &args.out, args.compare.as_deref())?;
+    Ok(std::process::ExitCode::SUCCESS)
+}

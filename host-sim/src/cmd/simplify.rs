@@ -1,0 +1,762 @@
+//! `host-sim simplify`: runs the library on a mesh file, prints its report, memory figures and
+//! (unless `--no-measure`) the validity check and the Metro error of the result, as text or
+//! (`--json`) as one JSON object.
+//!
+//! The output path and format are checked before anything else; the input may be standard
+//! input and the output standard output (`-`). Output files keep only the vertices the result
+//! uses unless `--keep-numbering` (or optimal placement, whose moved vertices only their
+//! numbering ties to the input's).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{anyhow, bail, Result};
+use tinydecimate::cost::Placement;
+use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Storage, Target};
+
+use crate::io::{Format, MeshData};
+use crate::simplify::{format_report, report_json, simplify_seams};
+use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
+
+mod textured;
+
+/// Which schedule, on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ScheduleArg {
+    /// The default and the one to use: the cheapest legal collapse of the whole mesh first,
+    /// so the error grows as slowly as it can.
+    Greedy,
+    /// Cheng, Pan and Shi's passes as the paper writes them (λ = 1, normal-variation cost):
+    /// collapses in sweeps over the mesh, each vertex at most once per pass. For comparison
+    /// with the paper; its error is higher than greedy's at the same triangle count.
+    Passes,
+}
+
+/// Which cost, on the command line (`Config::with_cost`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CostArg {
+    /// The default and the one to use for the lowest geometric error: memoryless quadric,
+    /// the squared distance to the removed vertex's current planes plus a boundary term
+    /// (`Config::new()`). Nothing stored per vertex.
+    Quadric,
+    /// The paper's normal variation W (Cheng, Pan and Shi), scaled by ℓ² for the greedy
+    /// schedule (`Config::paper()`): keeps flat regions flat rather than minimising distance;
+    /// for comparison with the paper, higher Metro error than `quadric`.
+    Normal,
+}
+
+impl From<CostArg> for CostKind {
+    fn from(c: CostArg) -> CostKind {
+        match c {
+            CostArg::Quadric => CostKind::Quadric,
+            CostArg::Normal => CostKind::NormalVariation,
+        }
+    }
+}
+
+pub use crate::simplify::OperatorArg;
+
+/// Which quadric, on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum QuadricArg {
+    /// The cost of `--cost` (memoryless quadric by default): nothing stored per vertex, the
+    /// choice when RAM is tight.
+    #[default]
+    Memoryless,
+    /// `tinydecimate::cost::StoredQuadric`: a 4x4 quadric per vertex
+    /// (40 B), summed on collapse, boundary planes weighted by --boundary-weight (greedy
+    /// schedule only). Lower error than memoryless when 40 B per vertex can be spared.
+    Stored,
+}
+
+/// Where stored quadrics leave the kept vertex, on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlacementArg {
+    /// At an endpoint: positions are only read, the output's vertices are input vertices.
+    #[default]
+    Subset,
+    /// At the minimiser of the summed quadric (or the best of the endpoints and the
+    /// midpoint): lower error, but vertices move, so the output file carries the moved
+    /// positions (and the input's numbering: check it with `check --placement optimal`).
+    Optimal,
+}
+
+impl From<PlacementArg> for Placement {
+    fn from(p: PlacementArg) -> Placement {
+        match p {
+            PlacementArg::Subset => Placement::Subset,
+            PlacementArg::Optimal => Placement::Optimal,
+        }
+    }
+}
+
+/// A number in a range, for clap: the error names the range and what the value means.
+fn ranged(
+    v: &str,
+    ok: impl Fn(f32) -> bool,
+    range: &str,
+    meaning: &str,
+) -> std::result::Result<f32, String> {
+    let x: f32 = v
+        .trim()
+        .parse()
+        .map_err(|_| format!("{v:?} is not a number; accepted: {range} ({meaning})"))?;
+    if x.is_finite() && ok(x) {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{v} is out of range; accepted: {range} ({meaning})"
+        ))
+    }
+}
+
+fn parse_ratio(v: &str) -> std::result::Result<f32, String> {
+    ranged(
+        v,
+        |x| (0.0..=1.0).contains(&x),
+        "0 to 1",
+        "the fraction of the input triangles to keep, 0.25 keeps a quarter",
+    )
+}
+
+/// The error bound at control points on the command line: a percentage of the bounding-box diagonal
+/// (`0.5%`) or an absolute distance in the input's units (`0.02`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaxError {
+    /// This fraction of the diagonal (`0.5%` is 0.005).
+    Fraction(f32),
+    /// This distance.
+    Absolute(f32),
+}
+
+impl MaxError {
+    /// The distance on `mesh`.
+    pub fn distance(self, positions: &[[f32; 3]]) -> f32 {
+        match self {
+            MaxError::Fraction(f) => f * tinydecimate::bound::bounding_diagonal(positions),
+            MaxError::Absolute(d) => d,
+        }
+    }
+}
+
+impl std::fmt::Display for MaxError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MaxError::Fraction(x) => write!(f, "{}%", 100.0 * x),
+            MaxError::Absolute(d) => write!(f, "{d}"),
+        }
+    }
+}
+
+/// `P%` or a distance.
+pub fn parse_max_error(v: &str) -> std::result::Result<MaxError, String> {
+    let v = v.trim();
+    if let Some(p) = v.strip_suffix('%') {
+        ranged(
+            p,
+            |x| x > 0.0 && x <= 100.0,
+            "above 0 %, at most 100 %",
+            "a percentage of the bounding-box diagonal, 0.5% is half a percent",
+        )
+        .map(|x| MaxError::Fraction(x / 100.0))
+    } else {
+        ranged(
+            v,
+            |x| x >= 0.0,
+            "0 or more, or a percentage such as 0.5%",
+            "a distance in the input's units",
+        )
+        .map(MaxError::Absolute)
+    }
+}
+
+fn parse_lambda(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x >= 0.0, "0 or more", "the feature factor λ")
+}
+
+fn parse_turn(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x > 0.0 && x < 180.0, "above 0, below 180", "degrees")
+}
+
+fn parse_quality(v: &str) -> std::result::Result<f32, String> {
+    ranged(
+        v,
+        |x| (0.0..1.0).contains(&x),
+        "0 or more, below 1",
+        "1 is an equilateral triangle",
+    )
+}
+
+fn parse_weight(v: &str) -> std::result::Result<f32, String> {
+    ranged(v, |x| x >= 0.0, "0 or more", "a weight")
+}
+
+fn parse_samples(v: &str) -> std::result::Result<f64, String> {
+    ranged(v, |x| x > 0.0, "above 0", "samples per triangle").map(f64::from)
+}
+
+/// How vertices at identical positions are treated (`--seams`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum SeamsArg {
+    /// One vertex with several wedges, collapsed together.
+    Weld,
+    /// Separate vertices (each seam an open boundary).
+    Split,
+}
+
+/// `host-sim simplify IN OUT ...`
+#[derive(Clone, Debug, clap::Args)]
+#[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
+pub struct Args {
+    /// Input mesh (.obj, .ply, .stl, .gltf, .glb; `-` reads standard input, the format found
+    /// from the bytes). Quads and n-gons are split into triangles (ear clipping). glTF keeps
+    /// every vertex attribute and is written as glTF; an OBJ with texture coordinates or
+    /// normals written to OBJ keeps them and its materials, a PLY written to PLY its vertex
+    /// properties. Otherwise only positions and faces are read: attributes are not carried,
+    /// and a warning says which were dropped.
+    pub input: PathBuf,
+    /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
+    /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no
+    /// output triangle uses are dropped (see --keep-numbering; kept with `--placement optimal`).
+    pub output: PathBuf,
+    /// Output format, instead of the output's extension.
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
+    /// Keep every input vertex in the output file, so that its indices are the input's (what
+    /// a firmware's index buffer into the same positions needs). STL has no numbering.
+    #[arg(long)]
+    pub keep_numbering: bool,
+    /// Vertices at identical positions (a renderer's split on UV seams, hard normals,
+    /// materials): `weld` collapses them together as one vertex with several wedges, each
+    /// triangle keeping its own wedge (the default); `split` treats each as its own vertex, so
+    /// every seam is an open boundary that only shrinks along itself.
+    #[arg(long, value_enum, default_value_t = SeamsArg::Weld)]
+    pub seams: SeamsArg,
+    /// Target fraction of the input triangles, 0 to 1.
+    #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
+    pub ratio: Option<f32>,
+    /// Target triangle count (with --ratio, the higher target wins).
+    #[arg(long, group = "target")]
+    pub target_triangles: Option<usize>,
+    /// Error bound at control points (Zhu, Wang and Meng 2007): what is guaranteed is that
+    /// no control point, i.e. no original triangle's centroid and no vertex of an original
+    /// feature edge, ends farther than this from the result. Points of the original surface
+    /// between control points are not bounded: the Metro one-sided and Hausdorff distances
+    /// can exceed it (the run prints them next to it). `P%` of the bounding-box diagonal (`0.5%`) or an absolute distance in the
+    /// input's units. Alone, simplifies as far as the bound allows; with --ratio or
+    /// --target-triangles, whichever stops first. Any schedule and cost; `--quadric stored`
+    /// with subset placement only. Prints E_max and E_mean (eq. 4-5) next to the Metro
+    /// one-sided maximum from the input to the result.
+    #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_max_error)]
+    pub max_error: Option<MaxError>,
+    /// Collapse schedule.
+    #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
+    pub schedule: ScheduleArg,
+    /// Feature factor λ: a vertex is a feature iff D > λ·mean(D) (default 2; 1 with passes).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_lambda)]
+    pub lambda: Option<f32>,
+    /// Normalise the feature measure D by valence² (FeatureMode::ValenceNormalized).
+    #[arg(long)]
+    pub valence_normalized: bool,
+    /// Turn feature detection off (every vertex may be collapsed). The default with
+    /// `--quadric stored` (`Config::stored()`).
+    #[arg(long, conflicts_with = "features")]
+    pub no_features: bool,
+    /// Turn feature detection on with `--quadric stored` (Lin Mouguang 2007's rule on top of the
+    /// quadrics; on by default in every other mode).
+    #[arg(long)]
+    pub features: bool,
+    /// Greedy: feature vertices may not even be the kept end of a collapse (the paper's rule).
+    #[arg(long)]
+    pub no_feature_targets: bool,
+    /// Largest normal turn of a triangle in one collapse, degrees.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_turn)]
+    pub max_turn: Option<f32>,
+    /// Smallest triangle quality a collapse may create (unless already worse).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_quality)]
+    pub min_quality: Option<f32>,
+    /// Weight of the boundary retreat in the cost.
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_weight)]
+    pub boundary_weight: Option<f32>,
+    /// Collapse cost (default: the schedule's own, quadric for greedy as in `Config::new()`,
+    /// normal for passes as in `Config::paper()`).
+    #[arg(long, value_enum)]
+    pub cost: Option<CostArg>,
+    /// Simplification operator: half-edge collapse, or the triangle collapse of
+    /// Zhu, Wang and Meng 2007 (greedy schedule only).
+    #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
+    pub operator: OperatorArg,
+    /// Quadric: `stored` keeps a quadric per vertex, replacing --cost.
+    #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
+    pub quadric: QuadricArg,
+    /// Placement of the kept vertex with `--quadric stored`.
+    #[arg(long, value_enum, default_value_t = PlacementArg::Subset)]
+    pub placement: PlacementArg,
+    /// Skip the validity check and the Metro measurement afterwards.
+    #[arg(long)]
+    pub no_measure: bool,
+    /// Metro face samples per triangle of the larger mesh.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = parse_samples)]
+    pub samples_per_triangle: f64,
+    /// Print the report, the check and the Metro error as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Allow the output to be the input file (it is overwritten).
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl Args {
+    /// The library configuration these arguments ask for.
+    pub fn config(&self) -> Config {
+        // `passes` means the paper as written (λ = 1, features take no part in any collapse).
+        let base = match self.schedule {
+            ScheduleArg::Greedy => Config::new().with_schedule(Schedule::Greedy),
+            ScheduleArg::Passes => Config::paper(),
+        };
+        let base = match self.cost {
+            Some(cost) => base.with_cost(cost.into()),
+            None => base,
+        };
+        let mut c = base.with_feature_mode(if self.valence_normalized {
+            FeatureMode::ValenceNormalized
+        } else {
+            FeatureMode::Paper
+        });
+        // A triangle count, else the ratio.
+        c = c.with_target(match self.target_triangles {
+            Some(t) => Target::Triangles(t),
+            None => Target::Ratio(self.ratio.unwrap_or(0.0)),
+        });
+        if let Some(l) = self.lambda {
+            c = c.with_lambda(l);
+        }
+        // Stored quadrics default to `Config::stored()`: no feature rule.
+        c.features = if self.quadric == QuadricArg::Stored {
+            self.features
+        } else {
+            !self.no_features
+        };
+        if self.no_feature_targets {
+            c.feature_targets = false;
+        }
+        if let Some(x) = self.max_turn {
+            c.max_normal_turn_deg = x;
+        }
+        if let Some(x) = self.min_quality {
+            c.min_quality = x;
+        }
+        if let Some(x) = self.boundary_weight {
+            c.boundary_weight = x;
+        }
+        c
+    }
+}
+
+/// `host-sim simplify`. Exit code 1 if the measured result is not a valid simplification.
+pub fn run(args: &Args) -> Result<ExitCode> {
+    // 1. Everything that can be refused is refused before the long work.
+    let to_stdout = crate::io::is_std(&args.output);
+    if to_stdout && args.json {
+        bail!("--json and an output of `-` would both write standard output: give an output file");
+    }
+    // glTF, and OBJ with texture coordinates or normals: attributes carried (textured.rs).
+    if let Some(code) = textured::run_if_attributes(args)? {
+        return Ok(code);
+    }
+    let out_format = crate::io::check_writable(&args.output, args.format)?;
+    if !args.force && crate::io::same_file(&args.input, &args.output) {
+        bail!(
+            "{}: the output is the input file and would overwrite it: give another output, or \
+             --force",
+            args.output.display()
+        );
+    }
+    // 2. The run, and the file it writes.
+    let run = simplify_file(args, out_format)?;
+    // 3. What was done and the memory it takes, then the check and the error.
+    let say = |text: &str| {
+        if to_stdout {
+            eprint!("{text}");
+        } else if !args.json {
+            crate::out!("{text}");
+        }
+    };
+    say(&run_text(args, &run));
+    let mut json = run_json(args, &run);
+    let mut valid = true;
+    if !args.no_measure {
+        valid = measure(args, &run, &say, &mut json)?;
+    }
+    json["valid"] = serde_json::Value::Bool(valid);
+    if args.json {
+        crate::outln!("{}", serde_json::to_string_pretty(&json)?);
+    }
+    Ok(if valid {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// One `simplify` run: the input, the result, what was written and how.
+struct Run {
+    mesh: MeshData,
+    config: Config,
+    out: MeshData,
+    written: MeshData,
+    out_format: Format,
+    report: Report,
+    elapsed: Duration,
+    stored: bool,
+    moved: bool,
+    keep_numbering: bool,
+}
+
+/// Loads the input, runs the library as `args` ask and writes the output file.
+fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
+    let mesh = crate::io::load_noting(&args.input)?;
+    let mut config = args.config();
+    if let Some(e) = args.max_error {
+        config = config.with_max_error(e.distance(&mesh.positions));
+    }
+    config
+        .validate()
+        .map_err(|e| anyhow!("configuration: {e}"))?;
+    let stored = args.quadric == QuadricArg::Stored;
+    // Optimal placement moves vertices: only their numbering says which input vertex each
+    // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
+    let moved = stored && args.placement == PlacementArg::Optimal;
+    if moved && out_format == Format::Stl {
+        bail!(
+            "--placement optimal moves vertices, and STL has no vertex numbering to tell which \
+             input vertex each one was: write OBJ or PLY"
+        );
+    }
+    let keep_numbering = args.keep_numbering || moved;
+    let bounded = args.max_error.is_some();
+    // The library refuses what it cannot run (stored quadrics with the passes schedule,
+    // optimal placement with a bound) before any work, naming the option.
+    let placement = stored.then(|| args.placement.into());
+    let weld = args.seams == SeamsArg::Weld;
+    let (out, report, elapsed) = simplify_seams(
+        &mesh,
+        &config,
+        args.operator,
+        placement,
+        bounded,
+        true,
+        weld,
+    )?;
+    let written = if keep_numbering {
+        out.clone()
+    } else {
+        crate::io::compact(&out).0
+    };
+    crate::io::save_as(&args.output, out_format, &written)?;
+    Ok(Run {
+        mesh,
+        config,
+        out,
+        written,
+        out_format,
+        report,
+        elapsed,
+        stored,
+        moved,
+        keep_numbering,
+    })
+}
+
+/// The run in words: files, modes, the library's report and the memory figures.
+fn run_text(args: &Args, run: &Run) -> String {
+    use std::fmt::Write as _;
+    let Run {
+        mesh,
+        config,
+        written,
+        out_format,
+        report,
+        elapsed,
+        stored,
+        moved,
+        ..
+    } = run;
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "simplify {} -> {} ({:?}, {} vertices{})",
+        args.input.display(),
+        args.output.display(),
+        out_format,
+        written.positions.len(),
+        if args.keep_numbering {
+            ", input numbering kept"
+        } else if *moved {
+            ", input numbering kept: vertices moved"
+        } else {
+            ", unreferenced dropped"
+        }
+    );
+    if *stored {
+        let _ = writeln!(
+            text,
+            "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
+            config.schedule, args.placement, config.boundary_weight
+        );
+    } else {
+        let _ = writeln!(
+            text,
+            "  schedule, cost, op     {:?}, {:?}, {:?} collapse",
+            config.schedule, config.cost, args.operator
+        );
+    }
+    if let Some(e) = args.max_error {
+        let _ = writeln!(
+            text,
+            "  error bound            d_hold {e} = {:.6e} (guaranteed at the control points; \
+             feature edges past {}°)",
+            config.max_error, config.control_angle_deg
+        );
+    }
+    let _ = writeln!(text, "{}", format_report(report));
+    let _ = writeln!(
+        text,
+        "  library call           {:.3} ms",
+        elapsed.as_secs_f64() * 1e3
+    );
+    let (v, t) = (mesh.positions.len(), mesh.triangles.len());
+    let per_tri = |b: usize| b as f64 / t.max(1) as f64;
+    let host = Storage::<u32>::bytes(v, t);
+    let _ = writeln!(
+        text,
+        "  workspace (this run)   {host} bytes: Storage<u32> sized to the mesh ({:.1} bytes per \
+         input triangle)",
+        per_tri(host)
+    );
+    let (need, link) = workspace_bytes(v, t);
+    let _ = writeln!(
+        text,
+        "  workspace (right-size) {need} bytes for V = {v}, T = {t} with {link}-byte links \
+         ({} bytes per vertex, {} per triangle; {:.2} bytes per input triangle)",
+        if link == 2 {
+            element_bytes::<u16>().0
+        } else {
+            element_bytes::<u32>().0
+        },
+        if link == 2 {
+            element_bytes::<u16>().1
+        } else {
+            element_bytes::<u32>().1
+        },
+        per_tri(need)
+    );
+    if args.max_error.is_some() {
+        let (b16, b32) = control_bytes(v, t);
+        let _ = writeln!(
+            text,
+            "  control links          2T + V = {} links: {b16} bytes with u16 links ({:.2} per \
+             input triangle), {b32} with u32 ({:.2})",
+            tinydecimate::bound::control_len(t, v),
+            per_tri(b16),
+            per_tri(b32)
+        );
+    }
+    if *stored {
+        let _ = writeln!(
+            text,
+            "  stored quadrics        {} bytes ({QUADRIC_BYTES} per vertex); with the workspace \
+             {:.2} bytes per input triangle",
+            v * QUADRIC_BYTES,
+            per_tri(need + v * QUADRIC_BYTES)
+        );
+    }
+    text
+}
+
+/// The JSON object of `--json`, before the check and the error are added.
+fn run_json(args: &Args, run: &Run) -> serde_json::Value {
+    let (v, t) = (run.mesh.positions.len(), run.mesh.triangles.len());
+    let config = &run.config;
+    serde_json::json!({
+        "input": args.input.display().to_string(),
+        "output": args.output.display().to_string(),
+        "output_format": format!("{:?}", run.out_format),
+        "output_vertices": run.written.positions.len(),
+        "keep_numbering": run.keep_numbering,
+        "schedule": format!("{:?}", config.schedule),
+        "cost": format!("{:?}", config.cost),
+        "operator": format!("{:?}", args.operator),
+        "quadric": format!("{:?}", args.quadric),
+        "placement": format!("{:?}", args.placement),
+        "max_error": args.max_error.map(|e| e.to_string()),
+        "d_hold": if config.max_error.is_finite() { Some(config.max_error) } else { None },
+        "report": report_json(&run.report),
+        "library_ms": run.elapsed.as_secs_f64() * 1e3,
+        "workspace_bytes": workspace_bytes(v, t).0,
+    })
+}
+
+/// The check of the file as written and read back, and the Metro error (and the bound's
+/// figures): said with `say`, added to `json`. Whether the result is valid.
+fn measure(
+    args: &Args,
+    run: &Run,
+    say: &dyn Fn(&str),
+    json: &mut serde_json::Value,
+) -> Result<bool> {
+    use std::fmt::Write as _;
+    let Run {
+        mesh,
+        config,
+        out,
+        written,
+        out_format,
+        report,
+        moved,
+        ..
+    } = run;
+    let out_format = *out_format;
+    let mut text = String::new();
+    // The library drops degenerate and duplicate triangles before it starts; the check
+    // compares the output with the input as the library saw it (`meshcheck::clean`).
+    // One checker, one verdict: what `host-sim check` says of the file, as written and
+    // read back (an STL welded by position, a compact file matched back by position).
+    let ext = format!("{out_format:?}");
+    let as_read = crate::io::encode(out_format, written)
+        .map_err(|e| anyhow!("{e}"))
+        .and_then(|b| crate::io::parse_bytes(&b, &ext))
+        .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
+    let (_, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    if args.seams == SeamsArg::Weld {
+        // Welded seams: the result in the input's numbering (a written file matches twins by
+        // position in order, which cannot say which wedge a corner was), both welded by
+        // position, and the wedges of the kept positions.
+        validity = crate::check::compare_opts(mesh, out, *moved, true);
+    }
+    let valid = validity.is_valid();
+    let _ = writeln!(
+        text,
+        "check (output vs the cleaned input: the input less its {} degenerate and {} \
+         duplicate triangles, as the library dropped them):",
+        report.degenerate_dropped, report.duplicates_dropped
+    );
+    if let Some(n) = &note {
+        let _ = writeln!(text, "note: {n}");
+    }
+    let _ = writeln!(text, "{validity}");
+    let opts = crate::metro::MetroOptions {
+        samples_per_triangle: args.samples_per_triangle,
+        progress: true,
+        ..Default::default()
+    };
+    let m = crate::metro::metro(mesh, out, &opts);
+    let _ = writeln!(text, "metro (input vs output):");
+    let _ = writeln!(text, "{m}");
+    if let (Some(emax), Some(emean)) = (report.max_error, report.mean_error) {
+        let pct = |x: f64| 100.0 * x / m.diagonal.max(f64::MIN_POSITIVE);
+        let _ = writeln!(
+            text,
+            "error bound (input units; % of the diagonal):\n\
+             \x20 d_hold                   {:.6e} = {:.5} %\n\
+             \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
+             \x20 E_mean (eq. 5)           {:.6e} = {:.5} %\n\
+             \x20 Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
+            config.max_error,
+            pct(f64::from(config.max_error)),
+            emax,
+            pct(f64::from(emax)),
+            emean,
+            pct(f64::from(emean)),
+            m.a_to_b.max,
+            m.a_to_b.max_pct,
+        );
+    }
+    say(&text);
+    json["check"] = serde_json::json!({
+        "against": "cleaned input",
+        "validity": validity,
+        "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
+        "valid": valid,
+    });
+    json["metro"] = serde_json::to_value(&m)?;
+    Ok(valid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    #[test]
+    fn arguments_make_the_config() {
+        let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.25"]).unwrap();
+        let cfg = c.args.config();
+        assert_eq!(cfg.target, Target::Ratio(0.25));
+        assert_eq!(cfg.schedule, Schedule::Greedy);
+        assert_eq!(cfg.feature_mode, FeatureMode::Paper);
+        assert_eq!(cfg.cost, CostKind::Quadric);
+        assert_eq!(cfg, Config::new().with_ratio(0.25));
+        let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.1", "--cost", "normal"])
+            .unwrap();
+        assert_eq!(
+            c.args.config(),
+            Config::new().with_cost(CostKind::NormalVariation)
+        );
+        let c =
+            Cli::try_parse_from(["x", "a", "b", "--ratio", "0.1", "--schedule", "passes"]).unwrap();
+        assert_eq!(c.args.config(), Config::paper().with_ratio(0.1));
+        let c = Cli::try_parse_from([
+            "x",
+            "a",
+            "b",
+            "--ratio",
+            "0.1",
+            "--schedule",
+            "passes",
+            "--cost",
+            "quadric",
+        ])
+        .unwrap();
+        assert_eq!(c.args.config().cost, CostKind::Quadric);
+        assert!(Cli::try_parse_from(["x", "a", "b", "--ratio", "0.1", "--cost", "plane"]).is_err());
+        let c = Cli::try_parse_from([
+            "x",
+            "a.obj",
+            "b.obj",
+            "--target-triangles",
+            "500",
+            "--schedule",
+            "passes",
+            "--lambda",
+            "1.5",
+            "--valence-normalized",
+        ])
+        .unwrap();
+        let cfg = c.args.config();
+        assert_eq!(cfg.target, Target::Triangles(500));
+        assert_eq!(cfg.schedule, Schedule::Passes);
+        assert_eq!(cfg.lambda, 1.5);
+        assert_eq!(cfg.feature_mode, FeatureMode::ValenceNormalized);
+        assert!(Cli::try_parse_from(["x", "a.obj", "b.obj"]).is_err());
+        // Stored quadrics: `Config::stored()` (no feature rule) unless --features.
+        let stored = |extra: &[&str]| {
+            let mut a = vec!["x", "a", "b", "--ratio", "0.1", "--quadric", "stored"];
+            a.extend_from_slice(extra);
+            Cli::try_parse_from(a).map(|c| c.args.config())
+        };
+        assert_eq!(stored(&[]).unwrap(), Config::stored().with_ratio(0.1));
+        assert_eq!(
+            stored(&["--features"]).unwrap(),
+            Config::new().with_ratio(0.1)
+        );
+        assert!(stored(&["--features", "--no-features"]).is_err());
+    }
+}

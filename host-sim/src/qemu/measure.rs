@@ -1,0 +1,636 @@
+//! `host-sim qemu --measure`: per board the image sizes (firmware, library alone, one
+//! instantiation), the calibrated timer, instructions and stack per case and per progressive
+//! stream, and the largest mesh it simplifies (bisection).
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{anyhow, bail, Context, Result};
+use meshfmt::{IndexType, Status};
+
+use super::build::{build, one_instantiation, ONE_INSTANTIATION};
+use super::run::{run_case, run_in, run_stream_bytes, scratch_dir};
+use super::Board;
+use crate::backend::Backend;
+use crate::golden::stream::StreamCase;
+use crate::golden::{self, Case, Golden, Outcome, Verdict};
+
+/// Image size by ELF section, in bytes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Sizes {
+    /// Allocated read-only sections plus the load image of `.data`: what goes into flash.
+    pub flash: u64,
+    /// `.data` + `.bss` + `.uninit`: static RAM.
+    pub static_ram: u64,
+    /// Of which `.text`.
+    pub text: u64,
+    /// Of which `.rodata`.
+    pub rodata: u64,
+    /// `.data`.
+    pub data: u64,
+    /// `.bss` + `.uninit`.
+    pub bss: u64,
+}
+
+/// Section sizes of a 32-bit little-endian ELF (what `size -A` would print, summed).
+pub fn elf_sizes(elf: &[u8]) -> Result<Sizes> {
+    let u16_at = |o: usize| -> Result<u64> {
+        Ok(u64::from(u16::from_le_bytes(
+            elf.get(o..o + 2).context("truncated ELF")?.try_into()?,
+        )))
+    };
+    let u32_at = |o: usize| -> Result<u64> {
+        Ok(u64::from(u32::from_le_bytes(
+            elf.get(o..o + 4).context("truncated ELF")?.try_into()?,
+        )))
+    };
+    if elf.get(0..4) != Some(b"\x7fELF") || elf.get(4) != Some(&1) || elf.get(5) != Some(&1) {
+        bail!("not a 32-bit little-endian ELF");
+    }
+    let shoff = u32_at(0x20)? as usize;
+    let shentsize = u16_at(0x2e)? as usize;
+    let shnum = u16_at(0x30)? as usize;
+    let shstrndx = u16_at(0x32)? as usize;
+    let sh = |i: usize, field: usize| u32_at(shoff + i * shentsize + field);
+    let strtab = sh(shstrndx, 0x10)? as usize;
+    let name_of = |i: usize| -> Result<String> {
+        let start = strtab + sh(i, 0)? as usize;
+        let end = elf[start..]
+            .iter()
+            .position(|&b| b == 0)
+            .context("section name")?
+            + start;
+        Ok(String::from_utf8_lossy(&elf[start..end]).into_owned())
+    };
+    const SHT_NOBITS: u64 = 8;
+    const SHF_WRITE: u64 = 1;
+    const SHF_ALLOC: u64 = 2;
+    let mut s = Sizes::default();
+    for i in 0..shnum {
+        let (ty, flags, size) = (sh(i, 4)?, sh(i, 8)?, sh(i, 0x14)?);
+        if flags & SHF_ALLOC == 0 {
+            continue;
+        }
+        let name = name_of(i)?;
+        // riscv-rt's link.x marks the free RAM as `.heap` and `.stack` (NOLOAD): not statics.
+        if name == ".heap" || name == ".stack" {
+            continue;
+        }
+        if ty == SHT_NOBITS {
+            s.static_ram += size;
+            s.bss += size;
+        } else {
+            s.flash += size;
+            if flags & SHF_WRITE != 0 {
+                s.static_ram += size;
+                s.data += size;
+            }
+        }
+        match name.as_str() {
+            ".text" => s.text += size,
+            ".rodata" => s.rodata += size,
+            _ => {}
+        }
+    }
+    Ok(s)
+}
+
+/// Runs the firmware's calibration loop (2 × 5 000 001 instructions) and returns the measured
+/// instructions per tick. With `-icount shift=0` it equals `1e9 / clock_hz` up to rounding.
+pub fn calibrate(board: &Board, elf: &Path) -> Result<f64> {
+    let dir = scratch_dir("calibrate")?;
+    let run = run_in(
+        board,
+        elf,
+        &dir,
+        &["calibrate", "cal.bin"],
+        Some("cal.bin"),
+        Duration::from_secs(60),
+    )?;
+    let _ = std::fs::remove_dir_all(&dir);
+    let bytes = run
+        .result
+        .as_ref()
+        .filter(|_| run.ok())
+        .ok_or_else(|| anyhow!("calibration on {} failed: {}", board.name, run.describe()))?;
+    let o = Outcome::decode(bytes)?;
+    if o.header.ticks == 0 {
+        bail!("the timer did not count on {}", board.name);
+    }
+    Ok(f64::from(o.header.error_a) / o.header.ticks as f64)
+}
+
+/// What `host-sim qemu --measure` reports for one board.
+#[derive(Clone, Debug)]
+pub struct Measurement {
+    /// Board.
+    pub board: &'static Board,
+    /// Math backend.
+    pub backend: Backend,
+    /// Image sizes of the firmware with the library.
+    pub sizes: Sizes,
+    /// Image sizes of the same firmware without the library (it echoes its input).
+    pub sizes_without: Sizes,
+    /// Flash of one instantiation on the board's target ([`one_instantiation`]): `.text +
+    /// .rodata` of the minimal firmware without and with the call.
+    pub instantiation: (u64, u64),
+    /// Measured instructions per timer tick.
+    pub instructions_per_tick: f64,
+    /// Workspace bytes (the library's static RAM on this board).
+    pub workspace_bytes: u32,
+    /// Capacity: vertices, u16 triangles, u32 triangles.
+    pub capacity: (u32, u32, u32),
+    /// Per case.
+    pub cases: Vec<CaseMeasurement>,
+    /// The largest mesh, per index type.
+    pub largest: Vec<Largest>,
+    /// The golden progressive streams, decoded on the board.
+    pub streams: Vec<StreamMeasurement>,
+}
+
+/// One golden stream decoded on a board (`meshfmt::pm::run`).
+#[derive(Clone, Debug)]
+pub struct StreamMeasurement {
+    /// Case name.
+    pub name: String,
+    /// Vertex splits received, and the trailer's tick counts converted to instructions:
+    /// decoding, coarsening every level, refining every level.
+    pub splits: u32,
+    /// See `splits`.
+    pub decode: u64,
+    /// See `splits`.
+    pub coarsen: u64,
+    /// See `splits`.
+    pub refine: u64,
+    /// Stack of the run.
+    pub stack_bytes: u32,
+    /// identical / skipped / DIFF / FAILED against the golden files.
+    pub verdict: &'static str,
+}
+
+/// One measured case.
+#[derive(Clone, Debug)]
+pub struct CaseMeasurement {
+    /// Case name.
+    pub name: String,
+    /// Triangles in.
+    pub triangles_in: u32,
+    /// Triangles out.
+    pub triangles_out: u32,
+    /// Collapses.
+    pub collapses: u32,
+    /// Instructions inside `Workspace::simplify`.
+    pub instructions: u64,
+    /// Stack used by the library (below its caller's frame).
+    pub stack_bytes: u32,
+    /// Deepest stack use of the whole firmware, from the top of the stack.
+    pub stack_high_water: u32,
+    /// `identical` to the host, `skipped` (too big), `DIFF` or `FAILED`.
+    pub verdict: &'static str,
+    /// Why it was skipped or failed.
+    pub note: String,
+}
+
+/// The largest mesh a board simplifies, found by bisection.
+#[derive(Clone, Debug)]
+pub struct Largest {
+    /// Index type of the probes.
+    pub index_type: IndexType,
+    /// Largest success: vertices, triangles, instructions.
+    pub ok: Option<(usize, usize, u64)>,
+    /// Smallest failure: vertices, triangles, why.
+    pub fail: Option<(usize, usize, String)>,
+    /// QEMU runs.
+    pub probes: u32,
+    /// Host time of the search.
+    pub wall: Duration,
+}
+
+/// The generated mesh of the capacity search: `strip T` (exactly `t` triangles, ≈ t/2
+/// vertices), simplified with `Config::new()`.
+pub fn probe_case(t: usize, index_type: IndexType) -> Case {
+    let m = meshfmt::golden::strip(t);
+    Case {
+        name: format!("strip-{t}"),
+        mesh: format!("strip {t}"),
+        positions: m.positions,
+        triangles: m.triangles,
+        index_type,
+        config: tinydecimate::Config::new(),
+        stored: None,
+    }
+}
+
+/// One capacity probe: `Ok((vertices, triangles, instructions))` if the board simplified
+/// it, `Err((vertices, why))` if not.
+type Probe = std::result::Result<(usize, usize, u64), (usize, String)>;
+
+/// Bisects the triangle count of [`probe_case`] until a run fails (the mesh does not fit, the
+/// library reports an error, or the firmware crashes or times out). Nothing is assumed about
+/// the board's capacity: doubling from 64 triangles finds a failure, bisection the boundary.
+pub fn largest_mesh(
+    board: &Board,
+    elf: &Path,
+    index_type: IndexType,
+    timeout: Duration,
+) -> Result<Largest> {
+    const LIMIT: usize = 4_000_000;
+    let t0 = Instant::now();
+    let mut probes = 0;
+    let mut probe = |t: usize| -> Result<Probe> {
+        probes += 1;
+        let case = probe_case(t, index_type);
+        let v = case.positions.len();
+        if index_type == IndexType::U16 && v > 1 << 16 {
+            return Ok(Err((v, "more vertices than u16 indices reach".into())));
+        }
+        let (outcome, run) = run_case(board, elf, &case, timeout)?;
+        Ok(match outcome {
+            Some(o) if o.header.status == Status::Ok => {
+                Ok((v, t, board.instructions(o.header.ticks)))
+            }
+            Some(o) if o.header.status == Status::TooBig => Err((
+                v,
+                format!(
+                    "too big for the buffers (holds {} vertices, {} triangles)",
+                    o.header.capacity_vertices, o.header.capacity_triangles
+                ),
+            )),
+            Some(o) => Err((
+                v,
+                format!("{:?} {:?}", o.header.status, o.header.error_kind),
+            )),
+            None => Err((
+                v,
+                format!(
+                    "firmware exit {:?}{}",
+                    run.exit_code,
+                    if run.timed_out { " (timed out)" } else { "" }
+                ),
+            )),
+        })
+    };
+    let (mut ok, mut lo) = (None, 0usize);
+    let mut fail = None;
+    let mut t = 64usize;
+    loop {
+        match probe(t)? {
+            Ok(r) => {
+                ok = Some(r);
+                lo = t;
+                if t >= LIMIT {
+                    break;
+                }
+                t = (t * 2).min(LIMIT);
+            }
+            Err((v, why)) => {
+                fail = Some((v, t, why));
+                break;
+            }
+        }
+    }
+    if let Some((_, mut hi, _)) = fail {
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match probe(mid)? {
+                Ok(r) => {
+                    ok = Some(r);
+                    lo = mid;
+                }
+                Err((v, why)) => {
+                    fail = Some((v, mid, why));
+                    hi = mid;
+                }
+            }
+        }
+    }
+    Ok(Largest {
+        index_type,
+        ok,
+        fail,
+        probes,
+        wall: t0.elapsed(),
+    })
+}
+
+/// Measures a board: image sizes with and without the library, calibration, every case of the
+/// manifest (compared with a fresh host run), and the largest mesh per index type.
+pub fn measure(
+    board: &'static Board,
+    backend: Backend,
+    cases: &[Case],
+    stream_cases: &[StreamCase],
+    timeout: Duration,
+) -> Result<Measurement> {
+    let without = build(board, backend, false)?;
+    let sizes_without = elf_sizes(&std::fs::read(&without)?)?;
+    let elf = build(board, backend, true)?;
+    let sizes = elf_sizes(&std::fs::read(&elf)?)?;
+    let instantiation = one_instantiation(board.target, backend)?;
+    // The calibration loop carries a few instructions of overhead, so it measures slightly
+    // over the exact figure; it only has to confirm the board's clock.
+    let measured = calibrate(board, &elf)?;
+    let ipt = board.instructions_per_tick();
+    if (measured - ipt).abs() > ipt * 1e-3 {
+        bail!(
+            "{}: the timer counts {measured:.4} instructions per tick, expected {ipt} \
+             (QEMU not run with -icount shift=0, or another clock?)",
+            board.name
+        );
+    }
+    let mut out = Vec::new();
+    let (mut workspace_bytes, mut capacity) = (0, (0, 0, 0));
+    for case in cases {
+        let expected = Golden::from_outcome(case, backend, &golden::reference(case)?)?;
+        let (outcome, run) = run_case(board, &elf, case, timeout)?;
+        let Some(o) = outcome else {
+            out.push(CaseMeasurement {
+                name: case.name.clone(),
+                triangles_in: case.triangles.len() as u32,
+                triangles_out: 0,
+                collapses: 0,
+                instructions: 0,
+                stack_bytes: 0,
+                stack_high_water: 0,
+                verdict: "FAILED",
+                note: run.describe(),
+            });
+            continue;
+        };
+        let h = &o.header;
+        if h.status != Status::TooBig {
+            workspace_bytes = h.workspace_bytes;
+        }
+        let it_cap = h.capacity_triangles;
+        match case.index_type {
+            IndexType::U16 => capacity = (h.capacity_vertices, it_cap, capacity.2),
+            IndexType::U32 => capacity = (h.capacity_vertices, capacity.1, it_cap),
+        }
+        let v = golden::judge(case, backend, &expected, &o)?;
+        out.push(CaseMeasurement {
+            name: case.name.clone(),
+            triangles_in: h.triangles_in,
+            triangles_out: h.triangles_out,
+            collapses: h.collapses,
+            instructions: board.instructions(h.ticks),
+            stack_bytes: h.stack_bytes,
+            stack_high_water: h.stack_high_water,
+            verdict: v.cell(),
+            note: match &v {
+                Verdict::Skipped(w) | Verdict::Failed(w) => w.clone(),
+                Verdict::Diff(d) => d.join("; "),
+                Verdict::Identical => String::new(),
+            },
+        });
+    }
+    let mut largest = Vec::new();
+    for it in [IndexType::U16, IndexType::U32] {
+        let l = largest_mesh(board, &elf, it, timeout)?;
+        eprintln!(
+            "{}: largest {} mesh found in {} QEMU runs, {:.1} s",
+            board.name,
+            if it == IndexType::U16 { "u16" } else { "u32" },
+            l.probes,
+            l.wall.as_secs_f64()
+        );
+        largest.push(l);
+    }
+    let mut streams = Vec::new();
+    for sc in stream_cases {
+        let expected = crate::golden::stream::golden_from_output(
+            sc,
+            backend,
+            &crate::golden::stream::reference(sc),
+        )?;
+        let run = run_stream_bytes(board, &elf, &sc.stream, timeout)?;
+        let (verdict, summary) = match (&run.result, run.ok()) {
+            (Some(o), true) => (
+                crate::golden::stream::judge(sc, backend, &expected, o).cell(),
+                meshfmt::pm::parse(o).map(|(_, s)| s),
+            ),
+            _ => ("FAILED", None),
+        };
+        let s = summary.unwrap_or_default();
+        streams.push(StreamMeasurement {
+            name: sc.name().to_string(),
+            splits: s.splits,
+            decode: board.instructions(s.decode_ticks),
+            coarsen: board.instructions(s.coarsen_ticks),
+            refine: board.instructions(s.refine_ticks),
+            stack_bytes: s.stack_bytes,
+            verdict,
+        });
+    }
+    Ok(Measurement {
+        board,
+        backend,
+        sizes,
+        sizes_without,
+        instantiation,
+        instructions_per_tick: measured,
+        workspace_bytes,
+        capacity,
+        cases: out,
+        largest,
+        streams,
+    })
+}
+
+/// Signed difference of two sizes.
+fn delta(a: u64, b: u64) -> i64 {
+    a as i64 - b as i64
+}
+
+/// Prints a measurement: sizes, then one line per case, then the largest meshes.
+pub fn print_measurement(m: &Measurement) {
+    let b = m.board;
+    let (s, w) = (&m.sizes, &m.sizes_without);
+    crate::outln!(
+        "\n== {} ({}, {}), {} backend",
+        b.name,
+        b.core,
+        b.target,
+        m.backend
+    );
+    crate::outln!(
+        "firmware:      flash {:>8} B (text {}, rodata {}, .data image {}), static RAM {:>8} B of {} KB, stack {} B",
+        s.flash,
+        s.text,
+        s.rodata,
+        s.data,
+        s.static_ram,
+        b.ram >> 10,
+        u64::from(b.ram).saturating_sub(s.static_ram)
+    );
+    let lib_stack = m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0);
+    crate::outln!(
+        "library alone: flash {:>8} B (text {:+}, rodata {:+}), static RAM {:>8} B (workspace {} B) + stack <= {} B \
+         [image with the library - image without]",
+        delta(s.flash, w.flash),
+        delta(s.text, w.text),
+        delta(s.rodata, w.rodata),
+        delta(s.static_ram, w.static_ram),
+        m.workspace_bytes,
+        lib_stack
+    );
+    let (without, with) = m.instantiation;
+    crate::outln!(
+        "instantiation: flash {:>8} B ({:.1} KB; text + rodata {with} with the call - {without} without) \
+         [tests/flash as scripts/flash.sh builds it: {ONE_INSTANTIATION}]",
+        delta(with, without),
+        delta(with, without) as f64 / 1024.0,
+    );
+    crate::outln!(
+        "capacity:      {} vertices, {} u16 / {} u32 triangles; {:.4} instructions per timer tick (calibrated)",
+        m.capacity.0, m.capacity.1, m.capacity.2, m.instructions_per_tick
+    );
+    crate::outln!(
+        "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  vs host",
+        "case",
+        "in",
+        "out",
+        "collapses",
+        "instructions",
+        "instr/coll",
+        "stack lib",
+        "high-water"
+    );
+    for c in &m.cases {
+        if c.verdict == "skipped" || c.verdict == "FAILED" {
+            crate::outln!(
+                "  {:<26} {:>6}  {}: {}",
+                c.name,
+                c.triangles_in,
+                c.verdict,
+                c.note
+            );
+            continue;
+        }
+        let per = if c.collapses > 0 {
+            format!("{}", c.instructions / u64::from(c.collapses))
+        } else {
+            "-".into()
+        };
+        crate::outln!(
+            "  {:<26} {:>6} {:>6} {:>9} {:>13} {:>11} {:>9} {:>10}  {}",
+            c.name,
+            c.triangles_in,
+            c.triangles_out,
+            c.collapses,
+            c.instructions,
+            per,
+            c.stack_bytes,
+            c.stack_high_water,
+            c.verdict
+        );
+    }
+    for l in &m.largest {
+        let it = if l.index_type == IndexType::U16 {
+            "u16"
+        } else {
+            "u32"
+        };
+        let ok = match l.ok {
+            Some((v, t, i)) => format!("{t} triangles / {v} vertices simplify ({i} instructions)"),
+            None => "nothing simplifies".into(),
+        };
+        let fail = match &l.fail {
+            Some((v, t, why)) => format!("{t} / {v} fail: {why}"),
+            None => "no failure up to the search limit".into(),
+        };
+        crate::outln!(
+            "largest {it} mesh (bisecting `strip T`, Config::new()): {ok}; {fail} [{} runs, {:.1} s]",
+            l.probes,
+            l.wall.as_secs_f64()
+        );
+    }
+    crate::outln!(
+        "  {:<26} {:>6} {:>13} {:>13} {:>13} {:>9}  vs host   [progressive streams, instructions per split]",
+        "stream",
+        "splits",
+        "decode",
+        "collapse",
+        "split",
+        "stack"
+    );
+    for st in &m.streams {
+        if st.verdict != "identical" {
+            crate::outln!("  {:<26} {}", st.name, st.verdict);
+            continue;
+        }
+        let per = |x: u64| format!("{:.0}", x as f64 / f64::from(st.splits.max(1)));
+        crate::outln!(
+            "  {:<26} {:>6} {:>13} {:>13} {:>13} {:>9}  {}",
+            st.name,
+            st.splits,
+            per(st.decode),
+            per(st.coarsen),
+            per(st.refine),
+            st.stack_bytes,
+            st.verdict
+        );
+    }
+}
+
+/// The summary table of several boards' measurements.
+pub fn print_summary(ms: &[Measurement]) {
+    if ms.is_empty() {
+        return;
+    }
+    crate::outln!(
+        "\nsummary ({} backend); sizes in bytes; lib = firmware image with - without the library; \
+         1-inst = one instantiation ({ONE_INSTANTIATION}; scripts/flash.sh); \
+         instr/collapse over the cases run (min..max)",
+        ms[0].backend
+    );
+    crate::outln!(
+        "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+        "board",
+        "fw flash",
+        "fw RAM",
+        "lib flash",
+        "1-inst flash",
+        "lib RAM",
+        "lib stack",
+        "instr/collapse",
+        "high-water",
+        "largest u16",
+        "largest u32"
+    );
+    for m in ms {
+        let per: Vec<u64> = m
+            .cases
+            .iter()
+            .filter(|c| c.collapses > 0)
+            .map(|c| c.instructions / u64::from(c.collapses))
+            .collect();
+        let range = match (per.iter().min(), per.iter().max()) {
+            (Some(a), Some(b)) => format!("{a}..{b}"),
+            _ => "-".into(),
+        };
+        let largest = |i: usize| {
+            m.largest
+                .get(i)
+                .and_then(|l| l.ok)
+                .map_or("-".into(), |(v, t, _)| format!("{t} T/{v} V"))
+        };
+        crate::outln!(
+            "{:<20} {:>9} {:>9} {:>9} {:>12} {:>9} {:>9} {:>17} {:>10} {:>15} {:>15}",
+            m.board.name,
+            m.sizes.flash,
+            m.sizes.static_ram,
+            delta(m.sizes.flash, m.sizes_without.flash),
+            delta(m.instantiation.1, m.instantiation.0),
+            delta(m.sizes.static_ram, m.sizes_without.static_ram),
+            m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0),
+            range,
+            m.cases
+                .iter()
+                .map(|c| c.stack_high_water)
+                .max()
+                .unwrap_or(0),
+            largest(0),
+            largest(1)
+        );
+    }
+}
