@@ -561,7 +561,7 @@ fn run_method(
         let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
             (Some(config), placement) => {
                 // Seams welded (`host-sim simplify`'s default), when the mesh has any.
-                let (out, report, elapsed) = crate::simplify::simplify_seams(
+                let (out, report, elapsed) = crate::simplify::simplify_parts(
                     mesh,
                     &config.with_ratio(ratio),
                     crate::simplify::OperatorArg::Edge,
@@ -569,13 +569,15 @@ fn run_method(
                     false,
                     false,
                     true,
+                    true,
                 )?;
                 let quadrics = if placement.is_some() {
                     v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
                 };
-                let bytes = workspace_bytes(v, t).0 + quadrics + wedge_bytes(mesh);
+                let bytes =
+                    workspace_bytes(v, t).0 + quadrics + wedge_bytes(mesh) + part_bytes(v, &config);
                 (out, elapsed, bytes, Some(report))
             }
             (None, _) => {
@@ -616,6 +618,16 @@ fn wedge_bytes(mesh: &MeshData) -> usize {
     3 * index * mesh.triangles.len()
 }
 
+/// Bytes of the part links a pruning run keeps (`Simplifier::with_parts`): two links per
+/// vertex (`u16` below 65 536 vertices), when the mode prunes.
+fn part_bytes(vertices: usize, config: &tinydecimate::Config) -> usize {
+    if !crate::simplify::prunes(true, config, false) {
+        return 0;
+    }
+    let link = if vertices <= 65_535 { 2 } else { 4 };
+    2 * link * vertices
+}
+
 /// Runs the benchmark. `command` is recorded as given.
 pub fn bench(opts: &Options, command: &str) -> Result<Results> {
     if opts.reps == 0 {
@@ -654,8 +666,10 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                 let run = run_method(mesh, method, ratio, target, opts.reps)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
                 // Ours welded seams: checked welded (no crack), as `host-sim simplify` does.
+                // Ours also prune parts: a part gone whole is allowed, one cut in part is not.
+                let ours = method.is_ours();
                 let validity =
-                    crate::check::compare_opts(mesh, &run.out, method.moves(), method.is_ours());
+                    crate::check::compare_parts(mesh, &run.out, method.moves(), ours, ours);
                 let m = metro(mesh, &run.out, &metro_opts);
                 let triangles_out = run.out.triangles.len();
                 rows.push(Row {

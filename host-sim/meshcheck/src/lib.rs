@@ -93,6 +93,13 @@ pub struct Options<'a> {
     /// changed boundary loops; and the input wedges of positions the output still uses but
     /// the output does not are counted ([`Verdict::lost_wedges`]).
     pub welded: bool,
+    /// Parts may vanish (`tinydecimate` with `Simplifier::with_parts`): a component of the
+    /// cleaned input none of whose vertices the output uses was removed on purpose and is
+    /// counted ([`Verdict::parts_removed`]); every test then compares the output with the
+    /// input less those components. A component the output still touches is compared in
+    /// full, so one cut in part is refused as before (its new boundary, its changed Euler
+    /// characteristic or loops). With `welded`, components of positions.
+    pub parts: bool,
 }
 
 /// Topology and defect counts of a mesh. See the crate documentation for the definitions.
@@ -290,6 +297,9 @@ pub struct Verdict {
     /// (information, not a defect: a face of a flat-shaded model collapsed away takes its own
     /// wedges with it).
     pub lost_wedges: usize,
+    /// With [`Options::parts`]: components of the cleaned input that the output does not
+    /// touch at all (removed whole, not a defect).
+    pub parts_removed: usize,
     /// Boundary loops of the cleaned input and of the output.
     pub boundary_loops: (usize, usize),
     /// Euler characteristic of the cleaned input and of the output.
@@ -364,6 +374,13 @@ impl fmt::Display for Verdict {
                 f,
                 "  wedges gone with faces   {}      (welded seams: their regions collapsed away)",
                 v.lost_wedges
+            )?;
+        }
+        if v.parts_removed > 0 {
+            writeln!(
+                f,
+                "  parts removed whole      {}      (compared: the input less those parts)",
+                v.parts_removed
             )?;
         }
         let note = if v.topology_compared {
@@ -802,9 +819,43 @@ fn check_welded(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     v
 }
 
+/// `cleaned` less its components that `output` does not touch, and how many those were.
+fn without_absent_parts(nv: usize, cleaned: &[Tri], output: &[Tri]) -> (Vec<Tri>, usize) {
+    let mut dsu = Dsu::new(nv);
+    for t in cleaned {
+        dsu.union(t[0], t[1]);
+        dsu.union(t[1], t[2]);
+    }
+    let mut present = vec![false; nv];
+    for &v in output.iter().flatten() {
+        if (v as usize) < nv {
+            let r = dsu.find(v);
+            present[r as usize] = true;
+        }
+    }
+    let mut absent = BTreeSet::new();
+    let kept = cleaned
+        .iter()
+        .copied()
+        .filter(|t| {
+            let r = dsu.find(t[0]);
+            if !present[r as usize] {
+                absent.insert(r);
+            }
+            present[r as usize]
+        })
+        .collect();
+    (kept, absent.len())
+}
+
 fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     let raw = analyse_with(input.positions, input.triangles, opts);
     let cleaned = clean(input.positions, input.triangles);
+    let (cleaned, parts_removed) = if opts.parts {
+        without_absent_parts(input.positions.len(), &cleaned, output.triangles)
+    } else {
+        (cleaned, 0)
+    };
     let cin = analyse_with(input.positions, &cleaned, opts);
     let out = analyse_with(output.positions, output.triangles, opts);
     let mut d = Vec::new();
@@ -918,6 +969,7 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         new_vertices,
         new_boundary_vertices,
         lost_wedges: 0,
+        parts_removed,
         boundary_loops: (ti.boundary_loops, to.boundary_loops),
         euler: (ti.euler, to.euler),
         components: (ti.components, to.components),
@@ -1047,6 +1099,7 @@ mod tests {
                 view: Some(view),
                 allow_moved: false,
                 welded: false,
+                parts: false,
             },
         );
         assert_eq!((a.folded.len(), a.folded_true.len()), (0, 1));

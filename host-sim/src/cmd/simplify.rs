@@ -644,12 +644,16 @@ fn measure(
         .map_err(|e| anyhow!("{e}"))
         .and_then(|b| crate::io::parse_bytes(&b, &ext))
         .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
-    let (_, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    let (read, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    // Pruned parts: an input part the output does not touch was removed on purpose.
+    let parts = args.parts == PartsArg::Prune;
     if args.seams == SeamsArg::Weld {
         // Welded seams: the result in the input's numbering (a written file matches twins by
         // position in order, which cannot say which wedge a corner was), both welded by
         // position, and the wedges of the kept positions.
-        validity = crate::check::compare_opts(mesh, out, *moved, true);
+        validity = crate::check::compare_parts(mesh, out, *moved, true, parts);
+    } else if parts {
+        validity = crate::check::compare_parts(mesh, &read, *moved, false, true);
     }
     let valid = validity.is_valid();
     let _ = writeln!(
