@@ -109,6 +109,8 @@ pub struct Options {
     pub samples_per_triangle: f64,
     /// Show a progress bar (only if stderr is a terminal).
     pub progress: bool,
+    /// Our modes prune parts (`host-sim simplify --parts prune`, the default).
+    pub prune: bool,
 }
 
 /// One simplifier.
@@ -553,6 +555,7 @@ fn run_method(
     ratio: f32,
     target: usize,
     reps: usize,
+    prune: bool,
 ) -> Result<Run> {
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let mut times_ms = Vec::with_capacity(reps);
@@ -569,15 +572,17 @@ fn run_method(
                     false,
                     false,
                     true,
-                    true,
+                    prune,
                 )?;
                 let quadrics = if placement.is_some() {
                     v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
                 };
-                let bytes =
-                    workspace_bytes(v, t).0 + quadrics + wedge_bytes(mesh) + part_bytes(v, &config);
+                let bytes = workspace_bytes(v, t).0
+                    + quadrics
+                    + wedge_bytes(mesh)
+                    + part_bytes(v, &config, prune);
                 (out, elapsed, bytes, Some(report))
             }
             (None, _) => {
@@ -620,8 +625,8 @@ fn wedge_bytes(mesh: &MeshData) -> usize {
 
 /// Bytes of the part links a pruning run keeps (`Simplifier::with_parts`): two links per
 /// vertex (`u16` below 65 536 vertices), when the mode prunes.
-fn part_bytes(vertices: usize, config: &tinydecimate::Config) -> usize {
-    if !crate::simplify::prunes(true, config, false) {
+fn part_bytes(vertices: usize, config: &tinydecimate::Config, prune: bool) -> usize {
+    if !crate::simplify::prunes(prune, config, false) {
         return 0;
     }
     let link = if vertices <= 65_535 { 2 } else { 4 };
@@ -663,13 +668,18 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
             let first = rows.len();
             for method in Method::ALL {
                 bar.set_message(format!("{name} {ratio} {}", method.label()));
-                let run = run_method(mesh, method, ratio, target, opts.reps)
+                let run = run_method(mesh, method, ratio, target, opts.reps, opts.prune)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
                 // Ours welded seams: checked welded (no crack), as `host-sim simplify` does.
-                // Ours also prune parts: a part gone whole is allowed, one cut in part is not.
+                // Ours may prune parts: a part gone whole is allowed, one cut in part is not.
                 let ours = method.is_ours();
-                let validity =
-                    crate::check::compare_parts(mesh, &run.out, method.moves(), ours, ours);
+                let validity = crate::check::compare_parts(
+                    mesh,
+                    &run.out,
+                    method.moves(),
+                    ours,
+                    ours && opts.prune,
+                );
                 let m = metro(mesh, &run.out, &metro_opts);
                 let triangles_out = run.out.triangles.len();
                 rows.push(Row {
@@ -720,7 +730,14 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                     "{name} {ratio} meshoptimizer at {} triangles",
                     r.triangles_out
                 ));
-                let run = run_method(mesh, Method::Meshopt, ratio, r.triangles_out, opts.reps)?;
+                let run = run_method(
+                    mesh,
+                    Method::Meshopt,
+                    ratio,
+                    r.triangles_out,
+                    opts.reps,
+                    opts.prune,
+                )?;
                 let validity = compare(mesh, &run.out);
                 let m = metro(mesh, &run.out, &metro_opts);
                 r.same_count = Some(SameCount {
@@ -1015,6 +1032,7 @@ mod tests {
             reps: 1,
             samples_per_triangle: 2.0,
             progress: false,
+            prune: true,
         };
         let r = bench(&opts, "test").unwrap();
         check_rows(&r);
