@@ -1052,6 +1052,80 @@ mod tests {
         }));
     }
 
+    /// With `parts`, a component the output does not touch is allowed and counted; one cut in
+    /// part, a new boundary on a kept part, or a defect elsewhere is still refused.
+    #[test]
+    fn parts_gone_whole_are_allowed_and_cut_ones_refused() {
+        // A closed octahedron (vertices 0-5) and a 3 x 3 grid beside it (vertices 6-21).
+        let mut p: Vec<[f32; 3]> = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let mut t: Vec<Tri> = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let (gp, gt) = grid(3);
+        p.extend(gp.iter().map(|q| [q[0] + 5.0, q[1], q[2]]));
+        t.extend(gt.iter().map(|x| x.map(|v| v + 6)));
+        let opts = Options {
+            parts: true,
+            ..Default::default()
+        };
+        let verdict = |o: &[Tri]| {
+            check_with(
+                MeshRef {
+                    positions: &p,
+                    triangles: &t,
+                },
+                MeshRef {
+                    positions: &p,
+                    triangles: o,
+                },
+                &opts,
+            )
+        };
+        // The octahedron gone whole: valid, one part removed; without the option a defect.
+        let grid_only = t[8..].to_vec();
+        let v = verdict(&grid_only);
+        assert!(v.is_valid(), "{v}");
+        assert_eq!((v.parts_removed, v.components), (1, (1, 1)));
+        assert!(!check(&p, &t, &grid_only).is_valid());
+        // The octahedron cut in part (one face left open): refused.
+        let cut: Vec<Tri> = t[1..].to_vec();
+        let v = verdict(&cut);
+        assert_eq!(v.parts_removed, 0);
+        assert_eq!(v.new_boundary_vertices, 3, "{v}");
+        assert!(v.defects.contains(&Defect::BoundaryLoops {
+            input: 1,
+            output: 2
+        }));
+        // Cut down to one triangle of the octahedron: still refused.
+        let mut rest = grid_only.clone();
+        rest.push(t[0]);
+        assert!(!verdict(&rest).is_valid());
+        // The octahedron gone and a hole in the grid: the new boundary is refused.
+        let mut holed = grid_only.clone();
+        holed.drain(8..10);
+        let v = verdict(&holed);
+        assert_eq!(v.parts_removed, 1);
+        assert!(v.new_boundary_vertices > 0, "{v}");
+        assert!(!v.is_valid());
+        // Everything gone: both parts removed, nothing else to say.
+        let v = verdict(&[]);
+        assert_eq!(v.parts_removed, 2);
+    }
+
     #[test]
     fn dirty_input_is_compared_after_cleaning() {
         let (p, t) = grid(2);
