@@ -256,6 +256,8 @@ pub struct Stopped {
     pub feature_vertices: usize,
     /// Passes (greedy: rounds of the queue).
     pub passes: u32,
+    /// Parts removed whole (`--parts prune`).
+    pub parts_removed: usize,
     /// Refused candidates by reason.
     pub rejected: Rejected,
 }
@@ -268,6 +270,7 @@ impl Stopped {
             locked_vertices: r.locked_vertices,
             feature_vertices: r.feature_vertices,
             passes: r.passes,
+            parts_removed: r.parts_removed,
             rejected: Rejected::of(r),
         }
     }
