@@ -84,9 +84,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// part (the last in size order) always stays. [`Report::parts_removed`](crate::Report)
     /// counts them; a removed part's vertices count as removed.
     ///
-    /// `links`: two per vertex (`Storage::VERTEX_BYTES`' link size twice: 4 B with `u16`), at
-    /// least as many as positions; their contents on entry do not matter. Labelling and
-    /// sorting the parts happens here (O(T log V)).
+    /// `links`: one pair of links per position (4 B with `u16` links, 8 B with `u32`), at
+    /// least as many pairs as positions; their contents on entry do not matter. The parts are
+    /// labelled and sorted here, in O(T log V).
     ///
     /// Errors: [`Error::Capacity`] (vertices) if `links` is short;
     /// [`Error::InvalidConfig`] for [`ConfigField::Parts`] with the passes schedule, an error
