@@ -52,6 +52,9 @@ pub enum ConfigField {
     Placement,
     /// [`Config::cost`](crate::Config::cost) names another cost than the one given to [`Storage::start`](crate::Storage::start).
     Cost,
+    /// Removing whole parts (`Simplifier::with_parts`, crate feature `parts`) with the passes
+    /// schedule, an error bound or a collapse log, or asked for after the first step.
+    Parts,
 }
 
 /// Why a mesh was not simplified. Every error is returned before the caller's triangle buffer
@@ -139,6 +142,11 @@ impl core::fmt::Display for Error {
                 ConfigField::Cost => write!(
                     f,
                     "configuration field Cost names another cost than the one given"
+                ),
+                ConfigField::Parts => write!(
+                    f,
+                    "configuration field Parts: removing parts needs the greedy schedule, no \
+                     error bound and no collapse log, before the first step"
                 ),
                 _ => write!(f, "configuration field {field:?} is out of range"),
             },

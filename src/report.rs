@@ -89,6 +89,9 @@ pub struct Report {
     pub collapses: usize,
     /// Vertices that lost all their triangles.
     pub vertices_removed: usize,
+    /// Parts (connected components) removed whole because they cost less than the collapses
+    /// left (`Simplifier::with_parts`, crate feature `parts`); 0 otherwise.
+    pub parts_removed: usize,
     /// Vertices locked because the mesh is not a manifold around them.
     pub locked_vertices: usize,
     /// Feature vertices found by the last global classification (the start of the last pass

@@ -756,6 +756,7 @@ fn check_output<I: Idx>(
         }),
         allow_moved: false,
         welded: false,
+        parts: false,
     };
     let mesh = |triangles| meshcheck::MeshRef {
         positions: pos,

@@ -109,6 +109,8 @@ pub struct Options {
     pub samples_per_triangle: f64,
     /// Show a progress bar (only if stderr is a terminal).
     pub progress: bool,
+    /// Our modes prune parts (`host-sim simplify --parts prune`, the default).
+    pub prune: bool,
 }
 
 /// One simplifier.
@@ -254,6 +256,8 @@ pub struct Stopped {
     pub feature_vertices: usize,
     /// Passes (greedy: rounds of the queue).
     pub passes: u32,
+    /// Parts removed whole (`--parts prune`).
+    pub parts_removed: usize,
     /// Refused candidates by reason.
     pub rejected: Rejected,
 }
@@ -266,6 +270,7 @@ impl Stopped {
             locked_vertices: r.locked_vertices,
             feature_vertices: r.feature_vertices,
             passes: r.passes,
+            parts_removed: r.parts_removed,
             rejected: Rejected::of(r),
         }
     }
@@ -553,6 +558,7 @@ fn run_method(
     ratio: f32,
     target: usize,
     reps: usize,
+    prune: bool,
 ) -> Result<Run> {
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let mut times_ms = Vec::with_capacity(reps);
@@ -561,7 +567,7 @@ fn run_method(
         let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
             (Some(config), placement) => {
                 // Seams welded (`host-sim simplify`'s default), when the mesh has any.
-                let (out, report, elapsed) = crate::simplify::simplify_seams(
+                let (out, report, elapsed) = crate::simplify::simplify_parts(
                     mesh,
                     &config.with_ratio(ratio),
                     crate::simplify::OperatorArg::Edge,
@@ -569,13 +575,17 @@ fn run_method(
                     false,
                     false,
                     true,
+                    prune,
                 )?;
                 let quadrics = if placement.is_some() {
                     v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
                 };
-                let bytes = workspace_bytes(v, t).0 + quadrics + wedge_bytes(mesh);
+                let bytes = workspace_bytes(v, t).0
+                    + quadrics
+                    + wedge_bytes(mesh)
+                    + part_bytes(v, &config, prune);
                 (out, elapsed, bytes, Some(report))
             }
             (None, _) => {
@@ -616,6 +626,16 @@ fn wedge_bytes(mesh: &MeshData) -> usize {
     3 * index * mesh.triangles.len()
 }
 
+/// Bytes of the part links a pruning run keeps (`Simplifier::with_parts`): two links per
+/// vertex (`u16` below 65 536 vertices), when the mode prunes.
+fn part_bytes(vertices: usize, config: &tinydecimate::Config, prune: bool) -> usize {
+    if !crate::simplify::prunes(prune, config, false) {
+        return 0;
+    }
+    let link = if vertices <= 65_535 { 2 } else { 4 };
+    2 * link * vertices
+}
+
 /// Runs the benchmark. `command` is recorded as given.
 pub fn bench(opts: &Options, command: &str) -> Result<Results> {
     if opts.reps == 0 {
@@ -651,11 +671,18 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
             let first = rows.len();
             for method in Method::ALL {
                 bar.set_message(format!("{name} {ratio} {}", method.label()));
-                let run = run_method(mesh, method, ratio, target, opts.reps)
+                let run = run_method(mesh, method, ratio, target, opts.reps, opts.prune)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
                 // Ours welded seams: checked welded (no crack), as `host-sim simplify` does.
-                let validity =
-                    crate::check::compare_opts(mesh, &run.out, method.moves(), method.is_ours());
+                // Ours may prune parts: a part gone whole is allowed, one cut in part is not.
+                let ours = method.is_ours();
+                let validity = crate::check::compare_parts(
+                    mesh,
+                    &run.out,
+                    method.moves(),
+                    ours,
+                    ours && opts.prune,
+                );
                 let m = metro(mesh, &run.out, &metro_opts);
                 let triangles_out = run.out.triangles.len();
                 rows.push(Row {
@@ -706,7 +733,14 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                     "{name} {ratio} meshoptimizer at {} triangles",
                     r.triangles_out
                 ));
-                let run = run_method(mesh, Method::Meshopt, ratio, r.triangles_out, opts.reps)?;
+                let run = run_method(
+                    mesh,
+                    Method::Meshopt,
+                    ratio,
+                    r.triangles_out,
+                    opts.reps,
+                    opts.prune,
+                )?;
                 let validity = compare(mesh, &run.out);
                 let m = metro(mesh, &run.out, &metro_opts);
                 r.same_count = Some(SameCount {
@@ -1001,6 +1035,7 @@ mod tests {
             reps: 1,
             samples_per_triangle: 2.0,
             progress: false,
+            prune: true,
         };
         let r = bench(&opts, "test").unwrap();
         check_rows(&r);

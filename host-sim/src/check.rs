@@ -33,6 +33,19 @@ pub fn compare_opts(
     allow_moved: bool,
     welded: bool,
 ) -> Validity {
+    compare_parts(input, output, allow_moved, welded, false)
+}
+
+/// [`compare_opts`]; with `parts`, an input component the output does not touch was removed
+/// whole on purpose (`Simplifier::with_parts`): counted, and the rest compared
+/// (`meshcheck::Options::parts`).
+pub fn compare_parts(
+    input: &MeshData,
+    output: &MeshData,
+    allow_moved: bool,
+    welded: bool,
+    parts: bool,
+) -> Validity {
     meshcheck::check_with(
         meshcheck::MeshRef {
             positions: &input.positions,
@@ -46,6 +59,7 @@ pub fn compare_opts(
             view: None,
             allow_moved,
             welded,
+            parts,
         },
     )
 }

@@ -92,6 +92,33 @@ pub fn simplify_seams(
     progress: bool,
     weld: bool,
 ) -> Result<(MeshData, Report, Duration)> {
+    simplify_parts(
+        mesh, config, operator, placement, bounded, progress, weld, false,
+    )
+}
+
+/// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
+/// prunes in (the greedy schedule, no error bound).
+pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
+    prune && !bounded && config.schedule == tinydecimate::Schedule::Greedy
+}
+
+/// [`simplify_seams`]; with `prune`, parts cheaper than the next collapse vanish whole
+/// (`Simplifier::with_parts`, two `u32` links per vertex) in the runs where the library
+/// prunes ([`prunes`]); the others keep every part.
+#[allow(clippy::too_many_arguments)]
+pub fn simplify_parts(
+    mesh: &MeshData,
+    config: &Config,
+    operator: OperatorArg,
+    placement: Option<Placement>,
+    bounded: bool,
+    progress: bool,
+    weld: bool,
+    prune: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    let prune = prunes(prune, config, bounded);
+    let mut part_links = vec![[0u32; 2]; if prune { mesh.positions.len() } else { 0 }];
     let mut tris = mesh.triangles.clone();
     let mut positions = mesh.positions.clone();
     let n = if placement.is_some() {
@@ -136,10 +163,15 @@ pub fn simplify_seams(
                 .storage()
                 .start($p, &mut tris, config, $cost, $bound, $op)
                 .map_err(library_error)?;
-            let mut s = if wedges.is_empty() {
+            let s = if wedges.is_empty() {
                 s
             } else {
                 s.with_wedges(&mut wedges).map_err(library_error)?
+            };
+            let mut s = if prune {
+                s.with_parts(&mut part_links).map_err(library_error)?
+            } else {
+                s
             };
             let n0 = s.live_triangles();
             while !s.step(budget) {
@@ -221,6 +253,7 @@ pub fn format_report(r: &Report) -> String {
          \x20 stop                   {:?}\n\
          \x20 collapses              {}\n\
          \x20 vertices removed       {}\n\
+         \x20 parts removed          {}\n\
          \x20 locked vertices        {}\n\
          \x20 feature vertices       {}\n\
          \x20 passes                 {}\n\
@@ -236,6 +269,7 @@ pub fn format_report(r: &Report) -> String {
         r.stop,
         r.collapses,
         r.vertices_removed,
+        r.parts_removed,
         r.locked_vertices,
         r.feature_vertices,
         r.passes,
@@ -277,6 +311,7 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "stop": format!("{:?}", r.stop),
         "collapses": r.collapses,
         "vertices_removed": r.vertices_removed,
+        "parts_removed": r.parts_removed,
         "locked_vertices": r.locked_vertices,
         "feature_vertices": r.feature_vertices,
         "passes": r.passes,

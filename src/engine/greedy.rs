@@ -62,7 +62,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             // collapses: a new round re-keys everything, and only a round without a collapse
             // ends the run.
             if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
-                self.done(Stop::NoLegalCollapse);
+                // Short of the target: the smallest parts may still go (`with_parts`).
+                if !self.prune_below(f32::INFINITY) {
+                    self.done(Stop::NoLegalCollapse);
+                }
             } else {
                 self.new_round();
             }
@@ -74,6 +77,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             self.refresh_only = true;
             self.phase = Phase::Mean;
             self.v = 0;
+            return None;
+        }
+        if self.prune_below(key) {
+            // A part cheaper than this collapse went first (`with_parts`).
             return None;
         }
         if key > self.config.max_cost {

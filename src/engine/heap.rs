@@ -146,6 +146,17 @@ impl<'a, L: Index> Heap<'a, L> {
         self.slot_of(v).map(|_| self.key_of(v))
     }
 
+    /// The key array while nothing is queued (scratch before the first round: pruning sorts
+    /// its parts' sizes there); `None` once a vertex is queued.
+    #[cfg(feature = "parts")]
+    pub(crate) fn idle_keys(&mut self) -> Option<&mut [f32]> {
+        if self.len == 0 {
+            Some(&mut *self.key)
+        } else {
+            None
+        }
+    }
+
     /// The cheapest vertex and its key, without removing it.
     pub(crate) fn peek(&self) -> Option<(usize, f32)> {
         if self.len == 0 {

@@ -43,6 +43,7 @@ use heap::Heap;
 mod greedy;
 pub(crate) mod heap;
 mod log;
+mod parts;
 mod passes;
 mod price;
 mod report;
@@ -121,6 +122,9 @@ pub struct Simplifier<
     bound: B,
     /// The operator (a type: no state).
     operator: PhantomData<O>,
+    /// Parts that may vanish whole (`with_parts`).
+    #[cfg(feature = "parts")]
+    parts: parts::Parts<'a, L>,
 }
 
 impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
@@ -168,6 +172,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             initialised: false,
             bound,
             operator: PhantomData,
+            #[cfg(feature = "parts")]
+            parts: parts::Parts::off(),
         };
         if B::ON {
             s.enrol();

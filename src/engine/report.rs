@@ -30,6 +30,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             stop,
             collapses: self.collapses,
             vertices_removed: self.used_in.saturating_sub(used),
+            parts_removed: self.parts_removed(),
             locked_vertices: self.locked,
             feature_vertices: self.features,
             passes: self.passes,

@@ -262,6 +262,23 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         self.live = self.live.saturating_sub(1);
     }
 
+    /// Removes every triangle around `v` (pruning a whole part); returns how many. `v` and
+    /// the vertices it shared them with lose their flags once they have none left.
+    #[cfg(feature = "parts")]
+    pub(crate) fn drop_fan(&mut self, v: usize) -> usize {
+        let (mut n, mut guard) = (0, self.tris.len());
+        while guard > 0 {
+            guard -= 1;
+            let c = self.first(v);
+            if c == NIL {
+                break;
+            }
+            self.remove_triangle(c >> 2, NIL);
+            n += 1;
+        }
+        n
+    }
+
     /// Moves the live triangles to the front of the buffer, in their original order, and
     /// returns how many there are. The workspace's lists are stale afterwards.
     pub(crate) fn compact(&mut self) -> usize {

@@ -277,6 +277,7 @@ pub fn verdict_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> V
             view: None,
             allow_moved,
             welded: false,
+            parts: false,
         },
     )
 }

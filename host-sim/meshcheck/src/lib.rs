@@ -93,6 +93,13 @@ pub struct Options<'a> {
     /// changed boundary loops; and the input wedges of positions the output still uses but
     /// the output does not are counted ([`Verdict::lost_wedges`]).
     pub welded: bool,
+    /// Parts may vanish (`tinydecimate` with `Simplifier::with_parts`): a component of the
+    /// cleaned input none of whose vertices the output uses was removed on purpose and is
+    /// counted ([`Verdict::parts_removed`]); every test then compares the output with the
+    /// input less those components. A component the output still touches is compared in
+    /// full, so one cut in part is refused as before (its new boundary, its changed Euler
+    /// characteristic or loops). With `welded`, components of positions.
+    pub parts: bool,
 }
 
 /// Topology and defect counts of a mesh. See the crate documentation for the definitions.
@@ -290,6 +297,9 @@ pub struct Verdict {
     /// (information, not a defect: a face of a flat-shaded model collapsed away takes its own
     /// wedges with it).
     pub lost_wedges: usize,
+    /// With [`Options::parts`]: components of the cleaned input that the output does not
+    /// touch at all (removed whole, not a defect).
+    pub parts_removed: usize,
     /// Boundary loops of the cleaned input and of the output.
     pub boundary_loops: (usize, usize),
     /// Euler characteristic of the cleaned input and of the output.
@@ -364,6 +374,13 @@ impl fmt::Display for Verdict {
                 f,
                 "  wedges gone with faces   {}      (welded seams: their regions collapsed away)",
                 v.lost_wedges
+            )?;
+        }
+        if v.parts_removed > 0 {
+            writeln!(
+                f,
+                "  parts removed whole      {}      (compared: the input less those parts)",
+                v.parts_removed
             )?;
         }
         let note = if v.topology_compared {
@@ -802,9 +819,43 @@ fn check_welded(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     v
 }
 
+/// `cleaned` less its components that `output` does not touch, and how many those were.
+fn without_absent_parts(nv: usize, cleaned: &[Tri], output: &[Tri]) -> (Vec<Tri>, usize) {
+    let mut dsu = Dsu::new(nv);
+    for t in cleaned {
+        dsu.union(t[0], t[1]);
+        dsu.union(t[1], t[2]);
+    }
+    let mut present = vec![false; nv];
+    for &v in output.iter().flatten() {
+        if (v as usize) < nv {
+            let r = dsu.find(v);
+            present[r as usize] = true;
+        }
+    }
+    let mut absent = BTreeSet::new();
+    let kept = cleaned
+        .iter()
+        .copied()
+        .filter(|t| {
+            let r = dsu.find(t[0]);
+            if !present[r as usize] {
+                absent.insert(r);
+            }
+            present[r as usize]
+        })
+        .collect();
+    (kept, absent.len())
+}
+
 fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     let raw = analyse_with(input.positions, input.triangles, opts);
     let cleaned = clean(input.positions, input.triangles);
+    let (cleaned, parts_removed) = if opts.parts {
+        without_absent_parts(input.positions.len(), &cleaned, output.triangles)
+    } else {
+        (cleaned, 0)
+    };
     let cin = analyse_with(input.positions, &cleaned, opts);
     let out = analyse_with(output.positions, output.triangles, opts);
     let mut d = Vec::new();
@@ -918,6 +969,7 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         new_vertices,
         new_boundary_vertices,
         lost_wedges: 0,
+        parts_removed,
         boundary_loops: (ti.boundary_loops, to.boundary_loops),
         euler: (ti.euler, to.euler),
         components: (ti.components, to.components),
@@ -1000,6 +1052,80 @@ mod tests {
         }));
     }
 
+    /// With `parts`, a component the output does not touch is allowed and counted; one cut in
+    /// part, a new boundary on a kept part, or a defect elsewhere is still refused.
+    #[test]
+    fn parts_gone_whole_are_allowed_and_cut_ones_refused() {
+        // A closed octahedron (vertices 0-5) and a 3 x 3 grid beside it (vertices 6-21).
+        let mut p: Vec<[f32; 3]> = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let mut t: Vec<Tri> = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let (gp, gt) = grid(3);
+        p.extend(gp.iter().map(|q| [q[0] + 5.0, q[1], q[2]]));
+        t.extend(gt.iter().map(|x| x.map(|v| v + 6)));
+        let opts = Options {
+            parts: true,
+            ..Default::default()
+        };
+        let verdict = |o: &[Tri]| {
+            check_with(
+                MeshRef {
+                    positions: &p,
+                    triangles: &t,
+                },
+                MeshRef {
+                    positions: &p,
+                    triangles: o,
+                },
+                &opts,
+            )
+        };
+        // The octahedron gone whole: valid, one part removed; without the option a defect.
+        let grid_only = t[8..].to_vec();
+        let v = verdict(&grid_only);
+        assert!(v.is_valid(), "{v}");
+        assert_eq!((v.parts_removed, v.components), (1, (1, 1)));
+        assert!(!check(&p, &t, &grid_only).is_valid());
+        // The octahedron cut in part (one face left open): refused.
+        let cut: Vec<Tri> = t[1..].to_vec();
+        let v = verdict(&cut);
+        assert_eq!(v.parts_removed, 0);
+        assert_eq!(v.new_boundary_vertices, 3, "{v}");
+        assert!(v.defects.contains(&Defect::BoundaryLoops {
+            input: 1,
+            output: 2
+        }));
+        // Cut down to one triangle of the octahedron: still refused.
+        let mut rest = grid_only.clone();
+        rest.push(t[0]);
+        assert!(!verdict(&rest).is_valid());
+        // The octahedron gone and a hole in the grid: the new boundary is refused.
+        let mut holed = grid_only.clone();
+        holed.drain(8..10);
+        let v = verdict(&holed);
+        assert_eq!(v.parts_removed, 1);
+        assert!(v.new_boundary_vertices > 0, "{v}");
+        assert!(!v.is_valid());
+        // Everything gone: both parts removed, nothing else to say.
+        let v = verdict(&[]);
+        assert_eq!(v.parts_removed, 2);
+    }
+
     #[test]
     fn dirty_input_is_compared_after_cleaning() {
         let (p, t) = grid(2);
@@ -1047,6 +1173,7 @@ mod tests {
                 view: Some(view),
                 allow_moved: false,
                 welded: false,
+                parts: false,
             },
         );
         assert_eq!((a.folded.len(), a.folded_true.len()), (0, 1));

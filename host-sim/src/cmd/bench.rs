@@ -42,6 +42,10 @@ pub struct Args {
     /// meshoptimizer's `simplifySloppy` instead (table to --out only; default ratios 0.2,0.05).
     #[arg(long)]
     pub cluster: bool,
+    /// Parts in our modes, as `host-sim simplify --parts`: `prune` (the default) lets a part
+    /// cheaper than the next collapse vanish whole, `keep` keeps every part.
+    #[arg(long, value_enum, default_value_t = super::simplify::PartsArg::Prune)]
+    pub parts: super::simplify::PartsArg,
 }
 
 impl Args {
@@ -71,6 +75,7 @@ impl Args {
             reps: self.reps.unwrap_or(reps),
             samples_per_triangle: self.samples_per_triangle,
             progress: true,
+            prune: self.parts == super::simplify::PartsArg::Prune,
         };
         let partial = self.quick || self.only.is_some();
         let default = |p: &str| (!partial).then(|| PathBuf::from(p));

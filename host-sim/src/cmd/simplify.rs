@@ -16,7 +16,7 @@ use tinydecimate::cost::Placement;
 use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Storage, Target};
 
 use crate::io::{Format, MeshData};
-use crate::simplify::{format_report, report_json, simplify_seams};
+use crate::simplify::{format_report, report_json, simplify_parts};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
 mod textured;
@@ -205,6 +205,15 @@ pub enum SeamsArg {
     Split,
 }
 
+/// Whether small parts may vanish (`--parts`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum PartsArg {
+    /// Every part stays: a collapse never changes topology.
+    Keep,
+    /// A part cheaper than the next collapse vanishes whole (greedy runs without a bound).
+    Prune,
+}
+
 /// `host-sim simplify IN OUT ...`
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("target").required(true).multiple(true))]
@@ -233,6 +242,12 @@ pub struct Args {
     /// every seam is an open boundary that only shrinks along itself.
     #[arg(long, value_enum, default_value_t = SeamsArg::Weld)]
     pub seams: SeamsArg,
+    /// Parts (connected components): `prune` removes a part whole once it costs less than the
+    /// collapse about to be made, and short of the target with no collapse left the smallest
+    /// parts, never the last (the default; greedy schedule without --max-error only, else
+    /// every part stays); `keep` keeps every part, as a collapse never changes topology.
+    #[arg(long, value_enum, default_value_t = PartsArg::Prune)]
+    pub parts: PartsArg,
     /// Target fraction of the input triangles, 0 to 1.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
     pub ratio: Option<f32>,
@@ -440,7 +455,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     // optimal placement with a bound) before any work, naming the option.
     let placement = stored.then(|| args.placement.into());
     let weld = args.seams == SeamsArg::Weld;
-    let (out, report, elapsed) = simplify_seams(
+    let (out, report, elapsed) = simplify_parts(
         &mesh,
         &config,
         args.operator,
@@ -448,6 +463,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         bounded,
         true,
         weld,
+        args.parts == PartsArg::Prune,
     )?;
     let written = if keep_numbering {
         out.clone()
@@ -628,12 +644,16 @@ fn measure(
         .map_err(|e| anyhow!("{e}"))
         .and_then(|b| crate::io::parse_bytes(&b, &ext))
         .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
-    let (_, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    let (read, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
+    // Pruned parts: an input part the output does not touch was removed on purpose.
+    let parts = args.parts == PartsArg::Prune;
     if args.seams == SeamsArg::Weld {
         // Welded seams: the result in the input's numbering (a written file matches twins by
         // position in order, which cannot say which wedge a corner was), both welded by
         // position, and the wedges of the kept positions.
-        validity = crate::check::compare_opts(mesh, out, *moved, true);
+        validity = crate::check::compare_parts(mesh, out, *moved, true, parts);
+    } else if parts {
+        validity = crate::check::compare_parts(mesh, &read, *moved, false, true);
     }
     let valid = validity.is_valid();
     let _ = writeln!(

@@ -80,4 +80,11 @@ impl Cost for Builtin {
             q.round(mean_area2)
         }
     }
+
+    fn part(&self, r2: f32, area2: f32) -> f32 {
+        match self {
+            Builtin::Quadric(q) => q.part(r2, area2),
+            Builtin::NormalVariation(w) => w.part(r2, area2),
+        }
+    }
 }

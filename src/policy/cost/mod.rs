@@ -123,4 +123,21 @@ pub trait Cost {
     fn place(&self, _m: &Move) -> Option<V3> {
         None
     }
+    /// What removing a whole part (a connected component) costs, in this cost's units, for
+    /// pruning (`Simplifier::with_parts`, crate feature `parts`): `r2` is the part's squared
+    /// radius about its centroid and `area2` twice its area, both in normalised units. A part
+    /// is removed once it is cheaper than the collapse the queue is about to make. Infinite by
+    /// default: a cost that does not say what a part is worth never removes one.
+    fn part(&self, _r2: f32, _area2: f32) -> f32 {
+        f32::INFINITY
+    }
+}
+
+/// [`Cost::part`] for the quadric costs: `r2 · area2`, the area-weighted squared distance of
+/// every triangle plane of the part to a point within `r` of all of them (its centroid), which
+/// is at most what collapsing the whole part to its centroid would cost under a quadric (the
+/// sum over its triangles of twice the area times the squared distance of the centroid to the
+/// triangle's plane). Area times squared length, as the quadric keys are.
+pub(crate) fn quadric_part(r2: f32, area2: f32) -> f32 {
+    r2 * area2
 }
