@@ -94,12 +94,20 @@ fn non_finite_positions_name_the_vertex() {
 fn bad_configuration_is_refused() {
     let m = sphere();
     let mut ws = Workspace::<u32, 256, 512>::new();
-    let cases: [(Config, ConfigField); 6] = [
+    let cases: [(Config, ConfigField); 8] = [
         (Config::new().with_ratio(1.5), ConfigField::Target),
         (Config::new().with_ratio(f32::NAN), ConfigField::Target),
         (Config::new().with_lambda(-1.0), ConfigField::Lambda),
         (Config::new().with_max_passes(0), ConfigField::MaxPasses),
         (Config::new().with_max_cost(f32::NAN), ConfigField::MaxCost),
+        (
+            Config::new().with_error_limit(f32::NAN),
+            ConfigField::ErrorLimit,
+        ),
+        (
+            Config::new().with_error_limit(-1.0),
+            ConfigField::ErrorLimit,
+        ),
         (
             Config {
                 max_normal_turn_deg: 0.0,

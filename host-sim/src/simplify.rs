@@ -57,6 +57,9 @@ pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
         Error::InvalidConfig {
             field: ConfigField::Schedule,
         } => " (drop --schedule passes with --quadric stored)",
+        Error::InvalidConfig {
+            field: ConfigField::ErrorLimit,
+        } => " (--error-limit needs the greedy schedule and --operator edge)",
         _ => "",
     };
     anyhow!("tinydecimate: {e}{hint}")
@@ -225,7 +228,7 @@ pub fn format_report(r: &Report) -> String {
          \x20 feature vertices       {}\n\
          \x20 passes                 {}\n\
          \x20 triangles after pass   [{}]\n\
-         \x20 rejected (total {}): {}{}",
+         \x20 rejected (total {}): {}{}{}",
         r.triangles_in,
         r.degenerate_dropped,
         r.duplicates_dropped,
@@ -242,6 +245,14 @@ pub fn format_report(r: &Report) -> String {
         passes.join(", "),
         j.total(),
         j,
+        if r.over_limit > 0 || r.collapse_error > 0.0 {
+            format!(
+                "\n  error limit            {} candidates over it; largest collapse error made {:.6e}",
+                r.over_limit, r.collapse_error
+            )
+        } else {
+            String::new()
+        },
         match (r.max_error, r.mean_error) {
             (Some(a), Some(b)) => format!("\n  E_max, E_mean          {a:.6e}, {b:.6e}"),
             _ => String::new(),
@@ -284,6 +295,8 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "rejected": rejected,
         "max_error": r.max_error,
         "mean_error": r.mean_error,
+        "over_limit": r.over_limit,
+        "collapse_error": r.collapse_error,
     })
 }
 

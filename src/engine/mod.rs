@@ -105,6 +105,13 @@ pub struct Simplifier<
     pass_collapses: usize,
     /// A legal collapse was skipped because it cost more than `max_cost`.
     over_cost: bool,
+    /// `Config::error_limit` squared, in normalised units (infinite: no limit).
+    limit2: f32,
+    /// Candidates refused by the error limit, in all and in this round.
+    over_limit: u32,
+    round_over_limit: bool,
+    /// The largest squared error of a collapse made (tracked with a finite limit only).
+    reached2: f32,
     /// Greedy: refresh the feature threshold when the mesh is down to this many triangles.
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
@@ -158,6 +165,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             passes: 0,
             pass_collapses: 0,
             over_cost: false,
+            limit2: f32::INFINITY,
+            over_limit: 0,
+            round_over_limit: false,
+            reached2: 0.0,
             refresh_at: 0,
             refresh_only: false,
             pass_triangles: heapless::Vec::new(),
@@ -169,6 +180,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             bound,
             operator: PhantomData,
         };
+        if s.config.error_limit.is_finite() {
+            let l = s.mesh.normalised_length(s.config.error_limit);
+            s.limit2 = l * l;
+        }
         if B::ON {
             s.enrol();
         }

@@ -35,6 +35,14 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             passes: self.passes,
             pass_triangles: self.pass_triangles.clone(),
             rejected: self.rejected,
+            over_limit: self.over_limit,
+            collapse_error: self
+                .mesh
+                .input_length(if self.reached2 >= f32::MIN_POSITIVE {
+                    self.reached2 * crate::math::rsqrt(self.reached2)
+                } else {
+                    0.0
+                }),
             max_error: errors.map(|e| e.0),
             mean_error: errors.map(|e| e.1),
         }
