@@ -79,8 +79,15 @@ pub struct Report {
     pub triangles_in: usize,
     /// Input triangles dropped because two of their indices were equal.
     pub degenerate_dropped: usize,
-    /// Input triangles dropped because an earlier triangle had the same three vertices.
+    /// Input triangles dropped because an earlier triangle had the same three vertices in the
+    /// same winding.
     pub duplicates_dropped: usize,
+    /// Input triangles that are an earlier triangle turned over (the back of a double-sided
+    /// surface). They take no part in the run: each is written back after the output's other
+    /// triangles, turned over from its front, if the front survived (and counted in
+    /// `triangles_out`). The fronts aim for their share of the target, so the output's count
+    /// is the target's within the few twins whose fronts' survival differs from the average.
+    pub twins: usize,
     /// Triangles in the output (the prefix of the caller's buffer that holds the result).
     pub triangles_out: usize,
     /// The triangle count the engine aimed for.

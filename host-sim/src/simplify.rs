@@ -219,6 +219,7 @@ pub fn format_report(r: &Report) -> String {
         "  triangles in           {}\n\
          \x20 degenerate dropped     {}\n\
          \x20 duplicates dropped     {}\n\
+         \x20 double-sided twins     {}\n\
          \x20 triangles out          {} ({:.2} % of the input)\n\
          \x20 target                 {} (reached: {})\n\
          \x20 stop                   {:?}\n\
@@ -232,6 +233,7 @@ pub fn format_report(r: &Report) -> String {
         r.triangles_in,
         r.degenerate_dropped,
         r.duplicates_dropped,
+        r.twins,
         r.triangles_out,
         100.0 * r.triangles_out as f64 / r.triangles_in.max(1) as f64,
         r.target_triangles,
@@ -282,6 +284,7 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "triangles_in": r.triangles_in,
         "degenerate_dropped": r.degenerate_dropped,
         "duplicates_dropped": r.duplicates_dropped,
+        "twins": r.twins,
         "triangles_out": r.triangles_out,
         "target_triangles": r.target_triangles,
         "target_reached": r.target_reached,

@@ -90,6 +90,8 @@ pub struct Simplifier<
     rules: Rules,
     cost: C,
     target: usize,
+    /// The target of the whole output, twins included (`target` without twins).
+    target_out: usize,
     phase: Phase,
     /// Vertex cursor of the current sweep.
     v: usize,
@@ -140,7 +142,16 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         bound: B,
         _operator: O,
     ) -> Self {
-        let target = config.target.triangles(mesh.valid_in);
+        // Twins (double-sided triangles' backs) come back at the end, so the fronts aim for
+        // their share of the target.
+        let all = mesh.valid_in + mesh.twins;
+        let target_out = config.target.triangles(all);
+        let target = if mesh.twins == 0 {
+            target_out
+        } else {
+            // Rounded down: a wholly double-sided surface never ends above the target.
+            (target_out as u64 * mesh.valid_in as u64 / all.max(1) as u64) as usize
+        };
         let (mut locked, mut used_in) = (0, 0);
         for v in 0..mesh.vertex_count() {
             locked += mesh.has(v, flag::LOCKED) as usize;
@@ -153,6 +164,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             config,
             cost,
             target,
+            target_out,
             phase: Phase::Mean,
             v: 0,
             mean: Mean::default(),
