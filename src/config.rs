@@ -111,6 +111,16 @@ pub struct Config {
     /// [`Controls`](crate::bound::Controls); with [`NoBound`](crate::bound::NoBound) it is
     /// [`Error::InvalidConfig`](crate::Error::InvalidConfig) for `MaxError`. Non-negative.
     pub max_error: f32,
+    /// The error limit, in the input's units: the greedy edge collapse refuses a collapse whose
+    /// own error ([`Cost::error2`](crate::cost::Cost::error2): for the quadric costs the
+    /// area-weighted RMS distance from the kept vertex to the planes it replaces, plus how far
+    /// a boundary retreats) is above it, and a run that stops short of its target because of
+    /// it reports [`Stop::ErrorLimit`](crate::Stop::ErrorLimit): stopping is better than
+    /// cutting a corner to reach a count (meshoptimizer's `target_error` plays this part).
+    /// Infinite (the default): no limit. Costs without a distance (normal variation) are never
+    /// limited. Not a guarantee: for a guaranteed bound see [`Config::max_error`].
+    /// Non-negative; a finite limit needs the greedy schedule and edge collapse.
+    pub error_limit: f32,
     /// With an error bound: an original edge is a feature edge (its vertices are control
     /// points of the second kind, Zhu, Wang and Meng 2007 §2 fig. 2) when its two triangles'
     /// normals differ by more than this many degrees, in `(0, 180)`. Boundary and non-manifold
@@ -137,6 +147,7 @@ impl Config {
             min_quality: 0.05,
             boundary_weight: 1.0,
             max_error: f32::INFINITY,
+            error_limit: f32::INFINITY,
             control_angle_deg: 30.0,
         }
     }
@@ -217,6 +228,12 @@ impl Config {
         self
     }
 
+    /// Sets the error limit in the input's units (see [`Config::error_limit`]).
+    pub const fn with_error_limit(mut self, distance: f32) -> Self {
+        self.error_limit = distance;
+        self
+    }
+
     /// Detects and keeps feature vertices, or not.
     pub const fn with_features(mut self, features: bool) -> Self {
         self.features = features;
@@ -259,6 +276,12 @@ impl Config {
         self.with_max_error(fraction * crate::bound::bounding_diagonal(positions))
     }
 
+    /// Sets the error limit to `fraction` of the bounding-box diagonal of `positions` (0.02:
+    /// 2 % of the diagonal, what `host-sim simplify` uses by default).
+    pub fn with_relative_error_limit(self, fraction: f32, positions: &[[f32; 3]]) -> Self {
+        self.with_error_limit(fraction * crate::bound::bounding_diagonal(positions))
+    }
+
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), crate::Error> {
         use crate::{ConfigField as F, Error};
@@ -288,6 +311,9 @@ impl Config {
         }
         if self.max_error.is_nan() || self.max_error < 0.0 {
             return bad(F::MaxError);
+        }
+        if self.error_limit.is_nan() || self.error_limit < 0.0 {
+            return bad(F::ErrorLimit);
         }
         if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
             return bad(F::ControlAngle);

@@ -42,6 +42,9 @@ pub enum ConfigField {
     MinQuality,
     BoundaryWeight,
     MaxError,
+    /// [`Config::error_limit`](crate::Config::error_limit) negative or NaN, or finite with
+    /// another schedule than greedy or with [`TriangleCollapse`](crate::TriangleCollapse).
+    ErrorLimit,
     ControlAngle,
     /// [`TriangleCollapse`](crate::TriangleCollapse) with another schedule than greedy.
     Operator,

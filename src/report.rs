@@ -60,6 +60,10 @@ pub enum Stop {
     NoLegalCollapse,
     /// Every remaining legal collapse costs more than `max_cost`.
     MaxCost,
+    /// The collapses left that the rules allow are over
+    /// [`Config::error_limit`](crate::Config::error_limit): the target was not reached
+    /// because reaching it would cut corners. Raise the limit to go further.
+    ErrorLimit,
     /// `max_passes` passes were run ([`Schedule::Passes`](crate::Schedule::Passes)).
     MaxPasses,
     /// The collapse log given to [`Simplifier::record_into`](crate::Simplifier::record_into)
@@ -75,8 +79,15 @@ pub struct Report {
     pub triangles_in: usize,
     /// Input triangles dropped because two of their indices were equal.
     pub degenerate_dropped: usize,
-    /// Input triangles dropped because an earlier triangle had the same three vertices.
+    /// Input triangles dropped because an earlier triangle had the same three vertices in the
+    /// same winding.
     pub duplicates_dropped: usize,
+    /// Input triangles that are an earlier triangle turned over (the back of a double-sided
+    /// surface). They take no part in the run: each is written back after the output's other
+    /// triangles, turned over from its front, if the front survived (and counted in
+    /// `triangles_out`). The fronts aim for their share of the target, so the output's count
+    /// is the target's within the few twins whose fronts' survival differs from the average.
+    pub twins: usize,
     /// Triangles in the output (the prefix of the caller's buffer that holds the result).
     pub triangles_out: usize,
     /// The triangle count the engine aimed for.
@@ -104,6 +115,12 @@ pub struct Report {
     pub pass_triangles: heapless::Vec<u32, PASS_LOG>,
     /// Refused candidate collapses by reason.
     pub rejected: Rejections,
+    /// Candidate collapses refused because their error was over
+    /// [`Config::error_limit`](crate::Config::error_limit).
+    pub over_limit: u32,
+    /// With a finite [`Config::error_limit`](crate::Config::error_limit): the largest error
+    /// of a collapse made, in the input's units (what the limit compares). Zero without one.
+    pub collapse_error: f32,
     /// With an error bound ([`Controls`](crate::bound::Controls)):
     /// E_max of Zhu, Wang and Meng 2007 eq. 4, the largest distance of a control point (original
     /// centroid or feature-edge vertex) to its controlled triangle, in the input's units. Never

@@ -33,6 +33,13 @@ pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
     a.iter().all(|x| b.contains(x)) && b.iter().all(|x| a.contains(x))
 }
 
+/// Whether `b` is `a` with the same winding (a rotation of it); with [`same_set`] false, `b` is
+/// `a` turned over.
+#[inline]
+pub(crate) fn same_winding(a: [usize; 3], b: [usize; 3]) -> bool {
+    b == a || b == [a[1], a[2], a[0]] || b == [a[2], a[0], a[1]]
+}
+
 /// An input triangle with a repeated index: dropped.
 #[inline]
 pub(crate) fn is_degenerate([a, b, c]: [usize; 3]) -> bool {

@@ -176,6 +176,12 @@ impl<'a, L: Index> Storage<'a, L> {
                 field: ConfigField::Operator,
             });
         }
+        if config.error_limit.is_finite() && (O::TRIANGLE || config.schedule != Schedule::Greedy) {
+            // Only the greedy edge collapse measures each collapse's own error.
+            return Err(Error::InvalidConfig {
+                field: ConfigField::ErrorLimit,
+            });
+        }
         if !B::ON {
             bound.prepare(triangles, nv, config)?;
         }

@@ -94,12 +94,20 @@ fn non_finite_positions_name_the_vertex() {
 fn bad_configuration_is_refused() {
     let m = sphere();
     let mut ws = Workspace::<u32, 256, 512>::new();
-    let cases: [(Config, ConfigField); 6] = [
+    let cases: [(Config, ConfigField); 8] = [
         (Config::new().with_ratio(1.5), ConfigField::Target),
         (Config::new().with_ratio(f32::NAN), ConfigField::Target),
         (Config::new().with_lambda(-1.0), ConfigField::Lambda),
         (Config::new().with_max_passes(0), ConfigField::MaxPasses),
         (Config::new().with_max_cost(f32::NAN), ConfigField::MaxCost),
+        (
+            Config::new().with_error_limit(f32::NAN),
+            ConfigField::ErrorLimit,
+        ),
+        (
+            Config::new().with_error_limit(-1.0),
+            ConfigField::ErrorLimit,
+        ),
         (
             Config {
                 max_normal_turn_deg: 0.0,
@@ -123,15 +131,19 @@ fn degenerate_and_duplicate_triangles_are_dropped_and_counted() {
     m.triangles.push([5, 6, 5]);
     let t = m.triangles[10];
     m.triangles.push(t); // exact duplicate
-    m.triangles.push([t[1], t[0], t[2]]); // same vertices, other winding
+    m.triangles.push([t[2], t[0], t[1]]); // the same, rotated
+    m.triangles.push([t[1], t[0], t[2]]); // turned over: a twin, kept (double-sided)
+    m.triangles.push([t[0], t[2], t[1]]); // turned over again: a duplicate of the twin
     let (out, report) = simplify(&m, &Config::new().with_ratio(1.0));
     assert_eq!(report.degenerate_dropped, 2);
-    assert_eq!(report.duplicates_dropped, 2);
-    assert_eq!(report.triangles_out, 320, "ratio 1: only the bad ones go");
-    let clean = sphere();
+    assert_eq!(report.duplicates_dropped, 3);
+    assert_eq!(report.twins, 1);
+    assert_eq!(report.triangles_out, 321, "ratio 1: only the bad ones go");
+    let mut clean = sphere();
+    clean.triangles.push([t[0], t[2], t[1]]);
     assert_eq!(
         out.triangles, clean.triangles,
-        "the first copy is kept, in order"
+        "the first copy is kept, in order, and the twin after as its front turned over"
     );
 }
 

@@ -569,7 +569,7 @@ fn run_method(
                 // Seams welded (`host-sim simplify`'s default), when the mesh has any.
                 let (out, report, elapsed) = crate::simplify::simplify_parts(
                     mesh,
-                    &config.with_ratio(ratio),
+                    &with_default_limit(config.with_ratio(ratio), mesh),
                     crate::simplify::OperatorArg::Edge,
                     placement,
                     false,
@@ -607,6 +607,16 @@ fn run_method(
         scratch,
         report,
     })
+}
+
+/// `config` with `host-sim simplify`'s default error limit where it applies (the greedy
+/// schedule).
+fn with_default_limit(config: Config, mesh: &MeshData) -> Config {
+    if config.schedule == tinydecimate::Schedule::Greedy {
+        config.with_relative_error_limit(crate::cmd::simplify::DEFAULT_ERROR_LIMIT, &mesh.positions)
+    } else {
+        config
+    }
 }
 
 /// Bytes of the wedge copy a welded run keeps (`tinydecimate::seam`): three indices per

@@ -57,6 +57,9 @@ pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
         Error::InvalidConfig {
             field: ConfigField::Schedule,
         } => " (drop --schedule passes with --quadric stored)",
+        Error::InvalidConfig {
+            field: ConfigField::ErrorLimit,
+        } => " (--error-limit needs the greedy schedule and --operator edge)",
         _ => "",
     };
     anyhow!("tinydecimate: {e}{hint}")
@@ -248,6 +251,7 @@ pub fn format_report(r: &Report) -> String {
         "  triangles in           {}\n\
          \x20 degenerate dropped     {}\n\
          \x20 duplicates dropped     {}\n\
+         \x20 double-sided twins     {}\n\
          \x20 triangles out          {} ({:.2} % of the input)\n\
          \x20 target                 {} (reached: {})\n\
          \x20 stop                   {:?}\n\
@@ -258,10 +262,11 @@ pub fn format_report(r: &Report) -> String {
          \x20 feature vertices       {}\n\
          \x20 passes                 {}\n\
          \x20 triangles after pass   [{}]\n\
-         \x20 rejected (total {}): {}{}",
+         \x20 rejected (total {}): {}{}{}",
         r.triangles_in,
         r.degenerate_dropped,
         r.duplicates_dropped,
+        r.twins,
         r.triangles_out,
         100.0 * r.triangles_out as f64 / r.triangles_in.max(1) as f64,
         r.target_triangles,
@@ -276,6 +281,14 @@ pub fn format_report(r: &Report) -> String {
         passes.join(", "),
         j.total(),
         j,
+        if r.over_limit > 0 || r.collapse_error > 0.0 {
+            format!(
+                "\n  error limit            {} candidates over it; largest collapse error made {:.6e}",
+                r.over_limit, r.collapse_error
+            )
+        } else {
+            String::new()
+        },
         match (r.max_error, r.mean_error) {
             (Some(a), Some(b)) => format!("\n  E_max, E_mean          {a:.6e}, {b:.6e}"),
             _ => String::new(),
@@ -305,6 +318,7 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "triangles_in": r.triangles_in,
         "degenerate_dropped": r.degenerate_dropped,
         "duplicates_dropped": r.duplicates_dropped,
+        "twins": r.twins,
         "triangles_out": r.triangles_out,
         "target_triangles": r.target_triangles,
         "target_reached": r.target_reached,
@@ -319,6 +333,8 @@ pub fn report_json(r: &Report) -> serde_json::Value {
         "rejected": rejected,
         "max_error": r.max_error,
         "mean_error": r.mean_error,
+        "over_limit": r.over_limit,
+        "collapse_error": r.collapse_error,
     })
 }
 

@@ -64,7 +64,11 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
                 // Short of the target: the smallest parts may still go (`with_parts`).
                 if !self.prune_below(f32::INFINITY) {
-                    self.done(Stop::NoLegalCollapse);
+                    self.done(if self.round_over_limit {
+                        Stop::ErrorLimit
+                    } else {
+                        Stop::NoLegalCollapse
+                    });
                 }
             } else {
                 self.new_round();
@@ -122,6 +126,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                             self.mesh.set_flag(v, flag::RAISED, true);
                         }
                     } else {
+                        if self.over_error_limit(v, &w, to, c) {
+                            // Not cut to reach a count: the next candidate, if any.
+                            continue;
+                        }
                         self.heap.remove(v);
                         self.collapse_greedy(v, to, at);
                     }
@@ -133,7 +141,29 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         self.heap.remove(v);
     }
 
+    /// Whether `from -> to`, priced `c`, is over [`Config::error_limit`](crate::Config::error_limit)
+    /// (then counted); else its error is taken into the largest made. Nothing without a limit.
+    fn over_error_limit(&mut self, from: usize, w: &FanSummary<C::Fan>, to: usize, c: f32) -> bool {
+        if !self.limit2.is_finite() {
+            return false;
+        }
+        let e2 = match self.make_move(from, w, to, true) {
+            Some(m) => self.cost.error2(&w.fan, &m, c),
+            None => 0.0,
+        };
+        if e2 > self.limit2 {
+            self.over_limit = self.over_limit.saturating_add(1);
+            self.round_over_limit = true;
+            return true;
+        }
+        if e2 > self.reached2 {
+            self.reached2 = e2;
+        }
+        false
+    }
+
     pub(super) fn new_round(&mut self) {
+        self.round_over_limit = false;
         self.log_pass();
         self.phase = Phase::Mean;
         self.v = 0;

@@ -15,6 +15,12 @@ pub(crate) struct Heap<'a, L: Index> {
 }
 
 impl<'a, L: Index> Heap<'a, L> {
+    /// One link per vertex to lend once the run is over (the queue's order).
+    #[cfg(feature = "seams")]
+    pub(crate) fn spent(&mut self) -> &mut [L] {
+        self.heap
+    }
+
     pub(crate) fn new(heap: &'a mut [L], pos: &'a mut [L], key: &'a mut [f32]) -> Self {
         for p in pos.iter_mut() {
             *p = L::NIL;

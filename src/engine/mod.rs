@@ -91,6 +91,8 @@ pub struct Simplifier<
     rules: Rules,
     cost: C,
     target: usize,
+    /// The target of the whole output, twins included (`target` without twins).
+    target_out: usize,
     phase: Phase,
     /// Vertex cursor of the current sweep.
     v: usize,
@@ -106,6 +108,13 @@ pub struct Simplifier<
     pass_collapses: usize,
     /// A legal collapse was skipped because it cost more than `max_cost`.
     over_cost: bool,
+    /// `Config::error_limit` squared, in normalised units (infinite: no limit).
+    limit2: f32,
+    /// Candidates refused by the error limit, in all and in this round.
+    over_limit: u32,
+    round_over_limit: bool,
+    /// The largest squared error of a collapse made (tracked with a finite limit only).
+    reached2: f32,
     /// Greedy: refresh the feature threshold when the mesh is down to this many triangles.
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
@@ -137,7 +146,16 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         bound: B,
         _operator: O,
     ) -> Self {
-        let target = config.target.triangles(mesh.valid_in);
+        // Twins (double-sided triangles' backs) come back at the end, so the fronts aim for
+        // their share of the target.
+        let all = mesh.valid_in + mesh.twins;
+        let target_out = config.target.triangles(all);
+        let target = if mesh.twins == 0 {
+            target_out
+        } else {
+            // Rounded down: a wholly double-sided surface never ends above the target.
+            (target_out as u64 * mesh.valid_in as u64 / all.max(1) as u64) as usize
+        };
         let (mut locked, mut used_in) = (0, 0);
         for v in 0..mesh.vertex_count() {
             locked += mesh.has(v, flag::LOCKED) as usize;
@@ -150,6 +168,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             config,
             cost,
             target,
+            target_out,
             phase: Phase::Mean,
             v: 0,
             mean: Mean::default(),
@@ -162,6 +181,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             passes: 0,
             pass_collapses: 0,
             over_cost: false,
+            limit2: f32::INFINITY,
+            over_limit: 0,
+            round_over_limit: false,
+            reached2: 0.0,
             refresh_at: 0,
             refresh_only: false,
             pass_triangles: heapless::Vec::new(),
@@ -175,6 +198,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             #[cfg(feature = "parts")]
             parts: parts::Parts::off(),
         };
+        if s.config.error_limit.is_finite() {
+            let l = s.mesh.normalised_length(s.config.error_limit);
+            s.limit2 = l * l;
+        }
         if B::ON {
             s.enrol();
         }

@@ -44,8 +44,9 @@ pub(crate) struct Parts<'a, L: Index> {
     count: usize,
     /// Parts removed so far: the order's first `cursor` entries.
     cursor: usize,
-    /// The size of the part at the cursor.
+    /// The size of the part at the cursor, and its squared radius (normalised units).
     next: f32,
+    next_r2: f32,
     /// Removed parts that still had triangles.
     removed: usize,
 }
@@ -59,6 +60,7 @@ impl<L: Index> Parts<'_, L> {
             count: 0,
             cursor: 0,
             next: f32::INFINITY,
+            next_r2: f32::INFINITY,
             removed: 0,
         }
     }
@@ -120,10 +122,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             count,
             cursor: 0,
             next: f32::INFINITY,
+            next_r2: f32::INFINITY,
             removed: 0,
         };
         if count > 0 {
-            parts.next = measure(&self.mesh, &parts, &self.cost, parts.order(0));
+            (parts.next, parts.next_r2) =
+                measure(&self.mesh, &parts, &self.cost, parts.order(0));
         }
         self.parts = parts;
         Ok(self)
@@ -137,7 +141,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if p.cursor + 1 >= p.count || self.logging || self.mesh.live <= self.target {
             return false;
         }
-        if !(p.next < limit && p.next <= self.config.max_cost) {
+        // A part wider than the error limit stays: removing it is an error of its radius.
+        if !(p.next < limit && p.next <= self.config.max_cost && p.next_r2 <= self.limit2) {
             return false;
         }
         let root = p.order(p.cursor);
@@ -155,7 +160,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         p.cursor += 1;
         p.removed += usize::from(dropped > 0);
         let next = measure(&self.mesh, p, &self.cost, p.order(p.cursor));
-        self.parts.next = next;
+        (self.parts.next, self.parts.next_r2) = next;
         true
     }
 
@@ -241,7 +246,7 @@ fn label<L: Index, I: Index, C: Cost>(
     }
     for i in 0..count {
         let r = links.get(i).map_or(0, |l| l[1].to_usize());
-        let size = measure_ring(mesh, links, cost, r);
+        let size = measure_ring(mesh, links, cost, r).0;
         if let Some(k) = keys.get_mut(r) {
             *k = size;
         }
@@ -319,14 +324,15 @@ fn measure<L: Index, I: Index, C: Cost>(
     parts: &Parts<'_, L>,
     cost: &C,
     root: usize,
-) -> f32 {
+) -> (f32, f32) {
     if parts.cursor >= parts.count {
-        return f32::INFINITY;
+        return (f32::INFINITY, f32::INFINITY);
     }
     measure_ring(mesh, parts.links, cost, root)
 }
 
-/// The size of the part whose ring (slot 0 of `links`) goes through `root`: its squared
+/// The size of the part whose ring (slot 0 of `links`) goes through `root`, and its squared
+/// radius. The size: its squared
 /// radius about the mean of its vertices (all the part's vertices, removed ones too: with
 /// read-only positions the radius is the input's throughout) and twice the area of its live
 /// triangles, each counted at its smallest vertex.
@@ -336,7 +342,7 @@ fn measure_ring<L: Index, I: Index, C: Cost>(
     links: &[[L; 2]],
     cost: &C,
     root: usize,
-) -> f32 {
+) -> (f32, f32) {
     let ring = |v: usize| links.get(v).map_or(root, |l| l[0].to_usize());
     let (mut sum, mut n) = ([0.0f32; 3], 0u32);
     let (mut v, mut guard) = (root, links.len());
@@ -372,5 +378,5 @@ fn measure_ring<L: Index, I: Index, C: Cost>(
             break;
         }
     }
-    cost.part(r2, area2)
+    (cost.part(r2, area2), r2)
 }

@@ -25,8 +25,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             degenerate_dropped: self.mesh.degenerate,
             duplicates_dropped: self.mesh.duplicates,
             triangles_out: self.mesh.live,
-            target_triangles: self.target,
+            target_triangles: self.target_out,
             target_reached: self.mesh.live <= self.target,
+            twins: self.mesh.twins,
             stop,
             collapses: self.collapses,
             vertices_removed: self.used_in.saturating_sub(used),
@@ -36,6 +37,14 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             passes: self.passes,
             pass_triangles: self.pass_triangles.clone(),
             rejected: self.rejected,
+            over_limit: self.over_limit,
+            collapse_error: self
+                .mesh
+                .input_length(if self.reached2 >= f32::MIN_POSITIVE {
+                    self.reached2 * crate::math::rsqrt(self.reached2)
+                } else {
+                    0.0
+                }),
             max_error: errors.map(|e| e.0),
             mean_error: errors.map(|e| e.1),
         }
@@ -45,6 +54,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// Finishing early (before `step` returned `true`) keeps the valid mesh reached so far.
     pub fn finish(mut self) -> Report {
         let report = self.report();
+        #[cfg(feature = "seams")]
+        let n = self.mesh.compact(self.heap.spent());
+        #[cfg(not(feature = "seams"))]
         let n = self.mesh.compact();
         #[cfg(feature = "defmt")]
         defmt::debug!(
@@ -55,6 +67,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         );
         Report {
             triangles_out: n,
+            // With twins the fronts met their share; the whole output is what counts.
+            target_reached: if self.mesh.twins == 0 {
+                report.target_reached
+            } else {
+                n <= self.target_out
+            },
             ..report
         }
     }

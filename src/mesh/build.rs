@@ -67,6 +67,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             live: 0,
             degenerate: 0,
             duplicates: 0,
+            twins: 0,
             valid_in: 0,
             #[cfg(feature = "seams")]
             wedges: &mut [],
@@ -93,34 +94,48 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
-    /// Drops exact duplicates (same vertex set, any order or winding) and keeps the first. A
-    /// later copy shows up in the corner list of its first vertex. A copy leaves all three
-    /// lists while it is intact (a list walk finds its slot by its vertex), and only then is
-    /// written as removed, so no walk ever meets it.
+    /// Drops exact duplicates (same vertex set and winding) and keeps the first. A later copy
+    /// shows up in the corner list of its first vertex. A copy leaves all three lists while it
+    /// is intact (a list walk finds its slot by its vertex), and only then is written as
+    /// removed, so no walk ever meets it. A copy turned over (opposite winding: the back of a
+    /// double-sided leaf, card or pane) is not a duplicate but a twin: once every duplicate is
+    /// gone (the first sweep), the second sweep takes each twin out of the run too, so that the
+    /// front simplifies as the one-sided surface it is, and [`Mesh::compact`] writes it back
+    /// turned over from whatever its front became, as meshoptimizer keeps both sides.
     #[inline(always)]
     fn drop_duplicates(&mut self) {
-        for t in 0..self.tris.len() {
-            let tri = self.tri(t);
-            if is_dead(tri) {
-                continue;
-            }
-            let mut c = self.first(tri[0]);
-            let mut dup = false;
-            while c != NIL {
-                let u = c >> 2;
-                if u < t && tri::same_set(self.tri(u), tri) {
-                    dup = true;
-                    break;
+        for twins in [false, true] {
+            for t in 0..self.tris.len() {
+                let tri = self.tri(t);
+                if is_dead(tri) {
+                    continue;
                 }
-                c = self.after(c);
-            }
-            if dup {
-                for &x in &tri {
-                    self.unlink(x, t);
+                let mut c = self.first(tri[0]);
+                let mut first = NIL;
+                while c != NIL {
+                    let u = c >> 2;
+                    if u < t
+                        && tri::same_set(self.tri(u), tri)
+                        && (twins || tri::same_winding(self.tri(u), tri))
+                    {
+                        first = u;
+                        break;
+                    }
+                    c = self.after(c);
                 }
-                self.kill(t);
-                self.duplicates += 1;
-                self.live = self.live.saturating_sub(1);
+                if first != NIL {
+                    for &x in &tri {
+                        self.unlink(x, t);
+                    }
+                    if twins {
+                        self.kill_twin(t, first);
+                        self.twins += 1;
+                    } else {
+                        self.kill(t);
+                        self.duplicates += 1;
+                    }
+                    self.live = self.live.saturating_sub(1);
+                }
             }
         }
     }

@@ -279,9 +279,83 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         n
     }
 
+    /// Writes every twin ([`Mesh::kill_twin`]) whose front survived as its front turned over.
+    /// With welded seams each corner takes a back's own wedge at its position: the twin's own
+    /// if its input triangle had that position, else one that another back had there (kept in
+    /// `spare`, one link per vertex), else the front's.
+    fn revive_twins(&mut self, #[cfg(feature = "seams")] spare: &mut [L]) {
+        #[cfg(feature = "seams")]
+        let welded = !self.wedges.is_empty();
+        #[cfg(feature = "seams")]
+        if welded {
+            for s in spare.iter_mut() {
+                *s = L::NIL;
+            }
+            for t in 0..self.tris.len() {
+                if let (Some(&x), Some(n), Some(w)) =
+                    (self.tris.get(t), self.next.get(t), self.wedges.get(t))
+                {
+                    if x[0] == x[1] && x[1] != x[2] {
+                        for (p, &w) in [x[0].to_usize(), x[2].to_usize(), n[1].to_usize()]
+                            .iter()
+                            .zip(w)
+                        {
+                            if let Some(s) = spare.get_mut(*p) {
+                                *s = L::narrow(w.to_usize());
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for t in 0..self.tris.len() {
+            let (Some(&x), Some(n)) = (self.tris.get(t), self.next.get(t)) else {
+                break;
+            };
+            if !(x[0] == x[1] && x[1] != x[2]) {
+                continue;
+            }
+            let front = n[0].to_usize();
+            let f = self.tri(front);
+            if front >= t || super::is_dead(f) {
+                self.kill(t);
+                continue;
+            }
+            let back = [f[0], f[2], f[1]];
+            #[cfg(feature = "seams")]
+            if welded {
+                let own = [x[0].to_usize(), x[2].to_usize(), n[1].to_usize()];
+                if let (Some(&ow), Some(&fw)) = (self.wedges.get(t), self.wedges.get(front)) {
+                    let mut w = [fw[0], fw[2], fw[1]];
+                    for (w, &v) in w.iter_mut().zip(&back) {
+                        if let Some(k) = own.iter().position(|&o| o == v) {
+                            *w = ow.get(k).copied().unwrap_or(*w);
+                        } else if let Some(&s) = spare.get(v) {
+                            if s != L::NIL {
+                                *w = I::narrow(s.to_usize());
+                            }
+                        }
+                    }
+                    if let Some(slot) = self.wedges.get_mut(t) {
+                        *slot = w;
+                    }
+                }
+            }
+            if let Some(slot) = self.tris.get_mut(t) {
+                *slot = [I::narrow(back[0]), I::narrow(back[1]), I::narrow(back[2])];
+            }
+        }
+    }
+
     /// Moves the live triangles to the front of the buffer, in their original order, and
     /// returns how many there are. The workspace's lists are stale afterwards.
-    pub(crate) fn compact(&mut self) -> usize {
+    pub(crate) fn compact(&mut self, #[cfg(feature = "seams")] spare: &mut [L]) -> usize {
+        if self.twins > 0 {
+            self.revive_twins(
+                #[cfg(feature = "seams")]
+                spare,
+            );
+        }
         let mut n = 0;
         for t in 0..self.tris.len() {
             let Some(&tri) = self.tris.get(t) else { break };

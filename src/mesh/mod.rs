@@ -122,6 +122,9 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     /// Input triangles dropped at the start.
     pub(crate) degenerate: usize,
     pub(crate) duplicates: usize,
+    /// Input triangles that are an earlier triangle turned over (the back of a double-sided
+    /// surface): out of the run, written back at [`Mesh::compact`] behind their front.
+    pub(crate) twins: usize,
     pub(crate) valid_in: usize,
     /// With welded seams ([`crate::seam`]): each triangle's corners as wedges (the caller's
     /// vertices), kept up to date by [`Mesh::collapse`] and written back by [`Mesh::compact`];
@@ -161,6 +164,23 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     fn kill(&mut self, t: usize) {
         if let Some(x) = self.tris.get_mut(t) {
             *x = [x[0]; 3];
+        }
+    }
+
+    /// Writes `t` as the twin of `front` (`t` turned over), out of the run until
+    /// [`Mesh::compact`]: `[v, v, w]` (removed, but told apart from `[v, v, v]`), with `front`
+    /// in its first link (a removed triangle's links are never read).
+    fn kill_twin(&mut self, t: usize, front: usize) {
+        let x2 = self.tri(t)[2];
+        if let (Some(x), Some(n), Some(f)) = (
+            self.tris.get_mut(t),
+            self.next.get_mut(t),
+            L::from_usize(front),
+        ) {
+            *x = [x[0], x[0], x[1]];
+            n[0] = f;
+            // Its third position, for the backs' wedges at the end (links hold vertices).
+            n[1] = L::narrow(x2);
         }
     }
 

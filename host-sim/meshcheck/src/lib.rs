@@ -216,6 +216,10 @@ pub enum Defect {
     NewZeroArea {
         triangle: Tri,
     },
+    /// More double-sided twins in the output than in the input.
+    NewTwins {
+        count: usize,
+    },
     /// An output boundary vertex that was not on the input's boundary.
     NewBoundaryVertex {
         vertex: u32,
@@ -252,6 +256,9 @@ impl fmt::Display for Defect {
             Defect::NewPinchedVertex { vertex } => write!(f, "vertex {vertex}: new pinch"),
             Defect::NewFold { pair } => write!(f, "new folded pair {:?} / {:?}", pair.0, pair.1),
             Defect::NewZeroArea { triangle } => write!(f, "new zero-area triangle {triangle:?}"),
+            Defect::NewTwins { count } => {
+                write!(f, "{count} double-sided twins more than the input had")
+            }
             Defect::NewBoundaryVertex { vertex } => {
                 write!(f, "vertex {vertex}: new on the boundary")
             }
@@ -300,6 +307,9 @@ pub struct Verdict {
     /// With [`Options::parts`]: components of the cleaned input that the output does not
     /// touch at all (removed whole, not a defect).
     pub parts_removed: usize,
+    /// Twins (the back of a double-sided triangle: an earlier triangle turned over) in the input
+    /// and in the output. The other counts are taken over the fronts alone.
+    pub twins: (usize, usize),
     /// Boundary loops of the cleaned input and of the output.
     pub boundary_loops: (usize, usize),
     /// Euler characteristic of the cleaned input and of the output.
@@ -368,6 +378,13 @@ impl fmt::Display for Verdict {
         ];
         for (name, n) in counts {
             writeln!(f, "  {name:<24} {n:<6} {}", mark(n == 0))?;
+        }
+        if v.twins != (0, 0) {
+            writeln!(
+                f,
+                "  double-sided twins       {} -> {}  (backs of the fronts above, checked with them)",
+                v.twins.0, v.twins.1
+            )?;
         }
         if v.lost_wedges > 0 {
             writeln!(
@@ -519,10 +536,10 @@ pub fn normal_angle_deg(pos: &[[f32; 3]], t: Tri, u: Tri) -> Option<f64> {
 }
 
 /// The triangles as the library keeps them: repeated-index triangles and later duplicates
-/// (same vertex set) dropped; out-of-range triangles dropped too.
+/// (same vertex set) dropped, but for the first copy turned over (a double-sided triangle's
+/// back, see [`split_twins`]); out-of-range triangles dropped too.
 pub fn clean(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
-    let mut seen = HashSet::with_capacity(triangles.len());
-    triangles
+    let good: Vec<Tri> = triangles
         .iter()
         .copied()
         .filter(|t| {
@@ -530,8 +547,15 @@ pub fn clean(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
                 && t[0] != t[1]
                 && t[1] != t[2]
                 && t[0] != t[2]
-                && seen.insert(sorted(*t))
         })
+        .collect();
+    let (_, _, fronts) = split_twins(&good);
+    let fronts: HashSet<usize> = fronts.into_iter().collect();
+    let mut seen = HashSet::with_capacity(good.len());
+    good.iter()
+        .enumerate()
+        .filter(|(i, t)| !fronts.contains(i) || seen.insert(sorted(**t)))
+        .map(|(_, t)| *t)
         .collect()
 }
 
@@ -775,9 +799,76 @@ pub fn weld(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
 /// [`check`] with separate position arrays (same vertex numbering) and [`Options`].
 pub fn check_with(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     if opts.welded {
+        // Welded first: a back with its own vertices is a twin by position.
         return check_welded(input, output, opts);
     }
+    // Double-sided surfaces: each back (an earlier triangle turned over) is its front's copy,
+    // so the fronts are checked as the one-sided surface they are, and the backs counted.
+    let (fi, twins_in, _) = split_twins(input.triangles);
+    let (fo, twins_out, index) = split_twins(output.triangles);
+    if twins_in + twins_out > 0 {
+        let mut v = check_with(
+            MeshRef {
+                positions: input.positions,
+                triangles: &fi,
+            },
+            MeshRef {
+                positions: output.positions,
+                triangles: &fo,
+            },
+            opts,
+        );
+        // Defects name triangles by their place in the whole output.
+        for d in &mut v.defects {
+            if let Defect::OutOfRange { triangle }
+            | Defect::RepeatedIndex { triangle }
+            | Defect::Duplicate { triangle } = d
+            {
+                *triangle = index.get(*triangle).copied().unwrap_or(*triangle);
+            }
+        }
+        if twins_out > twins_in {
+            v.defects.push(Defect::NewTwins {
+                count: twins_out - twins_in,
+            });
+        }
+        v.twins = (twins_in, twins_out);
+        return v;
+    }
     check_split(input, output, opts)
+}
+
+/// The triangles less the twins (a triangle whose vertex set an earlier one has, turned over,
+/// and the first such), how many twins there were, and each kept triangle's place in
+/// `triangles`. Repeated copies in either winding stay, to be counted as duplicates.
+pub fn split_twins(triangles: &[Tri]) -> (Vec<Tri>, usize, Vec<usize>) {
+    use std::collections::HashMap;
+    // Per vertex set: the first copy's winding, and whether a twin was taken.
+    let mut seen: HashMap<Tri, (Tri, bool)> = HashMap::with_capacity(triangles.len());
+    let (mut kept, mut index, mut twins) = (Vec::with_capacity(triangles.len()), Vec::new(), 0);
+    for (i, &t) in triangles.iter().enumerate() {
+        let rotations = |a: Tri| [a, [a[1], a[2], a[0]], [a[2], a[0], a[1]]];
+        let twin = t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && {
+            match seen.get_mut(&sorted(t)) {
+                Some((first, taken)) if !*taken && !rotations(*first).contains(&t) => {
+                    *taken = true;
+                    true
+                }
+                Some(_) => false,
+                None => {
+                    seen.insert(sorted(t), (t, false));
+                    false
+                }
+            }
+        };
+        if twin {
+            twins += 1;
+        } else {
+            kept.push(t);
+            index.push(i);
+        }
+    }
+    (kept, twins, index)
 }
 
 /// [`check_with`] for welded seams: the tests on both meshes welded by position, then the
@@ -791,7 +882,7 @@ fn check_welded(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         welded: false,
         ..*opts
     };
-    let mut v = check_split(
+    let mut v = check_with(
         MeshRef {
             positions: input.positions,
             triangles: &wi,
@@ -970,6 +1061,7 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         new_boundary_vertices,
         lost_wedges: 0,
         parts_removed,
+        twins: (0, 0),
         boundary_loops: (ti.boundary_loops, to.boundary_loops),
         euler: (ti.euler, to.euler),
         components: (ti.components, to.components),

@@ -419,7 +419,8 @@ pub struct ResultHeader {
     pub triangles_out: u32,
     pub target_triangles: u32,
     pub target_reached: bool,
-    /// 0 running, 1 target, 2 no legal collapse, 3 max cost, 4 max passes.
+    /// 0 running, 1 target, 2 no legal collapse, 3 max cost, 4 max passes, 5 log full, 6 error
+    /// limit.
     pub stop: u8,
     pub pass_log_len: u8,
     pub collapses: u32,
@@ -759,6 +760,7 @@ pub mod lib {
                     Stop::MaxCost => 3,
                     Stop::MaxPasses => 4,
                     Stop::LogFull => 5,
+                    Stop::ErrorLimit => 6,
                 };
                 h.pass_log_len = r.pass_triangles.len().min(PASS_LOG) as u8;
                 for (d, s) in h.pass_triangles.iter_mut().zip(r.pass_triangles.iter()) {

@@ -87,6 +87,7 @@ pub fn stop_reason(code: u8) -> &'static str {
         3 => "every collapse left costs more than max_cost",
         4 => "max passes run",
         5 => "collapse log full",
+        6 => "every collapse left is over the error limit",
         _ => "unknown",
     }
 }

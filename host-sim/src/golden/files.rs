@@ -171,6 +171,8 @@ impl Golden {
             2 => "no legal collapse",
             3 => "max cost",
             4 => "max passes",
+            5 => "log full",
+            6 => "error limit",
             _ => "?",
         };
         writeln!(w, "stop = {stop:?}")?;

@@ -67,6 +67,13 @@ impl Cost for Builtin {
         }
     }
 
+    fn error2(&self, f: &QuadricFan, m: &Move, price: f32) -> f32 {
+        match self {
+            Builtin::Quadric(q) => q.error2(f, m, price),
+            Builtin::NormalVariation(_) => 0.0,
+        }
+    }
+
     fn needs_turn(&self) -> bool {
         matches!(self, Builtin::NormalVariation(_))
     }

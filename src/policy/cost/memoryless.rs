@@ -49,6 +49,21 @@ impl Default for Quadric {
     }
 }
 
+/// `dᵀ Q d` of the fan's quadric, clamped at zero (rounding can make it slightly negative).
+#[inline]
+fn form(f: &QuadricFan, d: [f32; 3]) -> f32 {
+    let q = &f.q;
+    let e = q[0] * d[0] * d[0]
+        + q[3] * d[1] * d[1]
+        + q[5] * d[2] * d[2]
+        + 2.0 * (q[1] * d[0] * d[1] + q[2] * d[0] * d[2] + q[4] * d[1] * d[2]);
+    if e > 0.0 {
+        e
+    } else {
+        0.0
+    }
+}
+
 /// The fan summary of [`Quadric`]: `Q` (upper triangle, row by row) and twice the area.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct QuadricFan {
@@ -86,18 +101,21 @@ impl Cost for Quadric {
 
     #[inline]
     fn price(&self, f: &QuadricFan, m: &Move) -> f32 {
-        let (q, d) = (&f.q, &m.d);
-        let e = q[0] * d[0] * d[0]
-            + q[3] * d[1] * d[1]
-            + q[5] * d[2] * d[2]
-            + 2.0 * (q[1] * d[0] * d[1] + q[2] * d[0] * d[2] + q[4] * d[1] * d[2]);
-        let e = if e > 0.0 { e } else { 0.0 };
+        let e = form(f, m.d);
         let thin = if f.area2 > 0.0 {
             1.0 + self.reference / f.area2
         } else {
             1.0
         };
         e * thin + self.boundary_weight * m.retreat2 * self.reference
+    }
+
+    /// The area-weighted mean squared distance from the kept vertex to the planes of the
+    /// triangles around the removed one (`dᵀQd / A_fan`), plus the squared boundary retreat.
+    fn error2(&self, f: &QuadricFan, m: &Move, _price: f32) -> f32 {
+        let e = form(f, m.d);
+        let e = if f.area2 > 0.0 { e / f.area2 } else { 0.0 };
+        e + m.retreat2
     }
 
     fn needs_turn(&self) -> bool {

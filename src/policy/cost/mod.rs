@@ -81,6 +81,13 @@ pub trait Cost {
     fn add(&self, fan: &mut Self::Fan, normal: V3, area2: f32);
     /// The price of one move of the vertex whose fan was summarised.
     fn price(&self, fan: &Self::Fan, m: &Move) -> f32;
+    /// The move's own geometric error, squared, in the normalised units of [`Move`]'s positions,
+    /// given the price [`Cost::price`] (or the placed price) gave it: what
+    /// [`Config::error_limit`](crate::Config::error_limit) is compared with. Zero by default: a
+    /// cost that measures no distance (normal variation) is never limited.
+    fn error2(&self, _fan: &Self::Fan, _m: &Move, _price: f32) -> f32 {
+        0.0
+    }
     /// Whether [`Move::turn`] must be computed (one more fan walk per candidate).
     fn needs_turn(&self) -> bool;
     /// Whether [`Cost::add`] and [`Cost::round`] use what they are given (the fan's normals

@@ -153,6 +153,19 @@ impl Cost for StoredQuadric<'_> {
         self.best(m).1
     }
 
+    /// The price over the summed plane weights (the trace of the two quadrics' 3×3 parts, as
+    /// each plane's normal is a unit vector): the weighted mean squared distance to every
+    /// original plane the two vertices carry.
+    fn error2(&self, _: &(), m: &Move, price: f32) -> f32 {
+        let trace = |q: VertexQuadric| q[0] + q[4] + q[7];
+        let w = trace(self.quadric(m.from)) + trace(self.quadric(m.to));
+        if w > 0.0 {
+            price / w
+        } else {
+            0.0
+        }
+    }
+
     fn needs_turn(&self) -> bool {
         false
     }

@@ -158,6 +158,7 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
         if let Some(e) = args.max_error {
             config = config.with_max_error(e.distance(&mesh.positions));
         }
+        config = config.with_error_limit(args.error_limit().distance(&mesh.positions));
         config
             .validate()
             .map_err(|e| anyhow!("configuration: {e}"))?;
