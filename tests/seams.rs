@@ -14,7 +14,7 @@ mod common;
 use std::collections::BTreeSet;
 
 use common::*;
-use tinydecimate::{seam, Builtin, Config, NoBound, Positions, Report, Stop};
+use tinydecimate::{seam, Builtin, Config, EdgeCollapse, NoBound, Positions, Report, Stop};
 
 /// Welds, simplifies (default configuration at `ratio`) and returns the output in the input's
 /// numbering.
@@ -33,6 +33,7 @@ fn simplify_welded(m: &MeshData, ratio: f32) -> (MeshData, Report) {
             &config,
             Builtin::new(),
             NoBound,
+            EdgeCollapse,
         )
         .expect("start")
         .with_wedges(&mut wedges)
