@@ -178,7 +178,7 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
             }
         })
         .collect();
-    counted.sort_by(|a, b| b.1.cmp(&a.1));
+    counted.sort_by_key(|c| std::cmp::Reverse(c.1));
     let relaxable = |(r, n, unit): &(&Relief, usize, &'static str)| {
         r.option.filter(|_| *n > 0).map(|(option, example)| Relax {
             limit: r.rule.name(),
@@ -294,5 +294,183 @@ impl Advice {
             );
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tinydecimate::legality::Kind;
+    use tinydecimate::{Config, RULES};
+
+    /// An outcome that stopped short with these refusals (by rule name).
+    fn short(stop: Stop, refused: &[(&str, u32)], features: usize, locked: usize) -> Outcome {
+        Outcome {
+            stop,
+            target_reached: false,
+            target_triangles: 100,
+            triangles_out: 120,
+            refused: RULES
+                .iter()
+                .map(|r| refused.iter().find(|x| x.0 == r.name).map_or(0, |x| x.1))
+                .collect(),
+            feature_vertices: features,
+            locked_vertices: locked,
+        }
+    }
+
+    fn options(a: &Advice) -> Vec<&str> {
+        a.relax.iter().map(|r| r.option).collect()
+    }
+
+    #[test]
+    fn one_row_per_rule_and_no_option_for_validity_rules() {
+        assert_eq!(RELIEF.len(), RULES.len());
+        for (row, rule) in RELIEF.iter().zip(RULES) {
+            assert_eq!(row.rule, rule.reject, "{}", rule.name);
+            assert_eq!(
+                row.option.is_none(),
+                rule.kind == Kind::Validity,
+                "{}",
+                rule.name
+            );
+            if let Some((option, example)) = row.option {
+                assert!(example.contains(option), "{example}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_rule_that_refused_most_is_named_with_its_option() {
+        // pr2_sensor_mount at 10 %.
+        let o = short(
+            Stop::NoLegalCollapse,
+            &[
+                ("boundary", 2835),
+                ("link", 691),
+                ("normal_turn", 12942),
+                ("sliver", 3427),
+                ("fold", 1117),
+            ],
+            122,
+            66,
+        );
+        let a = advise(&o, "in.obj", "out.obj").expect("stopped short");
+        assert_eq!(
+            (a.limit, a.count, a.unit),
+            ("normal_turn", 12942, "refusals")
+        );
+        assert_eq!(
+            options(&a),
+            ["--max-turn", "--min-quality", "--no-features"]
+        );
+        assert_eq!(a.relax[2].unit, "vertices");
+        assert_eq!(
+            a.fallback.as_deref(),
+            Some("host-sim cluster in.obj out.obj --target-triangles 100")
+        );
+        assert_eq!(
+            a.fallback_then_collapse.as_deref(),
+            Some("host-sim cluster in.obj out.obj --target-triangles 200 --then-collapse 100")
+        );
+        let text = a.text(&o, "  ");
+        assert!(text.contains("limit                  normal_turn, 12942 refusals"));
+        assert!(text.contains("relax                  --max-turn 120 (normal_turn"));
+        assert!(!text.contains("no option relaxes it"));
+        assert!(text.contains("--then-collapse 100"));
+    }
+
+    #[test]
+    fn a_validity_limit_says_so_and_offers_what_can_be_relaxed() {
+        let o = short(
+            Stop::NoLegalCollapse,
+            &[("fold", 1382), ("normal_turn", 623), ("sliver", 161)],
+            0,
+            0,
+        );
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!(a.limit, "fold");
+        assert_eq!(options(&a), ["--max-turn", "--min-quality"]);
+        assert!(a.text(&o, "").contains("(no option relaxes it)"));
+        // Nothing relaxable refused: nothing offered but the fallback.
+        let o = short(
+            Stop::NoLegalCollapse,
+            &[("boundary", 10), ("link", 3)],
+            0,
+            4,
+        );
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!(a.limit, "boundary");
+        assert!(a.relax.is_empty());
+        let text = a.text(&o, "");
+        assert!(text.contains("nothing refused can be relaxed") && text.contains("fallback"));
+    }
+
+    #[test]
+    fn flagged_vertices_name_the_limit_when_nothing_was_refused() {
+        let o = short(Stop::NoLegalCollapse, &[], 40, 7);
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!((a.limit, a.count, a.unit), ("feature", 40, "vertices"));
+        assert_eq!(options(&a), ["--no-features"]);
+        let o = short(Stop::NoLegalCollapse, &[], 0, 7);
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!((a.limit, a.count), ("locked", 7));
+        assert!(a.relax.is_empty());
+    }
+
+    #[test]
+    fn stops_and_bounds() {
+        let a = advise(&short(Stop::MaxPasses, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
+        assert_eq!((a.limit, options(&a)), ("max_passes", vec!["--schedule"]));
+        let a = advise(&short(Stop::MaxCost, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
+        assert_eq!(a.limit, "max_cost");
+        assert!(a.relax.is_empty());
+        let o = short(Stop::NoLegalCollapse, &[("bound", 900), ("seam", 20)], 0, 0);
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!(
+            (a.limit, options(&a)),
+            ("bound", vec!["--max-error", "--seams"])
+        );
+        // Reached: nothing to say.
+        let mut o = short(Stop::Target, &[("sliver", 5)], 0, 0);
+        o.target_reached = true;
+        assert_eq!(advise(&o, "a", "b"), None);
+    }
+
+    /// A real run held back by a tight normal-turn limit: the report names it.
+    #[test]
+    fn a_real_report_names_its_limit() {
+        let n = 24u32;
+        let w = n + 1;
+        let positions = (0..w * w)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                [x, y, (x * 0.7).sin() * (y * 0.5).cos() * 2.0]
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                let a = y * w + x;
+                triangles.extend([[a, a + 1, a + w + 1], [a, a + w + 1, a + w]]);
+            }
+        }
+        let mesh = crate::io::MeshData {
+            positions,
+            triangles,
+        };
+        let mut config = Config::new().with_ratio(0.05);
+        config.max_normal_turn_deg = 2.0;
+        let (_, report, _) = crate::simplify::simplify(&mesh, &config).expect("simplify");
+        assert!(!report.target_reached, "{report:?}");
+        let o = Outcome::from(&report);
+        let a = advise(&o, "in.obj", "out.obj").expect("stopped short");
+        assert_eq!(a.limit, "normal_turn", "{report:?}");
+        assert_eq!(a.relax[0].option, "--max-turn");
+        // Relaxed, it gets there.
+        config.max_normal_turn_deg = 120.0;
+        let (_, report, _) = crate::simplify::simplify(&mesh, &config).expect("simplify");
+        assert!(report.target_reached, "{report:?}");
+        assert_eq!(advise(&Outcome::from(&report), "a", "b"), None);
     }
 }
