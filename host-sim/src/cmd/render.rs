@@ -14,6 +14,7 @@ pub struct Args {
     pub out: std::path::PathBuf,
     /// Draw original | MESH | ORIGINAL coloured by its distance to MESH (surface MESH lost is
     /// hot) | MESH coloured by its distance to ORIGINAL, side by side, both heatmaps on one scale.
+    /// glTF models: original | MESH | MESH with its edges, textured.
     #[arg(long, value_name = "ORIGINAL")]
     pub compare: Option<std::path::PathBuf>,
 }

@@ -189,9 +189,10 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
         })
     };
     let mut relax: Vec<Relax> = counted.iter().filter_map(relaxable).collect();
-    if refusals > 0 && o.feature_vertices > 0 {
-        let feature = &RELIEF[Reject::Feature as usize];
-        relax.extend(relaxable(&(feature, o.feature_vertices, "vertices")));
+    if let Some(feature) = RELIEF.iter().find(|r| r.rule == Reject::Feature) {
+        if refusals > 0 {
+            relax.extend(relaxable(&(feature, o.feature_vertices, "vertices")));
+        }
     }
     let (limit, count, unit, why) = match o.stop {
         Stop::MaxPasses => {
