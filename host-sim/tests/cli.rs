@@ -265,6 +265,7 @@ fn json_max_error_and_stdio() {
     assert_eq!(j["check"]["against"], "cleaned input");
     assert!(j["metro"].is_object(), "{j}");
     assert_eq!(j["valid"], true);
+    assert!(j["advice"].is_null(), "{j}");
 
     // --max-error alone (a percentage of the diagonal or a distance): a guaranteed bound; a
     // tighter one keeps more triangles, E_max stays within it, any cost.
@@ -288,6 +289,8 @@ fn json_max_error_and_stdio() {
         assert!(emax <= d, "{e}: {emax} > {d}");
         assert!(j["report"]["mean_error"].as_f64().unwrap() <= emax);
         assert_eq!(j["valid"], true);
+        // The bound is the goal: stopping there is no shortfall.
+        assert!(j["advice"].is_null(), "{j}");
         kept.push(j["report"]["triangles_out"].as_u64().unwrap());
     }
     assert!(kept[0] > kept[1], "{kept:?}");
@@ -334,4 +337,59 @@ fn json_max_error_and_stdio() {
     // --json with `-` as output would mix the two.
     let o = run(&["simplify", s(&input), "-", "--ratio", "0.5", "--json"]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// A run that stops short says which limit stopped it, the option that relaxes it and the
+/// clustering fallback, in the text and in the JSON; relaxed as advised, it reaches the target.
+#[test]
+fn stopping_short_says_why_and_what_to_do() {
+    let d = tempfile::tempdir().unwrap();
+    let input = write(d.path(), "g.obj", &bumpy_obj(20, false));
+    let out = d.path().join("o.obj");
+    let args = [
+        "simplify",
+        s(&input),
+        s(&out),
+        "--ratio",
+        "0.05",
+        "--no-measure",
+    ];
+    let o = run(&[&args[..], &["--max-turn", "1", "--json"]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["report"]["target_reached"], false, "{j}");
+    let a = &j["advice"];
+    assert_eq!(a["limit"], "normal_turn", "{a}");
+    assert_eq!(a["relax"][0]["option"], "--max-turn", "{a}");
+    let target = j["report"]["target_triangles"].as_u64().unwrap();
+    assert_eq!(
+        a["fallback"].as_str().unwrap(),
+        format!(
+            "host-sim cluster {} {} --target-triangles {target}",
+            s(&input),
+            s(&out)
+        )
+    );
+    assert!(a["fallback_then_collapse"]
+        .as_str()
+        .unwrap()
+        .ends_with(&format!(
+            "--target-triangles {} --then-collapse {target}",
+            2 * target
+        )));
+    let o = run(&[&args[..], &["--max-turn", "1"]].concat());
+    let t = text(&o.stdout);
+    for line in [
+        "stopped short",
+        "limit                  normal_turn",
+        "relax                  --max-turn 120",
+        "fallback               host-sim cluster",
+    ] {
+        assert!(t.contains(line), "{line}: {t}");
+    }
+    // As advised.
+    let o = run(&[&args[..], &["--max-turn", "120", "--json"]].concat());
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["report"]["target_reached"], true, "{j}");
+    assert!(j["advice"].is_null());
 }

@@ -1,5 +1,5 @@
 //! `host-sim render MESH OUT.png [--compare ORIGINAL]`: a flat-shaded picture of a mesh, or a
-//! comparison with an error heatmap ([`crate::render::draw`]).
+//! comparison with error heatmaps both ways ([`crate::render::draw`]).
 
 use anyhow::Result;
 
@@ -12,7 +12,9 @@ pub struct Args {
     pub mesh: std::path::PathBuf,
     /// Output PNG.
     pub out: std::path::PathBuf,
-    /// Draw original | MESH | MESH coloured by its distance to ORIGINAL, side by side.
+    /// Draw original | MESH | ORIGINAL coloured by its distance to MESH (surface MESH lost is
+    /// hot) | MESH coloured by its distance to ORIGINAL, side by side, both heatmaps on one scale.
+    /// glTF models: original | MESH | MESH with its edges, textured.
     #[arg(long, value_name = "ORIGINAL")]
     pub compare: Option<std::path::PathBuf>,
 }

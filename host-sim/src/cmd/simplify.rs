@@ -19,6 +19,7 @@ use crate::io::{Format, MeshData};
 use crate::simplify::{format_report, report_json, simplify_parts};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
+mod advice;
 mod textured;
 
 /// Which schedule, on the command line.
@@ -597,6 +598,9 @@ fn run_text(args: &Args, run: &Run) -> String {
         );
     }
     let _ = writeln!(text, "{}", format_report(report));
+    if let Some((outcome, advice)) = advice_for(args, report) {
+        text += &advice.text(&outcome, "  ");
+    }
     let _ = writeln!(
         text,
         "  library call           {:.3} ms",
@@ -651,6 +655,18 @@ fn run_text(args: &Args, run: &Run) -> String {
     text
 }
 
+/// What to do when the run stopped short of the triangle count it was asked for (with
+/// `--max-error` alone the bound is the goal, and stopping there is no shortfall).
+fn advice_for(args: &Args, report: &Report) -> Option<(advice::Outcome, advice::Advice)> {
+    if args.ratio.is_none() && args.target_triangles.is_none() {
+        return None;
+    }
+    let outcome = advice::Outcome::from(report);
+    let input = args.input.display().to_string();
+    let output = args.output.display().to_string();
+    advice::advise(&outcome, &input, &output).map(|a| (outcome, a))
+}
+
 /// The JSON object of `--json`, before the check and the error are added.
 fn run_json(args: &Args, run: &Run) -> serde_json::Value {
     let (v, t) = (run.mesh.positions.len(), run.mesh.triangles.len());
@@ -669,6 +685,7 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "max_error": args.max_error.map(|e| e.to_string()),
         "d_hold": if config.max_error.is_finite() { Some(config.max_error) } else { None },
         "report": report_json(&run.report),
+        "advice": advice_for(args, &run.report).map(|(_, a)| a),
         "library_ms": run.elapsed.as_secs_f64() * 1e3,
         "workspace_bytes": workspace_bytes(v, t).0,
     })

@@ -136,6 +136,9 @@ fn refuse_optimal(args: &Args) -> Result<()> {
 /// One part's outcome.
 struct Part {
     triangles: Vec<[u32; 3]>,
+    /// The part's target, and whether it stopped short of it.
+    target: usize,
+    short: bool,
     line: String,
     valid: bool,
     json: serde_json::Value,
@@ -180,10 +183,18 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
                 String::new()
             }
         );
+        // Why it stopped short, per part; the fallback is for the whole file (`finish`).
+        let advice = super::advice_for(args, &report).map(|(outcome, mut a)| {
+            a.fallback = None;
+            a.fallback_then_collapse = None;
+            let _ = write!(line, "\n{}", a.text(&outcome, "    ").trim_end());
+            a
+        });
         let mut valid = true;
         let mut json = serde_json::json!({
             "part": label,
             "report": crate::simplify::report_json(&report),
+            "advice": advice,
         });
         if !args.no_measure {
             let weld = args.seams == super::SeamsArg::Weld;
@@ -217,6 +228,8 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
         }
         out.push(Part {
             triangles: tris,
+            target: report.target_triangles,
+            short: advice.is_some(),
             line,
             valid,
             json,
@@ -272,6 +285,16 @@ fn uv_stretch(
 
 fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
     let valid = parts.iter().all(|p| p.valid);
+    // A part stopped short: clustering reaches the file's count (on positions only; it reads
+    // no glTF).
+    let fallback =
+        (parts.iter().any(|p| p.short) && !crate::gltf::is_gltf_path(&args.input)).then(|| {
+            super::advice::fallbacks(
+                &args.input.display().to_string(),
+                &args.output.display().to_string(),
+                parts.iter().map(|p| p.target).sum(),
+            )
+        });
     if args.json {
         let mut j = serde_json::json!({
             "input": args.input.display().to_string(),
@@ -279,6 +302,7 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
             "parts": parts.iter().map(|p| p.json.clone()).collect::<Vec<_>>(),
             "triangles_out": parts.iter().map(|p| p.triangles.len()).sum::<usize>(),
             "valid": valid,
+            "fallback": fallback.as_ref().map(|f| [&f.0, &f.1]),
         });
         if let [p] = parts {
             // One part: its report where the plain path puts it.
@@ -289,6 +313,14 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
         let mut text = head;
         for p in parts {
             let _ = writeln!(text, "{}", p.line);
+        }
+        if let Some((alone, then)) = &fallback {
+            let _ = writeln!(
+                text,
+                "  fallback: {alone} (vertex clustering: reaches the count)\n            {then} \
+                 (clusters to at most twice the count, then collapses: lower error)\n            \
+                 both read positions only: the attributes are not carried"
+            );
         }
         crate::out!("{text}");
     }
