@@ -126,8 +126,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             removed: 0,
         };
         if count > 0 {
-            (parts.next, parts.next_r2) =
-                measure(&self.mesh, &parts, &self.cost, parts.order(0));
+            (parts.next, parts.next_r2) = measure(&self.mesh, &parts, &self.cost, parts.order(0));
         }
         self.parts = parts;
         Ok(self)

@@ -219,6 +219,19 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
             relax.clear();
             ("log_full", 0, "", "the collapse log is full")
         }
+        Stop::ErrorLimit => {
+            // On purpose: what is left would cut corners. Raising the limit is the one lever.
+            relax = vec![Relax {
+                limit: "error_limit",
+                count: 0,
+                unit: "",
+                option: "--error-limit",
+                example: "--error-limit 5%",
+            }];
+            let why = "every collapse left is over the error limit: reaching the count would \
+                       cut corners";
+            ("error_limit", 0, "", why)
+        }
         _ => match counted.first() {
             Some((r, n, unit)) if *n > 0 => (r.rule.name(), *n, *unit, r.why),
             _ => ("none", 0, "", "no collapse was refused"),
@@ -421,6 +434,10 @@ mod tests {
 
     #[test]
     fn stops_and_bounds() {
+        let a = advise(&short(Stop::ErrorLimit, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
+        assert_eq!(a.limit, "error_limit");
+        assert_eq!(a.relax.len(), 1);
+        assert_eq!(a.relax[0].option, "--error-limit");
         let a = advise(&short(Stop::MaxPasses, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
         assert_eq!((a.limit, options(&a)), ("max_passes", vec!["--schedule"]));
         let a = advise(&short(Stop::MaxCost, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
