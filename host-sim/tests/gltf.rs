@@ -845,7 +845,9 @@ fn ply_keeps_extra_vertex_properties() {
         .arg("simplify")
         .arg(&input)
         .arg(&output)
-        .args(["--ratio", "0.3"])
+        // Heights jump by up to 2 between neighbours: every collapse is over the default
+        // error limit, and this test is about the vertex properties.
+        .args(["--ratio", "0.3", "--error-limit", "none"])
         .output()
         .unwrap();
     let report = String::from_utf8_lossy(&o.stdout);

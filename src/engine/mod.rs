@@ -153,8 +153,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let target = if mesh.twins == 0 {
             target_out
         } else {
-            // Rounded down: a wholly double-sided surface never ends above the target.
-            (target_out as u64 * mesh.valid_in as u64 / all.max(1) as u64) as usize
+            // Rounded down: a wholly double-sided surface never ends above the target. In
+            // `usize` (no 64-bit division in the image); past its range, in `f32`.
+            match target_out.checked_mul(mesh.valid_in) {
+                Some(p) => p / all.max(1),
+                None => (target_out as f32 * (mesh.valid_in as f32 / all as f32)) as usize,
+            }
         };
         let (mut locked, mut used_in) = (0, 0);
         for v in 0..mesh.vertex_count() {
