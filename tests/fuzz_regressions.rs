@@ -50,12 +50,18 @@ fn duplicate_after_a_killed_duplicate_is_dropped() {
         [2.0, 1.0, 0.0],
         [2.0, -1.0, 0.0],
     ];
-    let mut tris: [[u32; 3]; 4] = [[0, 1, 2], [0, 1, 2], [1, 3, 4], [1, 4, 3]];
+    // The copy in the same winding (rotated) is a duplicate.
+    let mut tris: [[u32; 3]; 4] = [[0, 1, 2], [0, 1, 2], [1, 3, 4], [3, 4, 1]];
     let mut ws = Workspace::<u16, 64, 64>::new();
     let config = Config::new().with_ratio(1.0);
     let r = ws.simplify(&positions, &mut tris, &config).unwrap();
     assert_eq!(r.duplicates_dropped, 2, "{r:?}");
     assert_eq!(&tris[..r.triangles_out], &[[0, 1, 2], [1, 3, 4]]);
+    // Turned over, it is found the same way, and kept as the back of a double-sided triangle.
+    let mut tris: [[u32; 3]; 4] = [[0, 1, 2], [0, 1, 2], [1, 3, 4], [1, 4, 3]];
+    let r = ws.simplify(&positions, &mut tris, &config).unwrap();
+    assert_eq!((r.duplicates_dropped, r.twins), (1, 1), "{r:?}");
+    assert_eq!(&tris[..r.triangles_out], &[[0, 1, 2], [1, 3, 4], [1, 4, 3]]);
 }
 
 /// Unit normal (f64) of a triangle, zero if it has no area.
