@@ -84,6 +84,7 @@ fn opaque_config() -> Config {
         min_quality: opaque_f32(8),
         boundary_weight: opaque_f32(9),
         max_error: opaque_f32(19),
+        error_limit: opaque_f32(24),
         control_angle_deg: opaque_f32(20),
     };
     // The builders too.
@@ -96,6 +97,7 @@ fn opaque_config() -> Config {
         .with_max_passes(input(13))
         .with_max_cost(opaque_f32(14))
         .with_max_error(opaque_f32(21))
+        .with_error_limit(opaque_f32(25))
         .with_cost(c.cost);
     black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
