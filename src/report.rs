@@ -85,8 +85,9 @@ pub struct Report {
     /// Input triangles that are an earlier triangle turned over (the back of a double-sided
     /// surface). They take no part in the run: each is written back after the output's other
     /// triangles, turned over from its front, if the front survived (and counted in
-    /// `triangles_out`). The fronts aim for their share of the target, so the output's count
-    /// is the target's within the few twins whose fronts' survival differs from the average.
+    /// `triangles_out`). The fronts aim for their share of the target; when they meet it the
+    /// backs still to come are counted, and the share drops until the whole output is within
+    /// the target.
     pub twins: usize,
     /// Triangles in the output (the prefix of the caller's buffer that holds the result).
     pub triangles_out: usize,

@@ -81,7 +81,7 @@ fn step_by_step(m: &MeshData, config: &Config) -> (MeshData, Report, Steps) {
             }
         }
         for (slot, (old, new)) in before.iter().zip(s.buffer()).enumerate() {
-            let live = |t: &[u32; 3]| !(t[0] == t[1] && t[1] == t[2]);
+            let live = |t: &[u32; 3]| t[0] != t[1];
             if old == new || !live(old) || !live(new) {
                 continue;
             }

@@ -54,6 +54,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// pop instead ended the run, started a new round or a refresh of the feature threshold.
     pub(super) fn top(&mut self) -> Option<(usize, f32)> {
         if self.mesh.live <= self.target {
+            if self.twins_over() {
+                return None;
+            }
             self.done(Stop::Target);
             return None;
         }
@@ -160,6 +163,21 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             self.reached2 = e2;
         }
         false
+    }
+
+    /// With twins: whether the fronts' share of the target left the whole output (fronts and
+    /// the backs whose fronts live) above it; then the share drops by the excess and the run
+    /// goes on. One sweep of the buffer, only when the share is met.
+    fn twins_over(&mut self) -> bool {
+        if self.mesh.twins == 0 {
+            return false;
+        }
+        let out = self.mesh.live + self.mesh.live_twins();
+        if out <= self.target_out {
+            return false;
+        }
+        self.target = self.mesh.live.saturating_sub(out - self.target_out);
+        true
     }
 
     pub(super) fn new_round(&mut self) {

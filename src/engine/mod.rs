@@ -71,8 +71,9 @@ enum Phase {
 /// A simplification in progress; see [`Storage::start`](crate::Storage::start).
 ///
 /// Between steps the mesh is always valid: [`Simplifier::triangles`] yields its live
-/// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (degenerate,
-/// so a renderer draws nothing for them) until [`Simplifier::finish`] compacts it.
+/// triangles. The caller's buffer itself holds removed triangles as `[i, i, i]` (and the backs
+/// of double-sided triangles as `[i, i, j]`: degenerate, so a renderer draws nothing for them)
+/// until [`Simplifier::finish`] compacts it.
 ///
 /// `B` is the error bound: [`NoBound`] (none, the default) or
 /// [`Controls`](crate::bound::Controls). `O` is the operator: [`EdgeCollapse`] (the default)
@@ -253,7 +254,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     }
 
     /// The caller's buffer as it is now: live triangles in their original slots, removed ones
-    /// written as `[i, i, i]`.
+    /// with their first two indices equal: `[i, i, i]`, or `[i, i, j]` for the back of a
+    /// double-sided triangle, which [`Simplifier::finish`] writes back if its front survived.
     pub fn buffer(&self) -> &[[I; 3]] {
         self.mesh.tris
     }

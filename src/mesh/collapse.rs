@@ -279,6 +279,18 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         n
     }
 
+    /// Twins ([`Mesh::kill_twin`]) whose front is alive: the backs [`Mesh::compact`] will write.
+    pub(crate) fn live_twins(&self) -> usize {
+        let mut n = 0;
+        for (t, (x, l)) in self.tris.iter().zip(self.next.iter()).enumerate() {
+            let front = l[0].to_usize();
+            if x[0] == x[1] && x[1] != x[2] && front < t && !super::is_dead(self.tri(front)) {
+                n += 1;
+            }
+        }
+        n
+    }
+
     /// Writes every twin ([`Mesh::kill_twin`]) whose front survived as its front turned over.
     /// With welded seams each corner takes a back's own wedge at its position: the twin's own
     /// if its input triangle had that position, else one that another back had there (kept in

@@ -135,7 +135,10 @@ fn header(s: &mut String, r: &Results) {
         .collect();
     let _ = writeln!(
         s,
-        "* tinydecimate modes, each `.with_ratio(ratio)`: {}.",
+        "* tinydecimate modes, each `.with_ratio(ratio)`: {}. As `host-sim simplify` runs \
+         them: vertices at one position welded (`--seams weld`), the greedy modes with the \
+         error limit of 2 % of the diagonal (`--error-limit`) and, unless the bench was given \
+         `--parts keep`, parts pruned (`--parts prune`).",
         modes.join("; ")
     );
     let ratios: Vec<String> = r.ratios.iter().map(|x| fmt_pct(*x)).collect();
