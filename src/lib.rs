@@ -84,7 +84,7 @@
 //!         EdgeCollapse,
 //!     )?
 //!     .run();
-//! assert!(report.max_error.unwrap() <= 0.05);
+//! assert!(report.max_error.is_some_and(|e| e <= 0.05));
 //! # Ok::<(), tinydecimate::Error>(())
 //! ```
 #![cfg_attr(not(test), no_std)]
