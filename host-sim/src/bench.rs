@@ -567,15 +567,16 @@ fn run_method(
         let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
             (Some(config), placement) => {
                 // Seams welded (`host-sim simplify`'s default), when the mesh has any.
-                let (out, report, elapsed) = crate::simplify::simplify_parts(
+                let run = crate::simplify::Run {
+                    placement,
+                    weld: true,
+                    prune,
+                    ..Default::default()
+                };
+                let (out, report, elapsed) = crate::simplify::simplify_with(
                     mesh,
                     &with_default_limit(config.with_ratio(ratio), mesh),
-                    crate::simplify::OperatorArg::Edge,
-                    placement,
-                    false,
-                    false,
-                    true,
-                    prune,
+                    &run,
                 )?;
                 let quadrics = if placement.is_some() {
                     v * crate::workspace::QUADRIC_BYTES

@@ -65,39 +65,24 @@ pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
     anyhow!("tinydecimate: {e}{hint}")
 }
 
-/// Runs the library on `mesh` with any policies: the operator, stored quadrics (`placement`,
-/// else the configuration's built-in cost) and the error bound (`bounded`: control points in a `u32`
-/// link slice; the bound itself is `config.max_error`), stepping with a progress bar when
-/// `progress`. The library refuses combinations it cannot run. The result carries the
-/// positions as the library left them (moved by optimal placement). The wall time is that of
-/// the library alone (storage is allocated before).
-pub fn simplify_with(
-    mesh: &MeshData,
-    config: &Config,
-    operator: OperatorArg,
-    placement: Option<Placement>,
-    bounded: bool,
-    progress: bool,
-) -> Result<(MeshData, Report, Duration)> {
-    simplify_seams(mesh, config, operator, placement, bounded, progress, false)
-}
-
-/// [`simplify_with`]; with `weld`, seams are welded first (`tinydecimate::seam::weld`: the
-/// vertices at one position collapse together, each keeping its own wedge), when the mesh has
-/// any (none: the run is the same as without).
-#[allow(clippy::too_many_arguments)]
-pub fn simplify_seams(
-    mesh: &MeshData,
-    config: &Config,
-    operator: OperatorArg,
-    placement: Option<Placement>,
-    bounded: bool,
-    progress: bool,
-    weld: bool,
-) -> Result<(MeshData, Report, Duration)> {
-    simplify_parts(
-        mesh, config, operator, placement, bounded, progress, weld, false,
-    )
+/// The policies `host-sim` runs the library with, beside the configuration.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Run {
+    /// The operator.
+    pub operator: OperatorArg,
+    /// Stored quadrics with this placement; `None`: the configuration's built-in cost.
+    pub placement: Option<Placement>,
+    /// The error bound (control points in a `u32` link slice; the bound itself is
+    /// `config.max_error`).
+    pub bounded: bool,
+    /// Step with a progress bar.
+    pub progress: bool,
+    /// Weld seams first (`tinydecimate::seam::weld`: the vertices at one position collapse
+    /// together, each keeping its own wedge), when the mesh has any.
+    pub weld: bool,
+    /// Let parts cheaper than the next collapse vanish whole (`Simplifier::with_parts`, two
+    /// `u32` links per vertex) in the runs where the library prunes ([`prunes`]).
+    pub prune: bool,
 }
 
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
@@ -106,20 +91,22 @@ pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
     prune && !bounded && config.schedule == tinydecimate::Schedule::Greedy
 }
 
-/// [`simplify_seams`]; with `prune`, parts cheaper than the next collapse vanish whole
-/// (`Simplifier::with_parts`, two `u32` links per vertex) in the runs where the library
-/// prunes ([`prunes`]); the others keep every part.
-#[allow(clippy::too_many_arguments)]
-pub fn simplify_parts(
+/// Runs the library on `mesh` with the policies of `run`. The library refuses combinations
+/// it cannot run. The result carries the positions as the library left them (moved by optimal
+/// placement). The wall time is that of the library alone (storage is allocated before).
+pub fn simplify_with(
     mesh: &MeshData,
     config: &Config,
-    operator: OperatorArg,
-    placement: Option<Placement>,
-    bounded: bool,
-    progress: bool,
-    weld: bool,
-    prune: bool,
+    run: &Run,
 ) -> Result<(MeshData, Report, Duration)> {
+    let Run {
+        operator,
+        placement,
+        bounded,
+        progress,
+        weld,
+        prune,
+    } = *run;
     let prune = prunes(prune, config, bounded);
     let mut part_links = vec![[0u32; 2]; if prune { mesh.positions.len() } else { 0 }];
     let mut tris = mesh.triangles.clone();
@@ -303,7 +290,14 @@ pub fn simplify_with_progress(
     mesh: &MeshData,
     config: &Config,
 ) -> Result<(MeshData, Report, Duration)> {
-    simplify_with(mesh, config, OperatorArg::Edge, None, false, true)
+    simplify_with(
+        mesh,
+        config,
+        &Run {
+            progress: true,
+            ..Run::default()
+        },
+    )
 }
 
 /// The report as JSON: every field of `Report`.

@@ -118,8 +118,11 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             .with_ratio(0.0)
             .with_relative_max_error(f, &mesh.positions);
         let start = Instant::now();
-        let (ours, r, _) =
-            crate::simplify::simplify_with(&mesh, &config, OperatorArg::Edge, None, true, false)?;
+        let bounded = crate::simplify::Run {
+            bounded: true,
+            ..Default::default()
+        };
+        let (ours, r, _) = crate::simplify::simplify_with(&mesh, &config, &bounded)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let m = metro(&mesh, &ours, &opts);
         let emax = f64::from(r.max_error.unwrap_or(f32::NAN));
@@ -137,10 +140,10 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             let (tri, rt, _) = crate::simplify::simplify_with(
                 &mesh,
                 &config,
-                OperatorArg::Triangle,
-                None,
-                true,
-                false,
+                &crate::simplify::Run {
+                    operator: OperatorArg::Triangle,
+                    ..bounded
+                },
             )?;
             let mt = metro(&mesh, &tri, &opts);
             let e = f64::from(rt.max_error.unwrap_or(f32::NAN));

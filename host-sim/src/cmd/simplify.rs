@@ -16,7 +16,7 @@ use tinydecimate::cost::Placement;
 use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Storage, Target};
 
 use crate::io::{Format, MeshData};
-use crate::simplify::{format_report, report_json, simplify_parts};
+use crate::simplify::{format_report, report_json, simplify_with};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
 mod advice;
@@ -515,17 +515,15 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     // The library refuses what it cannot run (stored quadrics with the passes schedule,
     // optimal placement with a bound) before any work, naming the option.
     let placement = stored.then(|| args.placement.into());
-    let weld = args.seams == SeamsArg::Weld;
-    let (out, report, elapsed) = simplify_parts(
-        &mesh,
-        &config,
-        args.operator,
+    let run = crate::simplify::Run {
+        operator: args.operator,
         placement,
         bounded,
-        true,
-        weld,
-        args.parts == PartsArg::Prune,
-    )?;
+        progress: true,
+        weld: args.seams == SeamsArg::Weld,
+        prune: args.parts == PartsArg::Prune,
+    };
+    let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
         out.clone()
     } else {

@@ -25,16 +25,14 @@ use crate::io::MeshData;
 fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
-    let weld = args.seams == super::SeamsArg::Weld;
-    let (out, report, _) = crate::simplify::simplify_seams(
-        mesh,
-        config,
-        args.operator,
+    let run = crate::simplify::Run {
+        operator: args.operator,
         placement,
-        args.max_error.is_some(),
-        false,
-        weld,
-    )?;
+        bounded: args.max_error.is_some(),
+        weld: args.seams == super::SeamsArg::Weld,
+        ..Default::default()
+    };
+    let (out, report, _) = crate::simplify::simplify_with(mesh, config, &run)?;
     Ok((out.triangles, report))
 }
 
