@@ -42,14 +42,7 @@ fn stored(m: &MeshData, config: &Config) -> (MeshData, Report) {
         )
         .expect("start")
         .run();
-    tris.truncate(r.triangles_out);
-    (
-        MeshData {
-            positions: m.positions.clone(),
-            triangles: tris,
-        },
-        r,
-    )
+    output(&m.positions, tris, r)
 }
 
 /// The limit's promises on one run: it stopped on the limit short of the target, refused

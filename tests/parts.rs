@@ -85,27 +85,14 @@ fn run(m: &MeshData, ratio: f32, prune: bool) -> (MeshData, Report) {
         s
     };
     let report = s.run();
-    tris.truncate(report.triangles_out);
-    (
-        MeshData {
-            positions: m.positions.clone(),
-            triangles: tris,
-        },
-        report,
-    )
+    output(&m.positions, tris, report)
 }
 
 /// The shared checker with parts allowed to vanish whole.
 fn parts_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
-    meshcheck::check_with(
-        meshcheck::MeshRef {
-            positions: &input.positions,
-            triangles: &input.triangles,
-        },
-        meshcheck::MeshRef {
-            positions: &output.positions,
-            triangles: &output.triangles,
-        },
+    verdict_opts(
+        input,
+        output,
         &meshcheck::Options {
             parts: true,
             ..Default::default()

@@ -39,26 +39,13 @@ fn simplify_welded(m: &MeshData, ratio: f32) -> (MeshData, Report) {
         .with_wedges(&mut wedges)
         .expect("wedges")
         .run();
-    tris.truncate(report.triangles_out);
-    (
-        MeshData {
-            positions: m.positions.clone(),
-            triangles: tris,
-        },
-        report,
-    )
+    output(&m.positions, tris, report)
 }
 
 fn welded_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
-    meshcheck::check_with(
-        meshcheck::MeshRef {
-            positions: &input.positions,
-            triangles: &input.triangles,
-        },
-        meshcheck::MeshRef {
-            positions: &output.positions,
-            triangles: &output.triangles,
-        },
+    verdict_opts(
+        input,
+        output,
         &meshcheck::Options {
             welded: true,
             ..Default::default()

@@ -264,6 +264,18 @@ pub fn verdict(input: &MeshData, output: &MeshData) -> Verdict {
 
 /// [`verdict`]; with `allow_moved`, kept vertices may have moved (optimal placement).
 pub fn verdict_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> Verdict {
+    verdict_opts(
+        input,
+        output,
+        &meshcheck::Options {
+            allow_moved,
+            ..Default::default()
+        },
+    )
+}
+
+/// The shared checker's verdict with any of its options (welded seams, parts removed whole).
+pub fn verdict_opts(input: &MeshData, output: &MeshData, opts: &meshcheck::Options) -> Verdict {
     meshcheck::check_with(
         meshcheck::MeshRef {
             positions: &input.positions,
@@ -273,12 +285,19 @@ pub fn verdict_with(input: &MeshData, output: &MeshData, allow_moved: bool) -> V
             positions: &output.positions,
             triangles: &output.triangles,
         },
-        &meshcheck::Options {
-            view: None,
-            allow_moved,
-            welded: false,
-            parts: false,
+        opts,
+    )
+}
+
+/// A run's output: the first `report.triangles_out` of `tris`, on `positions`.
+pub fn output(positions: &[[f32; 3]], mut tris: Vec<Tri>, report: Report) -> (MeshData, Report) {
+    tris.truncate(report.triangles_out);
+    (
+        MeshData {
+            positions: positions.to_vec(),
+            triangles: tris,
         },
+        report,
     )
 }
 
