@@ -13,7 +13,7 @@
 # fuzz smoke run and Miri are not run here: CI runs them after this script (see .ci/run).
 # It installs the rustup targets it needs and defmt-print (the example's defmt decoder); QEMU
 # comes from `apt-get install qemu-system-arm qemu-system-misc` (qemu-system-riscv32), installed
-# here when missing and running as root.
+# here when missing and running as root (scripts/install-qemu.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,15 +23,7 @@ installed=$(rustup target list --installed)
 for t in $need_targets; do
   grep -qx "$t" <<<"$installed" || rustup target add "$t"
 done
-if ! command -v qemu-system-arm >/dev/null || ! command -v qemu-system-riscv32 >/dev/null; then
-  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
-    apt-get update -qq &&
-      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq qemu-system-arm qemu-system-misc
-  else
-    echo "scripts/test.sh needs QEMU for the golden checks on the boards: sudo apt-get install qemu-system-arm qemu-system-misc" >&2
-    exit 2
-  fi
-fi
+bash scripts/install-qemu.sh
 command -v defmt-print >/dev/null || cargo install defmt-print --locked
 
 echo "== host tests"

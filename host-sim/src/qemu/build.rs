@@ -177,6 +177,15 @@ fn runs(program: &str, arg: &str) -> bool {
         .is_ok_and(|s| s.success())
 }
 
+/// The distribution's release name (`VERSION_CODENAME` of `/etc/os-release`).
+fn distribution_codename() -> Option<String> {
+    let text = std::fs::read_to_string("/etc/os-release").ok()?;
+    text.lines()
+        .find_map(|l| l.strip_prefix("VERSION_CODENAME="))
+        .map(|c| c.trim_matches('"').to_string())
+        .filter(|c| !c.is_empty())
+}
+
 /// Makes sure the tools for `boards` are there, on a fresh machine too:
 ///
 /// * the Rust targets of the boards: missing ones are installed with `rustup target add`
@@ -245,16 +254,26 @@ pub fn preflight(boards: &[&Board]) -> Result<Option<ExitCode>> {
             programs.join(", "),
             packages.join(" ")
         );
+        let install = |extra: &[String]| {
+            Command::new("apt-get")
+                .args(["install", "-y", "-qq"])
+                .args(&packages)
+                .args(extra)
+                .env("DEBIAN_FRONTEND", "noninteractive")
+                .status()
+                .is_ok_and(|s| s.success())
+        };
+        // Some images ship a newer qemu-utils than their distribution's QEMU, which then
+        // refuses to install beside it: take the distribution's qemu-utils too (as
+        // scripts/install-qemu.sh does).
         let ok = Command::new("apt-get")
             .args(["update", "-qq"])
             .status()
             .is_ok_and(|s| s.success())
-            && Command::new("apt-get")
-                .args(["install", "-y", "-qq"])
-                .args(&packages)
-                .env("DEBIAN_FRONTEND", "noninteractive")
-                .status()
-                .is_ok_and(|s| s.success());
+            && (install(&[])
+                || distribution_codename().is_some_and(|c| {
+                    install(&["--allow-downgrades".into(), format!("qemu-utils/{c}")])
+                }));
         if ok && programs.iter().all(|p| runs(p, "--version")) {
             return Ok(None);
         }
