@@ -294,7 +294,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     self.v = nv;
                 } else if self.v < nv {
                     if self.mesh.has(self.v, flag::USED) {
-                        let w = self.walk(self.v);
+                        let mut w = self.unwalked();
+                        let w = self.walk(self.v, &mut w);
                         if self.config.features {
                             self.mean.add(w.variation.value(self.config.feature_mode));
                         }
@@ -343,7 +344,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     let v = self.v;
                     let is = self.config.features
                         && self.mesh.has(v, flag::USED)
-                        && self.is_feature_now(&self.walk(v));
+                        && self.is_feature_now(self.walk(v, &mut self.unwalked()));
                     self.mesh.set_flag(v, flag::FEATURE, is);
                     self.mesh.set_flag(v, flag::DONE, false);
                     self.features += is as usize;
