@@ -37,7 +37,11 @@ pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {
 /// `a` turned over.
 #[inline]
 pub(crate) fn same_winding(a: [usize; 3], b: [usize; 3]) -> bool {
-    b == a || b == [a[1], a[2], a[0]] || b == [a[2], a[0], a[1]]
+    // Element by element: array `==` is a `memcmp` call per rotation on a Cortex-M.
+    let [x, y, z] = a;
+    (b[0] == x && b[1] == y && b[2] == z)
+        || (b[0] == y && b[1] == z && b[2] == x)
+        || (b[0] == z && b[1] == x && b[2] == y)
 }
 
 /// An input triangle with a repeated index: dropped.

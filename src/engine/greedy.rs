@@ -29,14 +29,15 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
         }
-        let w = self.walk(v);
-        let is = self.config.features && self.is_feature_now(&w);
+        let mut w = self.unwalked();
+        let w = self.walk(v, &mut w);
+        let is = self.config.features && self.is_feature_now(w);
         self.mesh.set_flag(v, flag::FEATURE, is);
         if is && on!(Feature) {
             return self.heap.remove(v);
         }
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, &w, &mut cand);
+        let n = self.candidates(v, w, &mut cand);
         let mut key = f32::INFINITY;
         for &(c, _) in cand.iter().take(n) {
             if c < key {
@@ -105,9 +106,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let Some((v, key)) = self.top() else {
             return;
         };
-        let w = self.walk(v);
+        let mut w = self.unwalked();
+        let w = self.walk(v, &mut w);
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, &w, &mut cand);
+        let n = self.candidates(v, w, &mut cand);
         let cand = cand.get_mut(..n).unwrap_or(&mut []);
         let mut refused = false;
         while let Some((c, to)) = take_cheapest(cand) {
@@ -119,7 +121,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 return;
             }
             refused = true;
-            match self.legal(v, &w, to, c) {
+            match self.legal(v, w, to, c) {
                 Ok((c, at)) => {
                     if c > key {
                         // Its cheapest candidate was illegal: back in at its true price.
@@ -129,7 +131,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                             self.mesh.set_flag(v, flag::RAISED, true);
                         }
                     } else {
-                        if self.over_error_limit(v, &w, to, c) {
+                        if self.over_error_limit(v, w, to, c) {
                             // Not cut to reach a count: the next candidate, if any.
                             continue;
                         }
@@ -305,9 +307,10 @@ mod tests {
                 let Some(key) = self.heap.queued(v) else {
                     continue;
                 };
-                let w = self.walk(v);
+                let mut w = self.unwalked();
+                let w = self.walk(v, &mut w);
                 let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-                let n = self.candidates(v, &w, &mut cand);
+                let n = self.candidates(v, w, &mut cand);
                 let least = cand
                     .iter()
                     .take(n)
@@ -319,7 +322,7 @@ mod tests {
                 let legal = cand
                     .iter()
                     .take(n)
-                    .filter_map(|c| self.legal(v, &w, c.1, c.0).ok())
+                    .filter_map(|c| self.legal(v, w, c.1, c.0).ok())
                     .fold(f32::INFINITY, |m, c| if c.0 < m { c.0 } else { m });
                 if key > legal {
                     return Some((v, key, legal));

@@ -137,6 +137,24 @@ pub struct Simplifier<
     parts: parts::Parts<'a, L>,
 }
 
+/// `n / d` (`d > 0`) by binary long division. The run's one integer division (the fronts'
+/// share of the target): a Cortex-M0 has no divider, and the library's routine for it took
+/// about 400 B of flash there.
+fn div_floor(n: usize, d: usize) -> usize {
+    let (mut q, mut r) = (0usize, 0usize);
+    for i in (0..usize::BITS).rev() {
+        // `r < d` before the shift, so `2r + bit < 2d`: one subtraction, with the bit shifted
+        // out of `r` standing for the `2^BITS` it lost.
+        let carry = r >> (usize::BITS - 1);
+        r = r << 1 | (n >> i & 1);
+        if carry != 0 || r >= d {
+            r = r.wrapping_sub(d);
+            q |= 1 << i;
+        }
+    }
+    q
+}
+
 impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
     #[inline(always)]
     pub(crate) fn new(
@@ -157,7 +175,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             // Rounded down: a wholly double-sided surface never ends above the target. In
             // `usize` (no 64-bit division in the image); past its range, in `f32`.
             match target_out.checked_mul(mesh.valid_in) {
-                Some(p) => p / all.max(1),
+                Some(p) => div_floor(p, all.max(1)),
                 None => (target_out as f32 * (mesh.valid_in as f32 / all as f32)) as usize,
             }
         };
@@ -294,7 +312,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     self.v = nv;
                 } else if self.v < nv {
                     if self.mesh.has(self.v, flag::USED) {
-                        let w = self.walk(self.v);
+                        let mut w = self.unwalked();
+                        let w = self.walk(self.v, &mut w);
                         if self.config.features {
                             self.mean.add(w.variation.value(self.config.feature_mode));
                         }
@@ -343,7 +362,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     let v = self.v;
                     let is = self.config.features
                         && self.mesh.has(v, flag::USED)
-                        && self.is_feature_now(&self.walk(v));
+                        && self.is_feature_now(self.walk(v, &mut self.unwalked()));
                     self.mesh.set_flag(v, flag::FEATURE, is);
                     self.mesh.set_flag(v, flag::DONE, false);
                     self.features += is as usize;
@@ -397,6 +416,32 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         }
         if self.cost.stores() {
             self.cost.merge(a, b, pa, pb, p_new);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::div_floor;
+
+    /// The long division agrees with `/`, at the ends of the range too.
+    #[test]
+    fn div_floor_is_division() {
+        let big = [
+            usize::MAX,
+            usize::MAX - 1,
+            usize::MAX / 2,
+            usize::MAX / 2 + 1,
+        ];
+        let mut x = 0x9e37_79b9_usize;
+        for i in 0..20_000usize {
+            // A fixed pseudo-random sequence (xorshift), and small values.
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let n = [x, i, x >> (i % 31), big[i % 4]][i % 4];
+            let d = [x.rotate_left(11) >> (i % 29), i % 7, big[(i / 4) % 4], n][i / 4 % 4].max(1);
+            assert_eq!(div_floor(n, d), n / d, "{n} / {d}");
         }
     }
 }

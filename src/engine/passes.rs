@@ -53,13 +53,15 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         // moves the endpoint whose W is smaller), priced; the rules then run in price order.
         let mut cand = [(f32::INFINITY, NIL, NIL); 2 * MAX_CANDIDATES];
         let mut n = 0;
-        let wv = self.walk(v);
+        let mut wv = self.unwalked();
+        let wv = self.walk(v, &mut wv);
         let movable = self.movable();
         for y in wv.neighbours() {
             if self.mesh.has(y, flag::DONE) {
                 continue;
             }
-            let wy = self.walk(y);
+            let mut wy = self.unwalked();
+            let wy = self.walk(y, &mut wy);
             for (from, to, w) in [(v, y, &wv), (y, v, &wy)] {
                 if let Some(p) = self.price(from, w, to) {
                     if let Some(slot) = cand.get_mut(n) {
@@ -85,8 +87,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             }
             let checked = if movable {
                 // A placing cost: place with `from`'s own walk.
-                let w = self.walk(from);
-                self.legal(from, &w, to, c)
+                let mut w = self.unwalked();
+                let w = self.walk(from, &mut w);
+                self.legal(from, w, to, c)
             } else {
                 self.check(from, to, None).map(|()| (c, None))
             };

@@ -94,8 +94,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
             return self.heap.remove(v);
         }
-        let w = self.walk(v);
-        let is = self.config.features && self.is_feature_now(&w);
+        let mut w = self.unwalked();
+        let w = self.walk(v, &mut w);
+        let is = self.config.features && self.is_feature_now(w);
         self.mesh.set_flag(v, flag::FEATURE, is);
         if is && on!(Feature) {
             return self.heap.remove(v);
@@ -169,9 +170,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             let mut sum = 0.0f32;
             // Indexed with next3/prev3 directly: provably below 3 (no bounds check).
             for x in [tri[next3(k)], tri[prev3(k)]] {
-                let w = self.walk(x);
+                let mut w = self.unwalked();
+                let w = self.walk(x, &mut w);
                 sum += self
-                    .price_kept(x, &w, tri[prev3(next3(k))], true)
+                    .price_kept(x, w, tri[prev3(next3(k))], true)
                     .unwrap_or(f32::INFINITY);
             }
             *slot = (sum, k);
@@ -204,9 +206,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                         return true;
                     }
                     // The second move, on the mesh after the first.
-                    let w = self.walk(y);
-                    if self.mesh.live > self.target && self.price_kept(y, &w, keep, true).is_some()
-                    {
+                    let mut w = self.unwalked();
+                    let w = self.walk(y, &mut w);
+                    if self.mesh.live > self.target && self.price_kept(y, w, keep, true).is_some() {
                         match self.check(y, keep, None) {
                             Ok(()) => {
                                 self.heap.remove(y);

@@ -57,20 +57,33 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             .is_some_and(|d| d > self.threshold)
     }
 
-    /// One walk around `v`'s fan: the cost's summary of it, D, the boundary ends and the
-    /// neighbours (each corner's `a`, and a boundary fan's last `b`).
-    pub(super) fn walk(&self, v: usize) -> FanSummary<C::Fan> {
-        let mesh = &self.mesh;
-        let pv = mesh.p(v);
-        let mut w = FanSummary {
+    /// A summary of no walk yet, for [`Self::walk`] to fill in the caller's frame (a summary
+    /// returned from the walk was copied out with a `memcpy`, which took the library's
+    /// `memcpy` into every image: scripts/flash.sh).
+    #[inline(always)]
+    pub(super) fn unwalked(&self) -> FanSummary<C::Fan> {
+        FanSummary {
             fan: self.cost.empty(),
             variation: Variation::default(),
             ends: (NIL, NIL),
-            p: pv,
+            p: [0.0; 3],
             area2: 0.0,
             nb: [0; MAX_CANDIDATES],
             n: 0,
-        };
+        }
+    }
+
+    /// One walk around `v`'s fan into `w` (from [`Self::unwalked`]): the cost's summary of it,
+    /// D, the boundary ends and the neighbours (each corner's `a`, and a boundary fan's last
+    /// `b`). Returns `w`.
+    pub(super) fn walk<'w>(
+        &self,
+        v: usize,
+        w: &'w mut FanSummary<C::Fan>,
+    ) -> &'w FanSummary<C::Fan> {
+        let mesh = &self.mesh;
+        let pv = mesh.p(v);
+        w.p = pv;
         // Normals only when something reads them: the cost's fan summary or the feature rule.
         let normals = self.normals();
         let mut c = mesh.first(v);
