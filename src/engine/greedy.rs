@@ -217,11 +217,16 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         self.pass_collapses += 1;
         self.mesh.mark(b, false);
         self.rekey(b);
+        // A locked b's list is in no order: each corner names both its neighbours.
+        let locked = self.mesh.has(b, flag::LOCKED);
         let mut c = self.mesh.first(b);
         let mut last = NIL;
         while c != NIL {
-            let x = self.mesh.tri(c >> 2)[next3(c & 3)];
-            self.refresh(x, b);
+            let tri = self.mesh.tri(c >> 2);
+            self.refresh(tri[next3(c & 3)], b);
+            if locked {
+                self.refresh(tri[prev3(c & 3)], b);
+            }
             last = c;
             c = self.mesh.after(c);
         }

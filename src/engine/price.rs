@@ -105,7 +105,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             to,
             p_from: w.p,
             p_to,
-            keep: keep || !self.movable() || mesh.has(to, flag::FEATURE),
+            // A feature or locked vertex stays where it is.
+            keep: keep || !self.movable() || mesh.flags(to) & (flag::FEATURE | flag::LOCKED) != 0,
         })
     }
 

@@ -175,8 +175,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     }
 
     /// Replaces the (adjacent) corners of `b` in the `dead` triangles with the run
-    /// `head..tail`. Non-adjacent windows only arise from a switched-off rule: then the dead
-    /// corners are unlinked and the run goes in front.
+    /// `head..tail`. Non-adjacent windows arise when `b` is locked (its list has no order) or
+    /// from a switched-off rule: then the dead corners are unlinked and the run goes in front.
     pub(super) fn splice(&mut self, b: usize, dead: &[usize], head: usize, tail: usize) {
         let (mut w_first, mut w_pred, mut w_last, mut w_last_pred, mut w_succ) =
             (NIL, NIL, NIL, NIL, NIL);

@@ -16,8 +16,9 @@
 //! and ends at the one whose `v-b` has none. So a fan walk needs no search, each corner names
 //! one new neighbour (its `a`; a boundary fan adds its last `b`), and a collapse splices `a`'s
 //! surviving run into `b`'s list where the two removed triangles were. Locked vertices
-//! (non-manifold, pinched, inconsistently wound) keep an unordered list: they never move and are
-//! never the kept end, so nothing walks their fans in order.
+//! (non-manifold, pinched, inconsistently wound) keep an unordered list: they never move, and
+//! when one is the kept end the run goes in front of its list; nothing walks their fans in
+//! order.
 //!
 //! Every access goes through `get`, so a broken invariant shows up as a refused collapse, never
 //! as a panic.
@@ -375,18 +376,25 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     }
 
     /// Calls `f` once for each neighbour of `v`, in fan order: each corner's `a`, and for a
-    /// boundary fan the last corner's `b` too. Only for regular (unlocked) fans.
+    /// boundary fan the last corner's `b` too. A locked vertex's list has no order: then `f`
+    /// sees both neighbours of every corner (most of them twice).
     pub(crate) fn for_each_neighbour(&self, v: usize, mut f: impl FnMut(usize)) {
+        // A locked vertex's list is in no order: each corner names both its neighbours.
+        let locked = self.has(v, flag::LOCKED);
         let mut c = self.first(v);
         let mut last = NIL;
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            f(self.tri(c >> 2)[next3(c & 3)]);
+            let tri = self.tri(c >> 2);
+            f(tri[next3(c & 3)]);
+            if locked {
+                f(tri[prev3(c & 3)]);
+            }
             last = c;
             c = self.after(c);
         }
-        if self.has(v, flag::BOUNDARY) && last != NIL {
+        if !locked && self.has(v, flag::BOUNDARY) && last != NIL {
             f(self.tri(last >> 2)[prev3(last & 3)]);
         }
     }

@@ -162,8 +162,9 @@ pub const RULES: &[Rule] = &[
     Rule {
         reject: Reject::Locked,
         name: "locked",
-        protects: "a or b is on a non-manifold edge, a pinched fan or an inconsistently wound \
-                   edge: such parts of the input stay as they are",
+        protects: "a is on a non-manifold edge, a pinched fan or an inconsistently wound \
+                   edge, or b is and a is on the boundary: irregular vertices never move (an \
+                   interior vertex may move onto one)",
         kind: Kind::Validity,
         source: "Cheng, Pan and Shi §3.1 (irregular vertices)",
     },
@@ -455,9 +456,18 @@ fn shape_of<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, t: usize) -> Shape {
 }
 
 /// The flag rules alone: whether `a` may move at all, and onto a vertex with flags `fb`.
+///
+/// A locked vertex never moves, but an interior vertex may move onto it (meshoptimizer's
+/// kinds table lets a manifold vertex collapse onto a complex or locked one): the locked
+/// vertex keeps its irregular fans as they were, one of them takes `a`'s disc in, and the link
+/// condition, which then marks every neighbour of the locked vertex, refuses a collapse that
+/// would join two of its fans or add a triangle on one of its non-manifold edges.
 #[inline]
 pub(crate) fn flags_allow(rules: &Rules, fa: u8, fb: u8) -> Result<(), Reject> {
-    if fa & fb & flag::USED == 0 || (on!(Locked) && (fa | fb) & flag::LOCKED != 0) {
+    if fa & fb & flag::USED == 0
+        || (on!(Locked)
+            && (fa & flag::LOCKED != 0 || (fb & flag::LOCKED != 0 && fa & flag::BOUNDARY != 0)))
+    {
         return Err(Reject::Locked);
     }
     if on!(Feature)
@@ -676,11 +686,16 @@ pub(crate) fn check<L: Index, I: Index>(
     let (mut across_o1, mut across_o2) = (NIL, NIL);
     let mut c = mesh.first(b);
     let (mut last, mut guard) = (NIL, mesh.triangle_count());
+    // A locked b's list is in no order: each corner names both its neighbours.
+    let locked_b = mesh.has(b, flag::LOCKED);
     while c != NIL && guard > 0 {
         guard -= 1;
         let tri = mesh.tri(c >> 2);
         let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
         mesh.mark(x, true);
+        if locked_b {
+            mesh.mark(y, true);
+        }
         if y == o1 && x != a {
             across_o1 = c >> 2;
         }
@@ -714,6 +729,9 @@ pub(crate) fn check<L: Index, I: Index>(
                 return Err(Reject::Fold);
             }
         }
+        if locked_b && folds_onto_locked(mesh, (a, b), (o1, o2), &near, &after) {
+            return Err(Reject::Fold);
+        }
         if more && on!(Locked) {
             // Unreachable while the locked rule is on (see `near`); refused, not guessed at.
             return Err(Reject::Locked);
@@ -726,6 +744,30 @@ pub(crate) fn check<L: Index, I: Index>(
         }
     }
     Ok(())
+}
+
+/// A locked `b` (its list in no order, its edges perhaps non-manifold or inconsistently
+/// wound): whether a survivor holding `o1` or `o2` folds against any of `b`'s triangles on
+/// that edge, whichever way they are wound. Never inlined: only collapses onto a locked
+/// vertex call it.
+#[inline(never)]
+fn folds_onto_locked<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    (a, b): (usize, usize),
+    (o1, o2): (usize, usize),
+    near: &[Option<(usize, usize, Shape)>; 2],
+    after: &impl Fn(usize) -> Shape,
+) -> bool {
+    mesh.corners(b).any(|(u, _)| {
+        let s = mesh.tri(u);
+        !s.contains(&a)
+            && near.iter().flatten().any(|(x, y, now)| {
+                [o1, o2]
+                    .iter()
+                    .any(|&o| o != NIL && (*x == o || *y == o) && s.contains(&o))
+                    && folded(now, &after(u))
+            })
+    })
 }
 
 /// Welded seams: whether `a` may move onto `b` as far as its wedges go. Around `a`'s fan (in
