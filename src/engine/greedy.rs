@@ -217,22 +217,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         self.pass_collapses += 1;
         self.mesh.mark(b, false);
         self.rekey(b);
-        // A locked b's list is in no order: each corner names both its neighbours.
-        let locked = self.mesh.has(b, flag::LOCKED);
+        // Both neighbours of every corner: a locked b's list has no order.
         let mut c = self.mesh.first(b);
-        let mut last = NIL;
         while c != NIL {
             let tri = self.mesh.tri(c >> 2);
             self.refresh(tri[next3(c & 3)], b);
-            if locked {
-                self.refresh(tri[prev3(c & 3)], b);
-            }
-            last = c;
+            self.refresh(tri[prev3(c & 3)], b);
             c = self.mesh.after(c);
-        }
-        if last != NIL {
-            let y = self.mesh.tri(last >> 2)[prev3(last & 3)];
-            self.refresh(y, b);
         }
     }
 

@@ -375,27 +375,17 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         (x, y)
     }
 
-    /// Calls `f` once for each neighbour of `v`, in fan order: each corner's `a`, and for a
-    /// boundary fan the last corner's `b` too. A locked vertex's list has no order: then `f`
-    /// sees both neighbours of every corner (most of them twice).
+    /// Calls `f` for each neighbour of `v`: both neighbours of every corner, so each neighbour
+    /// once or twice, in any fan (a locked vertex's list has no order).
     pub(crate) fn for_each_neighbour(&self, v: usize, mut f: impl FnMut(usize)) {
-        // A locked vertex's list is in no order: each corner names both its neighbours.
-        let locked = self.has(v, flag::LOCKED);
         let mut c = self.first(v);
-        let mut last = NIL;
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
             let tri = self.tri(c >> 2);
             f(tri[next3(c & 3)]);
-            if locked {
-                f(tri[prev3(c & 3)]);
-            }
-            last = c;
+            f(tri[prev3(c & 3)]);
             c = self.after(c);
-        }
-        if !locked && self.has(v, flag::BOUNDARY) && last != NIL {
-            f(self.tri(last >> 2)[prev3(last & 3)]);
         }
     }
 

@@ -679,34 +679,32 @@ pub(crate) fn check<L: Index, I: Index>(
         }
         prev = Some((y, now));
     }
-    // Link condition: the only common neighbours of a and b are o1 and o2. One walk of b's fan
-    // marks b's neighbours (as `Mesh::for_each_neighbour` names them: each corner's `a`, and a
-    // boundary fan's last `b`), so this is O(valence), and finds b's triangles across (b, o1)
-    // and (b, o2), for the fold test.
-    let (mut across_o1, mut across_o2) = (NIL, NIL);
+    // Link condition: the only common neighbours of a and b are o1 and o2. One walk of b's
+    // list marks b's neighbours (as `Mesh::for_each_neighbour` names them: both of every
+    // corner's, so a locked b's unordered list is covered too), so this is O(valence), and
+    // finds b's triangles across (b, o1) and (b, o2), for the fold test. Around a locked b such
+    // a triangle may be wound either way, and a second one (a non-manifold edge) is refused;
+    // around a regular b neither happens.
+    let (mut across_o1, mut across_o2, mut extra) = (NIL, NIL, false);
     let mut c = mesh.first(b);
-    let (mut last, mut guard) = (NIL, mesh.triangle_count());
-    // A locked b's list is in no order: each corner names both its neighbours.
-    let locked_b = mesh.has(b, flag::LOCKED);
+    let mut guard = mesh.triangle_count();
     while c != NIL && guard > 0 {
         guard -= 1;
         let tri = mesh.tri(c >> 2);
         let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
         mesh.mark(x, true);
-        if locked_b {
-            mesh.mark(y, true);
+        mesh.mark(y, true);
+        if x != a && y != a {
+            if x == o1 || y == o1 {
+                extra |= across_o1 != NIL;
+                across_o1 = c >> 2;
+            }
+            if x == o2 || y == o2 {
+                extra |= across_o2 != NIL;
+                across_o2 = c >> 2;
+            }
         }
-        if y == o1 && x != a {
-            across_o1 = c >> 2;
-        }
-        if x == o2 && y != a {
-            across_o2 = c >> 2;
-        }
-        last = c;
         c = mesh.after(c);
-    }
-    if mesh.has(b, flag::BOUNDARY) && last != NIL {
-        mesh.mark(mesh.tri(last >> 2)[prev3(last & 3)], true);
     }
     let mut common = false;
     mesh.for_each_neighbour(a, |x| {
@@ -715,6 +713,9 @@ pub(crate) fn check<L: Index, I: Index>(
     mesh.for_each_neighbour(b, |x| mesh.mark(x, false));
     if on!(Link) && common {
         return Err(Reject::Link);
+    }
+    if on!(Locked) && extra {
+        return Err(Reject::Locked);
     }
 
     // Folds across (b, o1) and (b, o2).
@@ -729,9 +730,7 @@ pub(crate) fn check<L: Index, I: Index>(
                 return Err(Reject::Fold);
             }
         }
-        if locked_b && folds_onto_locked(mesh, (a, b), (o1, o2), &near, &after) {
-            return Err(Reject::Fold);
-        }
+
         if more && on!(Locked) {
             // Unreachable while the locked rule is on (see `near`); refused, not guessed at.
             return Err(Reject::Locked);
@@ -744,30 +743,6 @@ pub(crate) fn check<L: Index, I: Index>(
         }
     }
     Ok(())
-}
-
-/// A locked `b` (its list in no order, its edges perhaps non-manifold or inconsistently
-/// wound): whether a survivor holding `o1` or `o2` folds against any of `b`'s triangles on
-/// that edge, whichever way they are wound. Never inlined: only collapses onto a locked
-/// vertex call it.
-#[inline(never)]
-fn folds_onto_locked<L: Index, I: Index>(
-    mesh: &Mesh<'_, L, I>,
-    (a, b): (usize, usize),
-    (o1, o2): (usize, usize),
-    near: &[Option<(usize, usize, Shape)>; 2],
-    after: &impl Fn(usize) -> Shape,
-) -> bool {
-    mesh.corners(b).any(|(u, _)| {
-        let s = mesh.tri(u);
-        !s.contains(&a)
-            && near.iter().flatten().any(|(x, y, now)| {
-                [o1, o2]
-                    .iter()
-                    .any(|&o| o != NIL && (*x == o || *y == o) && s.contains(&o))
-                    && folded(now, &after(u))
-            })
-    })
 }
 
 /// Welded seams: whether `a` may move onto `b` as far as its wedges go. Around `a`'s fan (in
