@@ -1,9 +1,10 @@
 //! One QEMU run of a firmware image: the command line ([`qemu_command`]), the run with its
 //! files and timeout ([`run_in`]), and the runs of a case, a stream or a command.
 
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
@@ -55,6 +56,57 @@ impl Run {
     }
 }
 
+/// `board.qemu_args`, with a RISC-V `-cpu rv32,...` as this QEMU accepts it: since QEMU 8 the
+/// `rv32` CPU has extensions on by default (Zawrs, Zfa) that need the A or F extension a board
+/// switches off, and QEMU then refuses to start ("Zawrs extension requires A extension"), while
+/// QEMU 7.2 has no such properties to switch off. The first of the board's CPU with both off,
+/// with Zawrs off, and as given that this QEMU starts is used (probed once per CPU string).
+fn board_args(board: &Board) -> Vec<String> {
+    board
+        .qemu_args
+        .iter()
+        .map(|a| match a.strip_prefix("rv32,") {
+            Some(_) => riscv_cpu(board.qemu.program, board.machine, a),
+            None => a.to_string(),
+        })
+        .collect()
+}
+
+/// See [`board_args`].
+fn riscv_cpu(program: &str, machine: &str, cpu: &str) -> String {
+    static SEEN: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
+    let mut seen = SEEN.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, c)) = seen.iter().find(|(k, _)| k == cpu) {
+        return c.clone();
+    }
+    let chosen = [",zawrs=false,zfa=false", ",zawrs=false", ""]
+        .iter()
+        .map(|extra| format!("{cpu}{extra}"))
+        .find(|c| qemu_starts(program, machine, c))
+        .unwrap_or_else(|| cpu.to_string());
+    seen.push((cpu.to_string(), chosen.clone()));
+    chosen
+}
+
+/// Whether QEMU starts `machine` with CPU `cpu`: paused (`-S`), told to quit on its monitor; a
+/// CPU it refuses makes it exit with an error before it reads the monitor.
+fn qemu_starts(program: &str, machine: &str, cpu: &str) -> bool {
+    let child = Command::new(program)
+        .args(["-machine", machine, "-bios", "none", "-cpu", cpu, "-S"])
+        .args(["-display", "none", "-serial", "null", "-monitor", "stdio"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn();
+    let Ok(mut child) = child else {
+        return false;
+    };
+    if let Some(mut stdin) = child.stdin.take() {
+        let _ = stdin.write_all(b"quit\n");
+    }
+    child.wait().is_ok_and(|s| s.success())
+}
+
 /// The QEMU command line for `board`, with semihosting arguments `args`.
 pub fn qemu_command(board: &Board, elf: &Path, args: &[&str]) -> Command {
     let mut sh = String::from("enable=on,target=native,arg=tinydecimate-firmware");
@@ -64,7 +116,7 @@ pub fn qemu_command(board: &Board, elf: &Path, args: &[&str]) -> Command {
     }
     let mut cmd = Command::new(board.qemu.program);
     cmd.args(["-machine", board.machine])
-        .args(board.qemu_args)
+        .args(board_args(board))
         .args(["-nographic", "-monitor", "none", "-serial", "null"])
         // One instruction = 1 ns of virtual time: SysTick (and RISC-V's mcycle) counts
         // instructions, repeatably.
