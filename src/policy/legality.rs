@@ -163,8 +163,9 @@ pub const RULES: &[Rule] = &[
         reject: Reject::Locked,
         name: "locked",
         protects: "a is on a non-manifold edge, a pinched fan or an inconsistently wound \
-                   edge, or b is and a is on the boundary: irregular vertices never move (an \
-                   interior vertex may move onto one)",
+                   edge, or b is and a is on the boundary or b's edge to o1 or o2 is \
+                   non-manifold: irregular vertices never move (an interior vertex may move \
+                   onto one)",
         kind: Kind::Validity,
         source: "Cheng, Pan and Shi §3.1 (irregular vertices)",
     },
