@@ -35,31 +35,6 @@ fn same(a: Vec<Tri>, b: Vec<Tri>, what: &str) {
     }
 }
 
-/// Simplifies with a collapse log; returns the log and the output.
-fn simplify_logged(m: &MeshData, config: &Config) -> (Vec<[u32; 2]>, Vec<Tri>, Stop) {
-    let mut tris = m.triangles.clone();
-    let mut log = vec![[0u32; 2]; m.positions.len()];
-    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
-    let mut s = ws
-        .start(
-            tinydecimate::Positions::Read(&m.positions),
-            &mut tris,
-            config,
-            tinydecimate::Builtin::new(),
-            tinydecimate::NoBound,
-            EdgeCollapse,
-        )
-        .unwrap()
-        .record_into(&mut log);
-    while !s.step(u32::MAX) {}
-    let n = s.records().len();
-    let r = s.finish();
-    assert_eq!(n, r.collapses);
-    log.truncate(n);
-    tris.truncate(r.triangles_out);
-    (log, tris, r.stop)
-}
-
 struct Owned {
     tris: Vec<Tri>,
     links: Vec<Tri>,

@@ -6,7 +6,6 @@ mod common;
 use common::*;
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder, StreamError, HEADER};
-use tinydecimate::EdgeCollapse;
 use tinydecimate::{Config, Progressive};
 
 struct Store {
@@ -37,28 +36,7 @@ impl Store {
 
 /// The simplifier's collapse log for `m` at `ratio`.
 fn collapse_log(m: &MeshData, ratio: f32) -> Vec<[u32; 2]> {
-    let mut tris = m.triangles.clone();
-    let mut log = vec![[0u32; 2]; m.positions.len()];
-    let n = {
-        let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
-        let mut s = ws
-            .start(
-                tinydecimate::Positions::Read(&m.positions),
-                &mut tris,
-                &Config::new().with_ratio(ratio),
-                tinydecimate::Builtin::new(),
-                tinydecimate::NoBound,
-                EdgeCollapse,
-            )
-            .unwrap()
-            .record_into(&mut log);
-        while !s.step(u32::MAX) {}
-        let n = s.records().len();
-        s.finish();
-        n
-    };
-    log.truncate(n);
-    log
+    simplify_logged(m, &Config::new().with_ratio(ratio)).0
 }
 
 /// Simplifies `m` to `ratio` with a log, builds the progressive mesh and encodes it.

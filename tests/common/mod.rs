@@ -74,6 +74,32 @@ pub fn simplify(m: &MeshData, config: &Config) -> (MeshData, Report) {
     )
 }
 
+/// Simplifies `m` by edge collapse with the built-in cost and a collapse log: the log, the
+/// output triangles and the report.
+pub fn simplify_logged(m: &MeshData, config: &Config) -> (Vec<[u32; 2]>, Vec<Tri>, Report) {
+    let mut tris = m.triangles.clone();
+    let mut log = vec![[0u32; 2]; m.positions.len()];
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut s = ws
+        .start(
+            tinydecimate::Positions::Read(&m.positions),
+            &mut tris,
+            config,
+            tinydecimate::Builtin::new(),
+            tinydecimate::NoBound,
+            tinydecimate::EdgeCollapse,
+        )
+        .expect("start")
+        .record_into(&mut log);
+    while !s.step(u32::MAX) {}
+    let n = s.records().len();
+    let r = s.finish();
+    assert_eq!(n, r.collapses);
+    log.truncate(n);
+    tris.truncate(r.triangles_out);
+    (log, tris, r)
+}
+
 /// FNV-1a over the triangles' little-endian bytes: a short fingerprint of an output.
 pub fn digest(tris: &[Tri]) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
