@@ -80,6 +80,10 @@ pub struct Run {
     /// Weld seams first (`tinydecimate::seam::weld`: the vertices at one position collapse
     /// together, each keeping its own wedge), when the mesh has any.
     pub weld: bool,
+    /// With welded seams, lock the vertices where more than two wedges meet
+    /// (`SeamCorners::Lock`, for carried attributes) instead of moving all their wedges
+    /// (`SeamCorners::Move`, the default: positions only, nothing to tear).
+    pub lock_seam_corners: bool,
     /// Let parts cheaper than the next collapse vanish whole (`Simplifier::with_parts`, two
     /// `u32` links per vertex) in the runs where the library prunes ([`prunes`]).
     pub prune: bool,
@@ -105,6 +109,7 @@ pub fn simplify_with(
         bounded,
         progress,
         weld,
+        lock_seam_corners,
         prune,
     } = *run;
     let prune = prunes(prune, config, bounded);
@@ -156,7 +161,12 @@ pub fn simplify_with(
             let s = if wedges.is_empty() {
                 s
             } else {
-                s.with_wedges(&mut wedges).map_err(library_error)?
+                let corners = if lock_seam_corners {
+                    tinydecimate::seam::SeamCorners::Lock
+                } else {
+                    tinydecimate::seam::SeamCorners::Move
+                };
+                s.with_wedges(&mut wedges, corners).map_err(library_error)?
             };
             let mut s = if prune {
                 s.with_parts(&mut part_links).map_err(library_error)?
