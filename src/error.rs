@@ -46,7 +46,9 @@ pub enum ConfigField {
     /// another schedule than greedy or with [`TriangleCollapse`](crate::TriangleCollapse).
     ErrorLimit,
     ControlAngle,
-    /// [`TriangleCollapse`](crate::TriangleCollapse) with another schedule than greedy.
+    /// [`TriangleCollapse`](crate::TriangleCollapse) or
+    /// [`VertexDecimation`](crate::VertexDecimation) with another schedule than greedy, or
+    /// `VertexDecimation` with an error bound.
     Operator,
     /// The schedule cannot run this cost ([`StoredQuadric`](crate::StoredQuadric): greedy only).
     Schedule,

@@ -18,7 +18,8 @@
 //! A guaranteed error bound (Zhu, Wang and Meng 2007, §2-§4) is a policy of the same engine:
 //! [`Config::with_max_error`] with [`bound::Controls`] given to [`Workspace::start`] checks control
 //! points (original centroids and feature-edge vertices) before every collapse; see [`bound`]. The
-//! paper's own operator, triangle collapse, is [`TriangleCollapse`] (see [`operator`]).
+//! paper's own operator, triangle collapse, is [`TriangleCollapse`] (see [`operator`]);
+//! Schroeder's vertex decimation is [`VertexDecimation`].
 //!
 //! Data flows one way:
 //!
@@ -119,7 +120,7 @@ pub use engine::Simplifier;
 pub use error::{Capacity, ConfigField, Error};
 pub use index::Index;
 pub use legality::{Reject, RULES};
-pub use operator::{EdgeCollapse, TriangleCollapse};
+pub use operator::{EdgeCollapse, TriangleCollapse, VertexDecimation};
 pub use progressive::Progressive;
 pub use report::{Rejections, Report, Stop, PASS_LOG};
 pub use workspace::{Positions, Storage, Workspace};

@@ -1,20 +1,57 @@
 //! The simplification operator: a type parameter of the engine ([`Storage::start`]'s
 //! `operator` argument), so that an image carries the code of the one it uses only.
 //!
+//! Adding one: a type here with its [`Kind`] (and sealed impl), its method in a file of its
+//! own under `src/operator/` (as [`VertexDecimation`] in `operator/decimate.rs`), and an
+//! engine path only if no existing [`Kind`] fits.
+//!
 //! [`Storage::start`]: crate::Storage::start
+
+mod decimate;
+
+pub use decimate::VertexDecimation;
+pub(crate) use decimate::{classify, triangulate, MAX_RING};
 
 mod sealed {
     pub trait Sealed {}
     impl Sealed for super::EdgeCollapse {}
     impl Sealed for super::TriangleCollapse {}
+    impl Sealed for super::VertexDecimation {}
 }
 
-/// An operator: [`EdgeCollapse`] or [`TriangleCollapse`].
+/// Which path of the engine an operator takes.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// Half-edge collapse: the engine's own path.
+    Edge,
+    /// Triangle collapse, as half-edge moves (`engine/triangle.rs`).
+    Triangle,
+    /// Vertex removal: a vertex's fan is replaced by a triangulation of its ring
+    /// (`engine/remove.rs`, `Mesh::replace_fan`).
+    Removal,
+}
+
+/// An operator: [`EdgeCollapse`], [`TriangleCollapse`] or [`VertexDecimation`].
 pub trait Operator: sealed::Sealed + Copy {
-    /// Whether this is the triangle collapse (compile-time: the engine's branches on it fold
-    /// away).
+    /// The engine's path for it (compile-time: the engine's branches on it fold away).
     #[doc(hidden)]
-    const TRIANGLE: bool;
+    const KIND: Kind;
+
+    /// A vertex-removal operator's parameters (`None` for the collapses).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn removal(&self) -> Option<VertexDecimation> {
+        None
+    }
+
+    /// When a round ends without an operation: relaxes the operator for one more round;
+    /// `false` if it cannot (the collapses never can).
+    #[doc(hidden)]
+    #[inline(always)]
+    fn relax(&mut self) -> bool {
+        false
+    }
 }
 
 /// Half-edge collapse (the default): one vertex moves onto a neighbour.
@@ -23,7 +60,7 @@ pub trait Operator: sealed::Sealed + Copy {
 pub struct EdgeCollapse;
 
 impl Operator for EdgeCollapse {
-    const TRIANGLE: bool = false;
+    const KIND: Kind = Kind::Edge;
 }
 
 /// Triangle collapse (Zhu, Wang and Meng 2007, §3): a triangle's three vertices merge into
@@ -65,7 +102,20 @@ impl Operator for EdgeCollapse {
 pub struct TriangleCollapse;
 
 impl Operator for TriangleCollapse {
-    const TRIANGLE: bool = true;
+    const KIND: Kind = Kind::Triangle;
+}
+
+impl Operator for VertexDecimation {
+    const KIND: Kind = Kind::Removal;
+
+    #[inline(always)]
+    fn removal(&self) -> Option<VertexDecimation> {
+        Some(*self)
+    }
+
+    fn relax(&mut self) -> bool {
+        self.grow()
+    }
 }
 
 /// The penalty factor `p > 1` for a refused triangle (Zhu, Wang and Meng 2007 §3: `p = 5`).

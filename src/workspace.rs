@@ -28,7 +28,7 @@ use crate::engine::heap::Heap;
 use crate::engine::Simplifier;
 use crate::index::Index;
 use crate::mesh::Mesh;
-use crate::operator::{EdgeCollapse, Operator};
+use crate::operator::{EdgeCollapse, Kind, Operator};
 use crate::policy::bound::{Bound, NoBound};
 use crate::policy::cost::{Builtin, Cost, Placement};
 use crate::{Capacity, Config, ConfigField, Error, Report, Schedule};
@@ -147,8 +147,9 @@ impl<'a, L: Index> Storage<'a, L> {
     ///   [`Cost`], e.g. [`StoredQuadric`](crate::cost::StoredQuadric).
     /// * `bound`: [`NoBound`], or the guaranteed error bound [`Config::max_error`] with
     ///   [`Controls`](crate::bound::Controls) (Zhu, Wang and Meng 2007; see [`crate::bound`]).
-    /// * `operator`: [`EdgeCollapse`], or [`TriangleCollapse`](crate::TriangleCollapse) (greedy
-    ///   schedule only).
+    /// * `operator`: [`EdgeCollapse`], [`TriangleCollapse`](crate::TriangleCollapse) (greedy
+    ///   schedule only) or [`VertexDecimation`](crate::VertexDecimation) (greedy schedule, no
+    ///   bound).
     ///
     /// Errors, all returned before the triangle buffer (or the positions) is touched:
     /// [`Error::InvalidConfig`] (a field out of range, or a policy that cannot run with it),
@@ -171,12 +172,16 @@ impl<'a, L: Index> Storage<'a, L> {
             bound.prepare(triangles, nv, config)?;
         }
         config.validate()?;
-        if O::TRIANGLE && config.schedule != Schedule::Greedy {
+        if (!matches!(O::KIND, Kind::Edge) && config.schedule != Schedule::Greedy)
+            || (matches!(O::KIND, Kind::Removal) && B::ON)
+        {
             return Err(Error::InvalidConfig {
                 field: ConfigField::Operator,
             });
         }
-        if config.error_limit.is_finite() && (O::TRIANGLE || config.schedule != Schedule::Greedy) {
+        if config.error_limit.is_finite()
+            && (!matches!(O::KIND, Kind::Edge) || config.schedule != Schedule::Greedy)
+        {
             // Only the greedy edge collapse measures each collapse's own error.
             return Err(Error::InvalidConfig {
                 field: ConfigField::ErrorLimit,

@@ -7,7 +7,7 @@ use super::{Phase, Simplifier};
 use crate::index::Index;
 use crate::math::V3;
 use crate::mesh::{flag, next3, prev3, NIL};
-use crate::operator::Operator;
+use crate::operator::{Kind, Operator};
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::feature::Variation;
@@ -18,8 +18,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// Greedy: re-classify `v` against the round's threshold and re-key it: the cheapest
     /// price among its candidates (a lower bound of its cheapest legal collapse).
     pub(super) fn rekey(&mut self, v: usize) {
-        if O::TRIANGLE {
-            return self.rekey_triangles(v);
+        match O::KIND {
+            Kind::Triangle => return self.rekey_triangles(v),
+            Kind::Removal => return self.rekey_removal(v),
+            Kind::Edge => {}
         }
         let f = self.mesh.flags(v);
         if self.keys_only_fall() {
@@ -65,7 +67,11 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             // Rules that look past a vertex's own fan may have changed far from recent
             // collapses: a new round re-keys everything, and only a round without a collapse
             // ends the run.
-            if self.pass_collapses == 0 || self.passes >= self.config.max_passes {
+            let over = self.passes >= self.config.max_passes;
+            if self.pass_collapses == 0 && !over && self.operator.relax() {
+                // A removal operator with a looser criterion gets another round.
+                self.new_round();
+            } else if self.pass_collapses == 0 || over {
                 // Short of the target: the smallest parts may still go (`with_parts`).
                 if !self.prune_below(f32::INFINITY) {
                     self.done(if self.round_over_limit {
@@ -100,8 +106,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
 
     /// Greedy: one pop of the queue.
     pub(super) fn pop(&mut self) {
-        if O::TRIANGLE {
-            return self.pop_triangles();
+        match O::KIND {
+            Kind::Triangle => return self.pop_triangles(),
+            Kind::Removal => return self.pop_removal(),
+            Kind::Edge => {}
         }
         let Some((v, key)) = self.top() else {
             return;

@@ -26,8 +26,6 @@
 //! refresh comes at most once per halving of the mesh, and a round or pass without a collapse
 //! ends the run. Every operation below is bounded by the valences involved.
 
-use core::marker::PhantomData;
-
 use crate::index::Index;
 use crate::math::V3;
 use crate::mesh::{flag, Mesh, NIL};
@@ -46,6 +44,7 @@ mod log;
 mod parts;
 mod passes;
 mod price;
+mod remove;
 mod report;
 mod triangle;
 mod walk;
@@ -76,8 +75,9 @@ enum Phase {
 /// until [`Simplifier::finish`] compacts it.
 ///
 /// `B` is the error bound: [`NoBound`] (none, the default) or
-/// [`Controls`](crate::bound::Controls). `O` is the operator: [`EdgeCollapse`] (the default)
-/// or [`TriangleCollapse`](crate::TriangleCollapse).
+/// [`Controls`](crate::bound::Controls). `O` is the operator: [`EdgeCollapse`] (the default),
+/// [`TriangleCollapse`](crate::TriangleCollapse) or
+/// [`VertexDecimation`](crate::VertexDecimation).
 pub struct Simplifier<
     'a,
     L: Index,
@@ -130,8 +130,8 @@ pub struct Simplifier<
     initialised: bool,
     /// The error bound (control points), if any.
     bound: B,
-    /// The operator (a type: no state).
-    operator: PhantomData<O>,
+    /// The operator (no state for the collapses; a removal operator's parameters).
+    operator: O,
     /// Parts that may vanish whole (`with_parts`).
     #[cfg(feature = "parts")]
     parts: parts::Parts<'a, L>,
@@ -163,7 +163,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         config: Config,
         cost: C,
         bound: B,
-        _operator: O,
+        operator: O,
     ) -> Self {
         // Twins (double-sided triangles' backs) come back at the end, so the fronts aim for
         // their share of the target.
@@ -217,7 +217,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             logged: 0,
             initialised: false,
             bound,
-            operator: PhantomData,
+            operator,
             #[cfg(feature = "parts")]
             parts: parts::Parts::off(),
         };

@@ -31,6 +31,7 @@ pub(crate) use crate::tri::{next3, prev3, NIL};
 
 mod build;
 mod collapse;
+mod replace;
 
 /// Per-vertex flag bits.
 pub(crate) mod flag {

@@ -851,6 +851,108 @@ fn check_moved_b<L: Index, I: Index>(
     Ok(())
 }
 
+/// The live triangle other than `skip`'s holding both `x` and `y`, if any (`x`'s list).
+fn other_with<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    x: usize,
+    y: usize,
+    skip: usize,
+) -> Option<usize> {
+    mesh.corners(x).map(|(t, _)| t).find(|&t| {
+        let s = mesh.tri(t);
+        s.contains(&y) && !s.contains(&skip)
+    })
+}
+
+/// The rules on a vertex removal: `v`'s fan replaced by `new`, triangles over its `ring`
+/// (ring positions, each wound in ring order; a `boundary` ring's closing edge, last to first,
+/// becomes a boundary edge), each checked against its plane's unit normal in `planes` (the
+/// average plane, or its side's of a feature line). The hard rules of a collapse, for
+/// triangles that have no "before":
+///
+/// * `locked`: a ring vertex is locked (its list has no fan order to splice into);
+/// * `link`: a diagonal, or a boundary ring's closing edge, is already an edge (a
+///   non-manifold edge, or a boundary loop closed);
+/// * `duplicate`: a new triangle already exists;
+/// * `sliver`: a new triangle has no area, or one so thin that rounding decides its normal;
+/// * `fold`: a new triangle faces away from the average plane, or folds against the triangle
+///   across its loop edge or another new one across a diagonal;
+/// * `normal_turn`: a new triangle's normal is farther from the average plane's than
+///   [`Config::max_normal_turn_deg`].
+pub(crate) fn check_fan<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    rules: &Rules,
+    v: usize,
+    (ring, boundary): (&[usize], bool),
+    new: &[[u8; 3]],
+    planes: &[V3],
+) -> Result<(), Reject> {
+    let n = ring.len();
+    let at = |k: u8| ring.get(k as usize).copied().unwrap_or(NIL);
+    if on!(Locked) && ring.iter().any(|&x| mesh.has(x, flag::LOCKED)) {
+        return Err(Reject::Locked);
+    }
+    for (i, (&t, &normal)) in new.iter().zip(planes).enumerate() {
+        let tri = t.map(at);
+        let now = Shape::of(tri.map(|x| mesh.p(x)));
+        if on!(Sliver) && now.quality < FLAT {
+            return Err(Reject::Sliver);
+        }
+        let d = math::dot(now.n, normal);
+        if on!(Fold) && d <= 0.0 {
+            return Err(Reject::Fold);
+        }
+        // Farther from the plane's normal than the turn limit (as `shape_rules` compares).
+        let turned = if rules.cos_turn >= 0.0 {
+            d < 0.0 || d * d < rules.cos_turn2 * now.n2
+        } else {
+            d < 0.0 && d * d > rules.cos_turn2 * now.n2
+        };
+        if on!(NormalTurn) && turned {
+            return Err(Reject::NormalTurn);
+        }
+        if on!(Duplicate) {
+            let [x, y, z] = tri;
+            if mesh
+                .corners(x)
+                .any(|(u, _)| mesh.tri(u).contains(&y) && mesh.tri(u).contains(&z))
+            {
+                return Err(Reject::Duplicate);
+            }
+        }
+        for (p, q) in [(t[0], t[1]), (t[1], t[2]), (t[0], t[2])] {
+            let (x, y) = (at(p), at(q));
+            // Loop edges (ring neighbours; around an interior vertex also last-first) stay.
+            let loop_edge = q == p + 1 || (!boundary && p == 0 && q as usize + 1 == n);
+            if loop_edge {
+                if on!(Fold) {
+                    if let Some(u) = other_with(mesh, x, y, v) {
+                        if folded(&now, &shape_of(mesh, u)) {
+                            return Err(Reject::Fold);
+                        }
+                    }
+                }
+            } else {
+                if on!(Link) && other_with(mesh, x, y, v).is_some() {
+                    return Err(Reject::Link);
+                }
+                // The other new triangle on this diagonal (none on a boundary's closing edge).
+                if on!(Fold) {
+                    for &o in new.iter().skip(i + 1) {
+                        if o.contains(&p) && o.contains(&q) {
+                            let other = Shape::of(o.map(|k| mesh.p(at(k))));
+                            if folded(&now, &other) {
+                                return Err(Reject::Fold);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -886,6 +988,66 @@ mod tests {
             }
         }
         (p, t)
+    }
+
+    /// A vertex removal whose diagonal is already an edge is refused by the link rule: a
+    /// pentagon fan around vertex 0 (ring 1..=5) with a vertex 6 below ring vertices 1, 2 and
+    /// 3, whose triangle (1, 3, 6) holds edge 1-3. Triangulating the hole with the diagonal
+    /// 1-3 would put a third triangle on it; the diagonals 1-4 and 4-2 put none. Fails if the
+    /// diagonal-exists check is switched off (`TINYDECIMATE_RULE_OFF=link`).
+    #[test]
+    fn removal_refuses_a_diagonal_that_is_an_edge() -> Result<(), crate::Error> {
+        let mut p = [[0.0f32; 3]; 7];
+        p[0] = [0.0, 0.0, 0.2];
+        for i in 0..5 {
+            let a = i as f32 * core::f32::consts::TAU / 5.0;
+            p[i + 1] = [
+                math::cos_deg(a.to_degrees()),
+                math::cos_deg(90.0 - a.to_degrees()),
+                0.0,
+            ];
+        }
+        p[6] = [
+            (p[1][0] + p[2][0] + p[3][0]) / 3.0,
+            (p[1][1] + p[2][1] + p[3][1]) / 3.0,
+            -0.8,
+        ];
+        let mut t: [[u16; 3]; 8] = [
+            [0, 1, 2],
+            [0, 2, 3],
+            [0, 3, 4],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 1, 6],
+            [3, 2, 6],
+            [1, 3, 6],
+        ];
+        let (mut head, mut next, mut flags) = ([0u16; 7], [[0u16; 3]; 8], [0u8; 7]);
+        let (mut s0, mut s1) = ([0u16; 7], [0u16; 7]);
+        let mesh = Mesh::build(
+            Positions::Read(&p),
+            &mut t,
+            &mut head,
+            &mut next,
+            &mut flags,
+            (&mut s0, &mut s1),
+        )?;
+        let rules = Rules::new(&Config::new());
+        let ring = [1, 2, 3, 4, 5];
+        let up = [[0.0, 0.0, 1.0]; 3];
+        assert!((1..6).all(|v| !mesh.has(v, flag::LOCKED)));
+        // Ring positions: the diagonal 0-2 is vertices 1-3.
+        let through_edge = [[0u8, 1, 2], [0, 2, 3], [0, 3, 4]];
+        assert_eq!(
+            check_fan(&mesh, &rules, 0, (&ring, false), &through_edge, &up),
+            Err(Reject::Link)
+        );
+        let around_it = [[0u8, 1, 3], [1, 2, 3], [0, 3, 4]];
+        assert_eq!(
+            check_fan(&mesh, &rules, 0, (&ring, false), &around_it, &up),
+            Ok(())
+        );
+        Ok(())
     }
 
     /// Whether one of `b`'s survivors of `a -> b` with `b` at `p` folds against any other

@@ -1,0 +1,596 @@
+//! Schroeder's vertex decimation as an operator of the engine ([`VertexDecimation`]): the
+//! classification of a vertex, its distance criterion and the re-triangulation of its hole
+//! by recursive loop splitting. The engine's removal path (`engine/remove.rs`) keys vertices
+//! by [`classify`], asks [`triangulate`] for the new fan, checks it with the shared rules
+//! (`legality::check_fan`) and writes it with `Mesh::replace_fan`.
+
+use crate::index::Index;
+use crate::math::{self, V3};
+use crate::mesh::{flag, next3, prev3, Mesh, NIL};
+
+/// The largest ring a vertex may have to be removed (its valence, plus one on a boundary):
+/// the hole's loop, and so every buffer of one removal, is at most this long.
+pub(crate) const MAX_RING: usize = 32;
+
+/// The default smallest aspect ratio of a split (distance of the loop's nearest vertex to the
+/// split plane over the split line's length).
+const MIN_ASPECT: f32 = 0.04;
+
+/// Vertex decimation (Schroeder, Zarge and Lorensen 1992): a vertex is removed with its
+/// triangles, and the hole is filled by triangulating the loop of its neighbours.
+///
+/// The survey seed (the simplification post's section "基于相邻面片和边界的局部平坦性原则",
+/// local flatness from the adjacent faces and the boundary, under the vertex-removal
+/// methods) gives the criterion: for an interior vertex `v` with fan `S`, the distance
+/// `d = |N · (v − C)|` to the average plane, `N` the unit vector of the area-weighted mean of
+/// the faces' normals and `C` the area-weighted mean of their centroids; for a boundary vertex,
+/// its distance to the line through its two boundary neighbours. The classification and the
+/// loop splitting are the paper's (the seed does not describe them):
+///
+/// * **complex** (non-manifold, pinched or inconsistently wound: the engine's locked
+///   vertices) and vertices with a locked neighbour are never removed;
+/// * a spoke is a **feature edge** when the normals of its two triangles differ by more than
+///   the feature angle ([`VertexDecimation::with_feature_angle`], 30° by default);
+/// * **simple** (interior, no feature edge): distance to the average plane;
+/// * **boundary** (no feature edge among its interior spokes): distance to the line through
+///   its two boundary neighbours;
+/// * **interior edge** (interior, exactly two feature edges): distance to the line through
+///   their other ends, and the hole is first split along that line, so the feature line stays;
+/// * **corner** (one or more than two feature edges, or a boundary vertex with one): never
+///   removed.
+///
+/// Order: the greedy queue, smallest distance first (ties by vertex index); `Config::max_cost`
+/// is Schroeder's threshold (no removal farther than it), the target count the stop.
+///
+/// Triangulation: recursive loop splitting. A split line joins two loop vertices that are not
+/// neighbours; its split plane holds the line and the average plane's normal. A split is
+/// valid when the two halves of the loop lie strictly on opposite sides of the plane (each on
+/// its own side, so no triangle turns over in the average plane), and its aspect ratio is the
+/// nearest vertex's distance to the plane over the line's length; the valid split with the
+/// largest ratio is taken (ties: the first in loop order) if its ratio is at least the minimum
+/// ([`VertexDecimation::with_min_aspect`], 0.1 by default), and each half is split again until
+/// it is a triangle. No split: the vertex stays until its fan changes. The loop is at most
+/// [`MAX_RING`](self) long (32; a vertex of higher valence stays), so every buffer is fixed.
+///
+/// The new fan then passes the same hard rules as a collapse (`legality::check_fan`): no
+/// diagonal (or a boundary vertex's new boundary edge) that is already an edge, no new
+/// triangle that already exists, none of zero area, none facing away from the average plane
+/// or turned from it past `Config::max_normal_turn_deg`, and no fold against the triangles
+/// across the loop or between the new ones. The `k` triangles of the fan are replaced by
+/// `k − 2` (`k − 1` on a boundary) written into the first of their own slots: fixed memory,
+/// triangles in the caller's buffer, positions only read.
+///
+/// Greedy schedule only, without an error bound, an error limit, welded seams or a collapse
+/// log (none of these can describe a removal): [`Storage::start`](crate::Storage::start)
+/// refuses the first three with [`ConfigField::Operator`](crate::ConfigField::Operator) (the
+/// error limit with [`ConfigField::ErrorLimit`](crate::ConfigField::ErrorLimit)); a welded run
+/// removes nothing (every candidate counts as a `seam` refusal) and a logged one stops at once
+/// with [`Stop::LogFull`](crate::Stop::LogFull). The report's `collapses` counts removals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct VertexDecimation {
+    /// The feature angle now, degrees.
+    pub(crate) feature_deg: f32,
+    /// Its cosine.
+    pub(crate) cos_feature: f32,
+    /// How much it grows when a round removes nothing, degrees.
+    pub(crate) step_deg: f32,
+    /// The most it grows to, degrees.
+    pub(crate) max_deg: f32,
+    /// Smallest aspect ratio of a split.
+    pub(crate) min_aspect: f32,
+}
+
+/// An angle in degrees clamped to `[0, 180]` (NaN: 0).
+fn clamp_deg(deg: f32) -> f32 {
+    if deg > 180.0 {
+        180.0
+    } else if deg > 0.0 {
+        deg
+    } else {
+        0.0
+    }
+}
+
+impl VertexDecimation {
+    /// Feature angle 30°, growing by 15° up to 90° when a round removes nothing; smallest
+    /// split aspect ratio 0.1.
+    pub const fn new() -> Self {
+        VertexDecimation {
+            feature_deg: 30.0,
+            // cos 30°.
+            cos_feature: 0.866_025_4,
+            step_deg: 15.0,
+            max_deg: 90.0,
+            min_aspect: MIN_ASPECT,
+        }
+    }
+
+    /// A spoke whose two triangles' normals differ by more than `deg` degrees (clamped to
+    /// `[0, 180]`) is a feature edge.
+    pub fn with_feature_angle(mut self, deg: f32) -> Self {
+        self.feature_deg = clamp_deg(deg);
+        self.cos_feature = math::cos_deg(self.feature_deg);
+        self
+    }
+
+    /// When a round of the queue removes nothing, the feature angle grows by `step` degrees,
+    /// up to `max` (as the original implementation's feature-angle increment and maximum):
+    /// corners and interior-edge vertices of the smaller angle become removable. A step of 0
+    /// (or a maximum at or below the angle) keeps the angle fixed.
+    pub fn with_feature_growth(mut self, step: f32, max: f32) -> Self {
+        self.step_deg = clamp_deg(step);
+        self.max_deg = clamp_deg(max);
+        self
+    }
+
+    /// The smallest aspect ratio a split may have (0 accepts any split whose halves lie on
+    /// their sides; negative values count as 0).
+    pub fn with_min_aspect(mut self, ratio: f32) -> Self {
+        self.min_aspect = if ratio > 0.0 { ratio } else { 0.0 };
+        self
+    }
+
+    /// Grows the feature angle by a step (see [`Self::with_feature_growth`]); `false` if it
+    /// is at its maximum already.
+    pub(crate) fn grow(&mut self) -> bool {
+        if !(self.step_deg > 0.0 && self.feature_deg < self.max_deg) {
+            return false;
+        }
+        let next = self.feature_deg + self.step_deg;
+        self.feature_deg = if next < self.max_deg {
+            next
+        } else {
+            self.max_deg
+        };
+        self.cos_feature = math::cos_deg(self.feature_deg);
+        true
+    }
+}
+
+impl Default for VertexDecimation {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A removable vertex's fan, classified.
+pub(crate) struct Fan {
+    /// The loop of neighbours in fan order (a boundary fan: from the first triangle's `a` to
+    /// the last one's `b`).
+    pub(crate) ring: [usize; MAX_RING],
+    /// Its length.
+    pub(crate) n: usize,
+    /// A boundary vertex (the loop's closing edge, last to first, becomes a boundary edge).
+    pub(crate) boundary: bool,
+    /// The average plane's unit normal.
+    pub(crate) normal: V3,
+    /// Schroeder's distance (normalised units).
+    pub(crate) key: f32,
+    /// An interior-edge vertex: the ring positions of its two feature spokes' ends.
+    pub(crate) line: Option<(usize, usize)>,
+}
+
+impl Fan {
+    /// The loop's vertices.
+    pub(crate) fn ring(&self) -> &[usize] {
+        self.ring.get(..self.n).unwrap_or(&[])
+    }
+}
+
+/// `√x` for `x ≥ 0` through the math module's `1/√` (0 below the tiny threshold).
+fn sqrt(x: f32) -> f32 {
+    if x > math::TINY2 && x.is_finite() {
+        x * math::rsqrt(x)
+    } else {
+        0.0
+    }
+}
+
+/// Distance from `p` to the line through `a` and `b`; `None` if `a` and `b` coincide.
+fn line_distance(p: V3, a: V3, b: V3) -> Option<f32> {
+    let e = math::sub(b, a);
+    let l2 = math::dot(e, e);
+    if !(l2 > math::TINY2 && l2.is_finite()) {
+        return None;
+    }
+    let c = math::cross(math::sub(p, a), e);
+    Some(sqrt(math::dot(c, c) / l2))
+}
+
+/// Classifies `v` and measures its distance; `None` if it is never removed now (complex,
+/// corner, a locked neighbour, a ring longer than [`MAX_RING`], a fan out of order or of no
+/// area).
+pub(crate) fn classify<L: Index, I: Index>(
+    mesh: &Mesh<'_, L, I>,
+    v: usize,
+    op: &VertexDecimation,
+) -> Option<Fan> {
+    let f = mesh.flags(v);
+    if f & flag::USED == 0 || f & flag::LOCKED != 0 {
+        return None;
+    }
+    let boundary = f & flag::BOUNDARY != 0;
+    let pv = mesh.p(v);
+    let mut fan = Fan {
+        ring: [NIL; MAX_RING],
+        n: 0,
+        boundary,
+        normal: [0.0; 3],
+        key: f32::INFINITY,
+        line: None,
+    };
+    // Unit normals of the fan's triangles, in order.
+    let mut units = [[0.0f32; 3]; MAX_RING];
+    let (mut sum_n, mut sum_c, mut sum_a) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+    let mut last_y = NIL;
+    let mut k = 0;
+    for (t, c) in mesh.corners(v) {
+        let tri = mesh.tri(t);
+        let (x, y) = (tri[next3(c)], tri[prev3(c)]);
+        if k > 0 && last_y != x {
+            return None;
+        }
+        if mesh.has(x, flag::LOCKED) || mesh.has(y, flag::LOCKED) {
+            return None;
+        }
+        *fan.ring.get_mut(k)? = x;
+        let (px, py) = (mesh.p(x), mesh.p(y));
+        let n = math::cross(math::sub(px, pv), math::sub(py, pv));
+        let l2 = math::dot(n, n);
+        let a2 = sqrt(l2);
+        *units.get_mut(k)? = math::unit_of(n, l2);
+        // Σ n(f) A(f) and Σ c(f) A(f), each area twice over (it cancels).
+        sum_n = math::add(sum_n, n);
+        let centroid = math::scale(math::add(pv, math::add(px, py)), 1.0 / 3.0);
+        sum_c = math::add(sum_c, math::scale(centroid, a2));
+        sum_a += a2;
+        last_y = y;
+        k += 1;
+    }
+    if boundary {
+        *fan.ring.get_mut(k)? = last_y;
+        fan.n = k + 1;
+        if k < 2 {
+            return None;
+        }
+    } else {
+        fan.n = k;
+        if k < 3 || fan.ring.first() != Some(&last_y) {
+            return None;
+        }
+    }
+    // A fan through one vertex twice is no disc.
+    let ring = fan.ring();
+    for (i, x) in ring.iter().enumerate() {
+        if ring.iter().skip(i + 1).any(|y| y == x) {
+            return None;
+        }
+    }
+    let l2 = math::dot(sum_n, sum_n);
+    if !(l2 > math::TINY2 && l2.is_finite() && sum_a > 0.0) {
+        return None;
+    }
+    fan.normal = math::scale(sum_n, math::rsqrt(l2));
+    // Feature spokes: spoke i (to ring[i]) lies between triangles i - 1 and i.
+    let mut features = [0usize; 2];
+    let mut nf = 0;
+    let first_spoke = if boundary { 1 } else { 0 };
+    for i in first_spoke..k {
+        let before = if i == 0 { k - 1 } else { i - 1 };
+        let (Some(&u), Some(&w)) = (units.get(before), units.get(i)) else {
+            return None;
+        };
+        if math::dot(u, w) < op.cos_feature {
+            if let Some(s) = features.get_mut(nf) {
+                *s = i;
+            }
+            nf += 1;
+        }
+    }
+    let p = |i: usize| fan.ring.get(i).map_or([0.0; 3], |&x| mesh.p(x));
+    let key = match (boundary, nf) {
+        // Simple: the distance to the average plane.
+        (false, 0) => {
+            let c = math::scale(sum_c, 1.0 / sum_a);
+            let d = math::dot(fan.normal, math::sub(pv, c));
+            Some(if d < 0.0 { -d } else { d })
+        }
+        // Interior edge: the distance to the feature line.
+        (false, 2) => {
+            let (i, j) = (features[0], features[1]);
+            fan.line = Some((i, j));
+            line_distance(pv, p(i), p(j))
+        }
+        // Boundary: the distance to the line through the boundary neighbours.
+        (true, 0) => line_distance(pv, p(0), p(k)),
+        // Corner.
+        _ => None,
+    }?;
+    if !key.is_finite() {
+        return None;
+    }
+    fan.key = key;
+    Some(fan)
+}
+
+/// Why no triangulation was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum NoSplit {
+    /// A loop had no split line whose halves lie on their sides of its plane with at least
+    /// the smallest aspect ratio.
+    Aspect,
+}
+
+/// The loop positions of mask `m`, in order, into `out`; how many.
+fn members(m: u32, out: &mut [u8; MAX_RING]) -> usize {
+    let mut c = 0;
+    for i in 0..MAX_RING {
+        if m >> i & 1 != 0 {
+            if let Some(s) = out.get_mut(c) {
+                *s = i as u8;
+            }
+            c += 1;
+        }
+    }
+    c
+}
+
+/// The squared aspect ratio of splitting loop `l` (positions into `pos`) along `l[x]`-`l[y]`
+/// (`x < y`, not neighbours) with the split plane through the line and `normal`: `None` if
+/// the halves do not lie strictly on their own sides (the inner half, `l[x+1..y]`, on the
+/// right of the line seen from `normal`, the outer half on the left).
+fn split_aspect2(l: &[u8], pos: &[V3; MAX_RING], normal: V3, x: usize, y: usize) -> Option<f32> {
+    let at = |i: usize| {
+        l.get(i)
+            .and_then(|&k| pos.get(k as usize))
+            .copied()
+            .unwrap_or([0.0; 3])
+    };
+    let (a, b) = (at(x), at(y));
+    let e = math::sub(b, a);
+    let s = math::cross(e, normal);
+    let (l2, s2) = (math::dot(e, e), math::dot(s, s));
+    if !(l2 > math::TINY2 && s2 > math::TINY2 && l2.is_finite() && s2.is_finite()) {
+        return None;
+    }
+    let mut least = f32::INFINITY;
+    for i in 0..l.len() {
+        if i == x || i == y {
+            continue;
+        }
+        let d = math::dot(s, math::sub(at(i), a));
+        let inner = x < i && i < y;
+        // `cross(e, normal)` points to the right of the line, where a counter-clockwise
+        // loop's inner half lies.
+        if (inner && d <= 0.0) || (!inner && d >= 0.0) {
+            return None;
+        }
+        let d2 = d * d;
+        if d2 < least {
+            least = d2;
+        }
+    }
+    // (distance to the plane / length)² = (d / |s|)² / |e|².
+    Some(least / s2 / l2)
+}
+
+/// The unit normal of loop `l` (positions into `pos`): its vector area (Newell), `None` if
+/// it has none.
+fn loop_normal(l: &[u8], pos: &[V3; MAX_RING]) -> Option<V3> {
+    let at = |k: u8| pos.get(k as usize).copied().unwrap_or([0.0; 3]);
+    let mut sum = [0.0f32; 3];
+    let mut prev = l.last().map(|&k| at(k))?;
+    for &k in l {
+        let p = at(k);
+        sum = math::add(sum, math::cross(prev, p));
+        prev = p;
+    }
+    let l2 = math::dot(sum, sum);
+    (l2 > math::TINY2 && l2.is_finite()).then(|| math::scale(sum, math::rsqrt(l2)))
+}
+
+/// Triangulates `fan`'s loop (positions `pos`, normalised, in ring order) by recursive loop
+/// splitting (see [`VertexDecimation`]) into `out` as triples of ring positions, each in loop
+/// order (so wound as the fan was), and each triangle's reference plane normal into `planes`:
+/// the fan's average plane, or for an interior-edge vertex the plane of its half of the loop
+/// (each side of the feature line is a surface of its own). Returns how many (`n − 2`).
+pub(crate) fn triangulate(
+    fan: &Fan,
+    pos: &[V3; MAX_RING],
+    min_aspect: f32,
+    out: &mut [[u8; 3]; MAX_RING],
+    planes: &mut [V3; MAX_RING],
+) -> Result<usize, NoSplit> {
+    let n = fan.n;
+    if !(3..=MAX_RING).contains(&n) {
+        return Err(NoSplit::Aspect);
+    }
+    let full = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
+    let min2 = min_aspect * min_aspect;
+    // Loops still to split, with their planes: each split makes two from one, and there are
+    // n - 2 triangles.
+    let mut stack = [(0u32, [0.0f32; 3]); MAX_RING];
+    let mut sp = 0;
+    if let Some(s) = stack.get_mut(sp) {
+        *s = (full, fan.normal);
+        sp += 1;
+    }
+    let mut made = 0;
+    let mut l = [0u8; MAX_RING];
+    while sp > 0 {
+        sp -= 1;
+        let (m, normal) = stack.get(sp).copied().unwrap_or((0, [0.0; 3]));
+        let c = members(m, &mut l);
+        let lp = l.get(..c).unwrap_or(&[]);
+        if c == 3 {
+            let (Some(slot), Some(plane)) = (out.get_mut(made), planes.get_mut(made)) else {
+                return Err(NoSplit::Aspect);
+            };
+            *slot = [l[0], l[1], l[2]];
+            *plane = normal;
+            made += 1;
+            continue;
+        }
+        if c < 3 {
+            return Err(NoSplit::Aspect);
+        }
+        // The best split: the feature line first for an interior-edge vertex.
+        let mut best: Option<(f32, usize, usize)> = None;
+        let forced = match fan.line {
+            Some((i, j)) if m == full => lp
+                .iter()
+                .position(|&k| k as usize == i)
+                .zip(lp.iter().position(|&k| k as usize == j)),
+            _ => None,
+        };
+        if let Some((x, y)) = forced {
+            let (x, y) = if x < y { (x, y) } else { (y, x) };
+            if let Some(a2) = split_aspect2(lp, pos, normal, x, y) {
+                best = Some((a2, x, y));
+            }
+        } else {
+            for x in 0..c {
+                for y in x + 2..c {
+                    if x == 0 && y == c - 1 {
+                        continue;
+                    }
+                    if let Some(a2) = split_aspect2(lp, pos, normal, x, y) {
+                        if best.is_none_or(|b| a2 > b.0) {
+                            best = Some((a2, x, y));
+                        }
+                    }
+                }
+            }
+        }
+        let Some((a2, x, y)) = best else {
+            return Err(NoSplit::Aspect);
+        };
+        if a2 < min2 {
+            return Err(NoSplit::Aspect);
+        }
+        let (Some(&kx), Some(&ky)) = (lp.get(x), lp.get(y)) else {
+            return Err(NoSplit::Aspect);
+        };
+        // Inner half: positions kx..=ky of the mask; outer: the rest and both ends.
+        let span = if ky as usize >= 31 {
+            u32::MAX
+        } else {
+            (1u32 << (ky as u32 + 1)) - 1
+        } & !((1u32 << kx) - 1);
+        let inner = m & span;
+        let outer = (m & !span) | (1u32 << kx) | (1u32 << ky);
+        for h in [inner, outer] {
+            // The feature line's halves take their own planes.
+            let plane = if forced.is_some() {
+                let mut hl = [0u8; MAX_RING];
+                let hc = members(h, &mut hl);
+                loop_normal(hl.get(..hc).unwrap_or(&[]), pos).ok_or(NoSplit::Aspect)?
+            } else {
+                normal
+            };
+            let s = stack.get_mut(sp).ok_or(NoSplit::Aspect)?;
+            *s = (h, plane);
+            sp += 1;
+        }
+    }
+    if made + 2 == n {
+        Ok(made)
+    } else {
+        Err(NoSplit::Aspect)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fan_of(p: &[V3]) -> (Fan, [V3; MAX_RING]) {
+        let mut pos = [[0.0; 3]; MAX_RING];
+        let mut ring = [NIL; MAX_RING];
+        for (i, q) in p.iter().enumerate() {
+            pos[i] = *q;
+            ring[i] = i;
+        }
+        (
+            Fan {
+                ring,
+                n: p.len(),
+                boundary: false,
+                normal: [0.0, 0.0, 1.0],
+                key: 0.0,
+                line: None,
+            },
+            pos,
+        )
+    }
+
+    /// Signed doubled area of a triangle of ring positions, seen from +z.
+    fn area_z(pos: &[V3; MAX_RING], t: [u8; 3]) -> f32 {
+        let [a, b, c] = t.map(|k| pos[k as usize]);
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    }
+
+    /// A concave loop (an L, counter-clockwise): every triangle the splitting makes faces +z
+    /// and they tile the loop. Fails if the side test of the split plane is dropped (a split
+    /// outside the loop makes a triangle facing −z) or if the aspect ratio stops choosing (the
+    /// widest split of a hexagon is then not the one taken).
+    #[test]
+    fn concave_loops_split_inside() {
+        let p = [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [4.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 4.0, 0.0],
+            [0.0, 4.0, 0.0],
+        ];
+        let (fan, pos) = fan_of(&p);
+        let mut out = [[0u8; 3]; MAX_RING];
+        let mut planes = [[0.0f32; 3]; MAX_RING];
+        let n = triangulate(&fan, &pos, 0.1, &mut out, &mut planes).expect("a split");
+        assert_eq!(n, 4);
+        let total: f32 = out[..n].iter().map(|&t| area_z(&pos, t)).sum();
+        for &t in &out[..n] {
+            assert!(area_z(&pos, t) > 0.0, "{t:?} faces away");
+        }
+        // The pieces tile the loop exactly (no overlap, nothing outside).
+        let mut shoelace = 0.0;
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            shoelace += a[0] * b[1] - a[1] * b[0];
+        }
+        assert!((total - shoelace).abs() < 1e-4, "{total} vs {shoelace}");
+        // The widest split of a regular hexagon is through opposite corners (aspect about 0.43),
+        // not between neighbours' neighbours (about 0.29): one diagonal joins opposite corners.
+        let hex: Vec<V3> = (0..6)
+            .map(|i| {
+                let a = i as f32 * core::f32::consts::PI / 3.0;
+                [a.cos(), a.sin(), 0.0]
+            })
+            .collect();
+        let (fan, pos) = fan_of(&hex);
+        let n = triangulate(&fan, &pos, 0.1, &mut out, &mut planes).expect("a split");
+        assert_eq!(n, 4);
+        let diagonals = out[..n]
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[0], t[2])])
+            .filter(|&(a, b)| b - a == 3)
+            .count();
+        // One diagonal, seen from its two triangles.
+        assert_eq!(diagonals, 2, "{:?}", &out[..n]);
+        // Below the aspect limit: refused.
+        let thin = [
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [10.0, 0.2, 0.0],
+            [0.0, 0.2, 0.0],
+        ];
+        let (fan, pos) = fan_of(&thin);
+        assert_eq!(
+            triangulate(&fan, &pos, 0.1, &mut out, &mut planes),
+            Err(NoSplit::Aspect)
+        );
+        assert!(triangulate(&fan, &pos, 0.0, &mut out, &mut planes).is_ok());
+    }
+}
