@@ -132,11 +132,14 @@ pub enum Method {
     StoredOptimal,
     /// meshoptimizer's `meshopt_simplifyWithUpdate` (positions moved, no attributes).
     MeshoptUpdate,
+    /// tinydecimate, `VertexDecimation` (Schroeder, Zarge and Lorensen 1992) with
+    /// `Config::new()`.
+    VertexDecimation,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 8] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -144,7 +147,16 @@ impl Method {
         Method::Stored,
         Method::StoredOptimal,
         Method::MeshoptUpdate,
+        Method::VertexDecimation,
     ];
+
+    /// The operator of our modes.
+    pub fn operator(self) -> crate::simplify::OperatorArg {
+        match self {
+            Method::VertexDecimation => crate::simplify::OperatorArg::VertexDecimation,
+            _ => crate::simplify::OperatorArg::Edge,
+        }
+    }
 
     /// Stored-quadric placement of our stored modes.
     pub fn placement(self) -> Option<tinydecimate::cost::Placement> {
@@ -171,13 +183,14 @@ impl Method {
             Method::Stored => "stored quadric, subset",
             Method::StoredOptimal => "stored quadric, optimal",
             Method::MeshoptUpdate => "meshoptimizer simplifyWithUpdate",
+            Method::VertexDecimation => "vertex decimation",
         }
     }
 
     /// The library configuration (before the ratio); `None` for meshoptimizer.
     pub fn config(self) -> Option<Config> {
         match self {
-            Method::Default => Some(Config::new()),
+            Method::Default | Method::VertexDecimation => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
@@ -195,6 +208,7 @@ impl Method {
             Method::Stored => "`StoredQuadric` (subset placement) with `Config::stored()`",
             Method::StoredOptimal => "`StoredQuadric` (optimal placement) with `Config::stored()`",
             Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
+            Method::VertexDecimation => "`VertexDecimation::new()` with `Config::new()`",
         }
     }
 
@@ -568,25 +582,30 @@ fn run_method(
             (Some(config), placement) => {
                 // Seams welded (`host-sim simplify`'s default), when the mesh has any.
                 let run = crate::simplify::Run {
+                    operator: method.operator(),
                     placement,
                     weld: true,
                     prune,
                     ..Default::default()
                 };
-                let (out, report, elapsed) = crate::simplify::simplify_with(
-                    mesh,
-                    &with_default_limit(config.with_ratio(ratio), mesh),
-                    &run,
-                )?;
+                // The error limit measures a collapse: edge collapse only.
+                let config = if method.operator() == crate::simplify::OperatorArg::Edge {
+                    with_default_limit(config.with_ratio(ratio), mesh)
+                } else {
+                    config.with_ratio(ratio)
+                };
+                let (out, report, elapsed) = crate::simplify::simplify_with(mesh, &config, &run)?;
                 let quadrics = if placement.is_some() {
                     v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
                 };
+                // Vertex decimation runs unwelded and without parts (`simplify_with`).
+                let edge = method.operator() == crate::simplify::OperatorArg::Edge;
                 let bytes = workspace_bytes(v, t).0
                     + quadrics
-                    + wedge_bytes(mesh)
-                    + part_bytes(v, &config, prune);
+                    + if edge { wedge_bytes(mesh) } else { 0 }
+                    + part_bytes(v, &config, prune && edge);
                 (out, elapsed, bytes, Some(report))
             }
             (None, _) => {
@@ -960,7 +979,7 @@ mod tests {
         );
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 5);
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 6);
     }
 
     #[test]

@@ -7,12 +7,15 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Result};
 use tinydecimate::bound::Controls;
 use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
-use tinydecimate::{Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse};
+use tinydecimate::{
+    Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse, VertexDecimation,
+};
 
 use crate::io::MeshData;
 use crate::workspace::HostWorkspace;
 
-/// Which operator, on the command line (`EdgeCollapse` or `TriangleCollapse`).
+/// Which operator, on the command line (`EdgeCollapse`, `TriangleCollapse` or
+/// `VertexDecimation`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum OperatorArg {
     /// The default and the one to use: half-edge collapse (one vertex merged into a
@@ -25,6 +28,10 @@ pub enum OperatorArg {
     /// time. For comparison with that paper: on real meshes its Hausdorff error is many times
     /// the edge collapse's and it runs about twice as long.
     Triangle,
+    /// Vertex decimation of Schroeder, Zarge and Lorensen 1992 (greedy, no bound): the
+    /// vertex nearest its average plane (or boundary or feature line) goes first and its hole
+    /// is re-triangulated by loop splitting. Runs without welded seams and part pruning.
+    VertexDecimation,
 }
 
 /// Runs the library on `mesh`. The result keeps all of `mesh`'s positions (the library only
@@ -112,7 +119,10 @@ pub fn simplify_with(
         lock_seam_corners,
         prune,
     } = *run;
-    let prune = prunes(prune, config, bounded);
+    // A removal has no collapse cost to weigh a part against, nor wedges for new triangles.
+    let removal = operator == OperatorArg::VertexDecimation;
+    let prune = prunes(prune, config, bounded) && !removal;
+    let weld = weld && !removal;
     let mut part_links = vec![[0u32; 2]; if prune { mesh.positions.len() } else { 0 }];
     let mut tris = mesh.triangles.clone();
     let mut positions = mesh.positions.clone();
@@ -193,6 +203,9 @@ pub fn simplify_with(
             match operator {
                 OperatorArg::Edge => drive_with!($p, $cost, $bound, EdgeCollapse),
                 OperatorArg::Triangle => drive_with!($p, $cost, $bound, TriangleCollapse),
+                OperatorArg::VertexDecimation => {
+                    drive_with!($p, $cost, $bound, VertexDecimation::new())
+                }
             }
         }};
     }
