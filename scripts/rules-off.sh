@@ -27,7 +27,7 @@ rules=("$@")
 # stored quadrics' validity over both placements, with and without the feature rule
 # (tests/stored.rs: the engine's one-price re-keying runs there); welded seams (tests/seams.rs,
 # for the `seam` rule, with the crate feature `seams`).
-read -r -a tests <<<"${RULES_OFF_TESTS:---features seams --test rules --test errors --test fuzz_regressions --test properties --test bound --test stored --test seams}"
+read -r -a tests <<<"${RULES_OFF_TESTS:---features seams --test rules --test errors --test fuzz_regressions --test properties --test bound --test stored --test seams --test decimate}"
 per_run_timeout=${RULES_OFF_TIMEOUT:-900}
 
 log_dir=$(mktemp -d)

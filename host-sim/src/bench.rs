@@ -1069,9 +1069,14 @@ mod tests {
                 .lines()
                 .filter(|l| l.contains(" %") && l.contains(&format!("| {} |", method.label())))
                 .count();
-            // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table.
+            // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table and
+            // one per run that stopped short in the stopped-short table.
             let extra = if method.is_ours() {
                 QUICK_RATIOS.len()
+                    + r.rows
+                        .iter()
+                        .filter(|x| x.method == method && !x.target_reached)
+                        .count()
             } else {
                 0
             };
