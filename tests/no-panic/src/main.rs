@@ -27,7 +27,7 @@ use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
     Config, CostKind, EdgeCollapse, FeatureMode, Index, NoBound, Positions, Progressive, Report,
-    Schedule, Simplifier, Target, TriangleCollapse, Workspace,
+    Schedule, Simplifier, Target, TriangleCollapse, VertexDecimation, Workspace,
 };
 
 #[panic_handler]
@@ -205,6 +205,21 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
         Builtin::new(),
         NoBound,
         TriangleCollapse,
+    ) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    let decimation = VertexDecimation::new()
+        .with_feature_angle(opaque_f32(6))
+        .with_feature_growth(opaque_f32(7), opaque_f32(8))
+        .with_min_aspect(opaque_f32(9));
+    match ws.start(
+        Positions::Read(p),
+        t,
+        &config,
+        Builtin::new(),
+        NoBound,
+        decimation,
     ) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
