@@ -12,7 +12,7 @@ impl<L: Index, I: Index> Mesh<'_, L, I> {
     /// Removes `v` and its `k` triangles and writes `new` (triangles over `v`'s neighbours,
     /// `new.len() ≤ k`, wound as the fan was) into the first `new.len()` of their slots; the
     /// rest are removed. Returns how many triangles were removed (`k − new.len()`), 0 if
-    /// nothing was done (a fan of more than [`MAX_FAN`](self) triangles, or `new` longer than
+    /// nothing was done (a fan of more than `MAX_FAN` triangles, or `new` longer than
     /// the fan). The caller has checked the new fan (`legality::check_fan`); `v` and its
     /// neighbours are not locked, so their lists are in fan order.
     ///

@@ -20,12 +20,13 @@ const MIN_ASPECT: f32 = 0.04;
 /// Vertex decimation (Schroeder, Zarge and Lorensen 1992): a vertex is removed with its
 /// triangles, and the hole is filled by triangulating the loop of its neighbours.
 ///
-/// The survey seed (the simplification post's section "基于相邻面片和边界的局部平坦性原则",
-/// local flatness from the adjacent faces and the boundary, under the vertex-removal
-/// methods) gives the criterion: for an interior vertex `v` with fan `S`, the distance
-/// `d = |N · (v − C)|` to the average plane, `N` the unit vector of the area-weighted mean of
-/// the faces' normals and `C` the area-weighted mean of their centroids; for a boundary vertex,
-/// its distance to the line through its two boundary neighbours. The classification and the
+/// The survey of mesh simplification (a Chinese blog post, "图形学——网格简化"), section
+/// "基于相邻面片和边界的局部平坦性原则" (local flatness from the adjacent faces and the
+/// boundary, among its vertex-removal methods), gives the criterion: for an interior vertex
+/// `v` with fan `S`, the distance `d = |N · (v − C)|` to the average plane, `N` the unit
+/// vector of the area-weighted mean of the faces' normals and `C` the area-weighted mean of
+/// their centroids (the post divides by `A(f)`; read as `Σ A(f)`); for a boundary vertex, its
+/// distance to the line through its two boundary neighbours. The classification and the
 /// loop splitting are the paper's (the seed does not describe them):
 ///
 /// * **complex** (non-manifold, pinched or inconsistently wound: the engine's locked
@@ -54,8 +55,9 @@ const MIN_ASPECT: f32 = 0.04;
 /// ([`VertexDecimation::with_min_aspect`], 0.04 by default), and each half is split again
 /// until it is a triangle. The halves of an interior-edge vertex's loop (split along its
 /// feature line) are split against their own planes (their loops' vector areas), each side of
-/// the line being a surface of its own. No split: the vertex stays until its fan changes. The loop is at most
-/// [`MAX_RING`](self) long (32; a vertex of higher valence stays), so every buffer is fixed.
+/// the line being a surface of its own. No split: the vertex stays until its fan changes.
+/// The loop is at most 32 vertices long (a vertex of higher valence stays), so every buffer
+/// is fixed.
 ///
 /// The new fan then passes the same hard rules as a collapse (`legality::check_fan`): no
 /// diagonal (or a boundary vertex's new boundary edge) that is already an edge, no new
