@@ -600,7 +600,7 @@ fn run_method(
                 } else {
                     0
                 };
-                // Vertex decimation runs unwelded and without parts (`simplify_with`).
+                // Vertex decimation runs without wedges and parts (`simplify_with`).
                 let edge = method.operator() == crate::simplify::OperatorArg::Edge;
                 let bytes = workspace_bytes(v, t).0
                     + quadrics

@@ -30,7 +30,8 @@ pub enum OperatorArg {
     Triangle,
     /// Vertex decimation of Schroeder, Zarge and Lorensen 1992 (greedy, no bound): the
     /// vertex nearest its average plane (or boundary or feature line) goes first and its hole
-    /// is re-triangulated by loop splitting. Runs without welded seams and part pruning.
+    /// is re-triangulated by loop splitting. Runs without part pruning; seams welded by
+    /// position without wedges (the output is positions only: new triangles have no wedges).
     VertexDecimation,
 }
 
@@ -119,10 +120,10 @@ pub fn simplify_with(
         lock_seam_corners,
         prune,
     } = *run;
-    // A removal has no collapse cost to weigh a part against, nor wedges for new triangles.
+    // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
+    // its run is welded by position, and the output keeps the welded numbering.
     let removal = operator == OperatorArg::VertexDecimation;
     let prune = prunes(prune, config, bounded) && !removal;
-    let weld = weld && !removal;
     let mut part_links = vec![[0u32; 2]; if prune { mesh.positions.len() } else { 0 }];
     let mut tris = mesh.triangles.clone();
     let mut positions = mesh.positions.clone();
@@ -157,7 +158,10 @@ pub fn simplify_with(
             .map_err(library_error)?
             > 0
         {
-            wedges = w;
+            // A removal's run takes the welded triangles alone (no wedges).
+            if !removal {
+                wedges = w;
+            }
             welded = tris.clone();
         }
     }
