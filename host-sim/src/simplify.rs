@@ -6,7 +6,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
 use tinydecimate::bound::Controls;
-use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
+use tinydecimate::cost::{
+    AttributeQuadric, AttributeState, Placement, StoredQuadric, VertexQuadric,
+};
 use tinydecimate::{Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse};
 
 use crate::io::MeshData;
@@ -91,6 +93,20 @@ pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
     prune && !bounded && config.schedule == tinydecimate::Schedule::Greedy
 }
 
+/// Vertex attributes for the attribute-aware stored quadric
+/// (`tinydecimate::cost::AttributeQuadric`): per vertex, texture coordinates then a normal
+/// (zeros where a mesh has none), and a weight per component (zero switches it off).
+#[derive(Clone, Debug, Default)]
+pub struct Attributes {
+    /// `[u, v, nx, ny, nz]` per vertex.
+    pub values: Vec<[f32; ATTRIBUTES]>,
+    /// One weight per component.
+    pub weights: [f32; ATTRIBUTES],
+}
+
+/// Components per vertex in [`Attributes`]: UV and normal.
+pub const ATTRIBUTES: usize = 5;
+
 /// Runs the library on `mesh` with the policies of `run`. The library refuses combinations
 /// it cannot run. The result carries the positions as the library left them (moved by optimal
 /// placement). The wall time is that of the library alone (storage is allocated before).
@@ -98,6 +114,17 @@ pub fn simplify_with(
     mesh: &MeshData,
     config: &Config,
     run: &Run,
+) -> Result<(MeshData, Report, Duration)> {
+    simplify_with_attributes(mesh, config, run, None)
+}
+
+/// [`simplify_with`], and with `attributes` the stored quadric with their attribute term
+/// (`AttributeQuadric`: stored quadrics with subset placement only, refused otherwise).
+pub fn simplify_with_attributes(
+    mesh: &MeshData,
+    config: &Config,
+    run: &Run,
+    attributes: Option<&Attributes>,
 ) -> Result<(MeshData, Report, Duration)> {
     let Run {
         operator,
@@ -117,6 +144,8 @@ pub fn simplify_with(
         0
     };
     let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; n];
+    let mut states =
+        vec![AttributeState::<ATTRIBUTES>::ZERO; if attributes.is_some() { n } else { 0 }];
     let n = if bounded {
         tinydecimate::bound::control_len(tris.len(), positions.len())
     } else {
@@ -187,33 +216,59 @@ pub fn simplify_with(
         }};
     }
     // Optimal placement writes the positions; every other run only reads them.
-    let report = match (placement, bounded) {
-        (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
-        (None, true) => drive!(
-            Positions::Read(&positions),
-            Builtin::new(),
-            Controls::new(original, &mut links)
-        ),
-        (Some(Placement::Subset), false) => drive!(
-            Positions::Read(&positions),
-            StoredQuadric::new(&mut quadrics, Placement::Subset),
-            NoBound
-        ),
-        (Some(Placement::Subset), true) => drive!(
-            Positions::Read(&positions),
-            StoredQuadric::new(&mut quadrics, Placement::Subset),
-            Controls::new(original, &mut links)
-        ),
-        (Some(Placement::Optimal), false) => drive!(
-            Positions::Write(&mut positions),
-            StoredQuadric::new(&mut quadrics, Placement::Optimal),
-            NoBound
-        ),
-        (Some(Placement::Optimal), true) => drive!(
-            Positions::Write(&mut positions),
-            StoredQuadric::new(&mut quadrics, Placement::Optimal),
-            Controls::new(original, &mut links)
-        ),
+    let report = if let Some(a) = attributes {
+        let cost = |q, s| {
+            AttributeQuadric::new(q, s, &a.values, a.weights)
+                .with_placement(placement.unwrap_or(Placement::Optimal))
+                .map_err(|e| {
+                    anyhow!(
+                        "{} (attribute weights need --quadric stored --placement subset)",
+                        e
+                    )
+                })
+        };
+        if bounded {
+            drive!(
+                Positions::Read(&positions),
+                cost(&mut quadrics, &mut states)?,
+                Controls::new(original, &mut links)
+            )
+        } else {
+            drive!(
+                Positions::Read(&positions),
+                cost(&mut quadrics, &mut states)?,
+                NoBound
+            )
+        }
+    } else {
+        match (placement, bounded) {
+            (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
+            (None, true) => drive!(
+                Positions::Read(&positions),
+                Builtin::new(),
+                Controls::new(original, &mut links)
+            ),
+            (Some(Placement::Subset), false) => drive!(
+                Positions::Read(&positions),
+                StoredQuadric::new(&mut quadrics, Placement::Subset),
+                NoBound
+            ),
+            (Some(Placement::Subset), true) => drive!(
+                Positions::Read(&positions),
+                StoredQuadric::new(&mut quadrics, Placement::Subset),
+                Controls::new(original, &mut links)
+            ),
+            (Some(Placement::Optimal), false) => drive!(
+                Positions::Write(&mut positions),
+                StoredQuadric::new(&mut quadrics, Placement::Optimal),
+                NoBound
+            ),
+            (Some(Placement::Optimal), true) => drive!(
+                Positions::Write(&mut positions),
+                StoredQuadric::new(&mut quadrics, Placement::Optimal),
+                Controls::new(original, &mut links)
+            ),
+        }
     };
     let elapsed = start.elapsed();
     if let Some(b) = bar {

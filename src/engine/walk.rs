@@ -139,7 +139,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
             let (px, py) = (self.mesh.p(x), self.mesh.p(y));
             let (ex, ey) = (math::sub(px, pv), math::sub(py, pv));
-            self.cost.triangle(v, [x, y], ex, ey);
+            self.cost
+                .triangle(v, self.mesh.caller_corners(c >> 2, c & 3), ex, ey);
             let n = math::cross(ex, ey);
             let l2 = math::dot(n, n);
             if l2 > math::TINY2 && l2.is_finite() {

@@ -20,6 +20,7 @@ use crate::simplify::{format_report, report_json, simplify_with};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
 mod advice;
+mod attributes;
 mod textured;
 
 /// Which schedule, on the command line.
@@ -193,6 +194,31 @@ fn parse_weight(v: &str) -> std::result::Result<f32, String> {
     ranged(v, |x| x >= 0.0, "0 or more", "a weight")
 }
 
+/// `--attribute-weights`: a weight for texture coordinates and one for normals.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AttributeWeights {
+    /// Both texture coordinates' weight.
+    pub uv: f32,
+    /// The normal's three components' weight.
+    pub normal: f32,
+}
+
+fn parse_attribute_weights(v: &str) -> std::result::Result<AttributeWeights, String> {
+    let mut w = AttributeWeights::default();
+    for item in v.split(',') {
+        let (name, value) = item
+            .split_once('=')
+            .ok_or_else(|| format!("`{item}`: give name=weight (uv=W,normal=W)"))?;
+        let x = parse_weight(value.trim())?;
+        match name.trim() {
+            "uv" => w.uv = x,
+            "normal" => w.normal = x,
+            n => return Err(format!("`{n}`: the attributes are uv and normal")),
+        }
+    }
+    Ok(w)
+}
+
 fn parse_samples(v: &str) -> std::result::Result<f64, String> {
     ranged(v, |x| x > 0.0, "above 0", "samples per triangle").map(f64::from)
 }
@@ -357,6 +383,13 @@ pub struct Args {
     /// Placement of the kept vertex with `--quadric stored`.
     #[arg(long, value_enum, default_value_t = PlacementArg::Subset)]
     pub placement: PlacementArg,
+    /// Attribute weights for the stored quadric (`tinydecimate::cost::AttributeQuadric`,
+    /// meshoptimizer's `simplifyWithAttributes` term): `uv=W,normal=W` (either or both). A
+    /// weighted attribute change of 1 across a triangle of size d is priced like moving it by
+    /// d. Needs `--quadric stored` with `--placement subset` and a mesh with attributes (glTF,
+    /// OBJ with vt/vn); with welded seams each position's first vertex's attributes are used.
+    #[arg(long, value_parser = parse_attribute_weights)]
+    pub attribute_weights: Option<AttributeWeights>,
     /// Skip the validity check and the Metro measurement afterwards.
     #[arg(long)]
     pub no_measure: bool,
@@ -500,6 +533,13 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     config
         .validate()
         .map_err(|e| anyhow!("configuration: {e}"))?;
+    if args.attribute_weights.is_some() {
+        bail!(
+            "{}: --attribute-weights needs vertex attributes: a glTF, or an OBJ with vt or vn \
+             written to OBJ",
+            args.input.display()
+        );
+    }
     let stored = args.quadric == QuadricArg::Stored;
     // Optimal placement moves vertices: only their numbering says which input vertex each
     // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.

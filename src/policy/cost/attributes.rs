@@ -143,13 +143,16 @@ impl<const N: usize> AttributeState<N> {
 /// never invents an attribute value. [`Placement::Optimal`] is refused with
 /// [`Error::InvalidConfig`] for [`ConfigField::Placement`].
 ///
-/// **Seams.** One attribute set per engine vertex. Where vertices at one position are welded
-/// (`seam::weld`), the engine vertex is the position's representative and its attributes are
-/// the ones used, for every triangle around it: a triangle across a UV seam then sees the
-/// jump as a steep gradient and the seam's vertices become dear to move (they are kept longer,
-/// which is what a seam needs; the cost does not see the other wedges' own values). With split
-/// seams every vertex has exactly its own attributes and this is meshoptimizer's per-wedge
-/// metric.
+/// **Seams.** One attribute state per engine vertex. Where vertices at one position are
+/// welded ([`seam::weld`](crate::seam::weld)), the engine vertex is the position's
+/// representative: each triangle's gradient is taken from its own wedges
+/// ([`Cost::triangle`]), but only the triangles whose wedge at the position carries the
+/// representative's attributes enter its state (the far side of a UV seam is not measured),
+/// and a collapse is priced against the representatives' attributes (moving onto a seam
+/// vertex from the far side of its representative's chart is priced with the seam's jump,
+/// so it is dear). meshoptimizer keeps a state per wedge and prices each wedge against the
+/// wedge it goes to. With split seams every vertex has exactly its own attributes and this
+/// is meshoptimizer's metric for the seamless case.
 ///
 /// **Error limit.** [`Config::error_limit`](crate::Config::error_limit) and the reported
 /// errors stay geometric: [`Cost::error2`] is the stored quadric's alone.
@@ -289,9 +292,16 @@ impl<const N: usize> Cost for AttributeQuadric<'_, '_, N> {
         self.geometry.boundary_plane(v, n, d, w)
     }
 
-    fn triangle(&mut self, v: usize, others: [usize; 2], e1: V3, e2: V3) {
-        let d1 = self.delta(v, others[0]);
-        let d2 = self.delta(v, others[1]);
+    /// The triangle's gradient from its own corners' attributes (its wedges when seams are
+    /// welded); a triangle whose corner at `v` carries other attributes than `v` (the far
+    /// side of a seam through the representative `v`) is left out.
+    fn triangle(&mut self, v: usize, corners: [usize; 3], e1: V3, e2: V3) {
+        let [c0, c1, c2] = corners;
+        if c0 != v && self.weighted(c0) != self.weighted(v) {
+            return;
+        }
+        let d1 = self.delta(c0, c1);
+        let d2 = self.delta(c0, c2);
         if let Some(s) = self.state.get_mut(v) {
             s.add_triangle(e1, e2, &d1, &d2);
         }

@@ -115,13 +115,14 @@ pub trait Cost {
     /// each vertex's state in a frame centred on it, which keeps `f32` sums of nearby planes
     /// free of the cancellation a global origin causes.
     fn plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
-    /// Hands a storing cost one triangle of `v`'s fan, `(v, others[0], others[1])` in its
-    /// winding, with `e1`, `e2` the other two corners' positions relative to `v` (normalised
-    /// units), once per triangle and corner, beside [`Cost::plane`] (only if [`Cost::stores`]).
-    /// A plane does not say which vertices span it: a cost that reads per-vertex data besides
-    /// positions (attribute gradients, [`AttributeQuadric`]) needs the corners. Nothing by
-    /// default.
-    fn triangle(&mut self, _v: usize, _others: [usize; 2], _e1: V3, _e2: V3) {}
+    /// Hands a storing cost one triangle of `v`'s fan when the planes are initialised (only
+    /// if [`Cost::stores`]), beside [`Cost::plane`]: its three corners as the caller's vertices
+    /// in winding order from `v`'s corner (`corners[0]` is `v` itself, or with welded seams
+    /// ([`crate::seam`]) the wedge the triangle has at `v`'s position), and `e1`, `e2` the
+    /// other two corners' positions relative to `v` (normalised units). A plane does not say
+    /// which vertices span it: a cost that reads per-vertex data besides positions (attribute
+    /// gradients, [`AttributeQuadric`]) needs the corners. Nothing by default.
+    fn triangle(&mut self, _v: usize, _corners: [usize; 3], _e1: V3, _e2: V3) {}
     /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle (Cheng,
     /// Pan and Shi 1998 §3.3); `weight` is the squared edge length, the cost applies its own
     /// factor.

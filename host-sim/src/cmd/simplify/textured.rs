@@ -22,7 +22,13 @@ use crate::io::MeshData;
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
-fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u32; 3]>, Report)> {
+/// `attributes`: `--attribute-weights`' attribute term (`super::attributes`).
+fn run_library(
+    mesh: &MeshData,
+    config: &Config,
+    args: &Args,
+    attributes: Option<&crate::simplify::Attributes>,
+) -> Result<(Vec<[u32; 3]>, Report)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
     let run = crate::simplify::Run {
@@ -32,7 +38,8 @@ fn run_library(mesh: &MeshData, config: &Config, args: &Args) -> Result<(Vec<[u3
         weld: args.seams == super::SeamsArg::Weld,
         ..Default::default()
     };
-    let (out, report, _) = crate::simplify::simplify_with(mesh, config, &run)?;
+    let (out, report, _) =
+        crate::simplify::simplify_with_attributes(mesh, config, &run, attributes)?;
     Ok((out.triangles, report))
 }
 
@@ -104,7 +111,7 @@ fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
     let file =
         crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
     let parts = vec![("vertex element".to_string(), file.mesh.clone(), None)];
-    let done = simplify_parts(args, &parts)?;
+    let done = simplify_parts(args, &parts, &[])?;
     let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
     std::fs::write(&args.output, out)
@@ -146,11 +153,16 @@ struct Part {
 /// its material reads (one per vertex), for the UV stretch figure.
 type Input = (String, MeshData, Option<Vec<[f32; 2]>>);
 
-/// Simplifies each mesh of `parts` with `args`' configuration.
-fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
+/// Simplifies each mesh of `parts` with `args`' configuration; `normals` (per part, may be
+/// shorter) are only read by `--attribute-weights`.
+fn simplify_parts(
+    args: &Args,
+    parts: &[Input],
+    normals: &[Option<Vec<[f32; 3]>>],
+) -> Result<Vec<Part>> {
     let total: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
     let mut out = Vec::new();
-    for (label, mesh, uvs) in parts {
+    for (k, (label, mesh, uvs)) in parts.iter().enumerate() {
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
@@ -163,8 +175,15 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
         config
             .validate()
             .map_err(|e| anyhow!("configuration: {e}"))?;
-        let (tris, report) =
-            run_library(mesh, &config, args).map_err(|e| anyhow!("{label}: {e}"))?;
+        let attributes = super::attributes::for_part(
+            args,
+            label,
+            mesh.positions.len(),
+            uvs.as_deref(),
+            normals.get(k).and_then(Option::as_deref),
+        )?;
+        let (tris, report) = run_library(mesh, &config, args, attributes.as_ref())
+            .map_err(|e| anyhow!("{label}: {e}"))?;
         let result = MeshData {
             positions: mesh.positions.clone(),
             triangles: tris.clone(),
@@ -221,7 +240,18 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
                 serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
             json["metro"] = serde_json::to_value(&m)?;
             if let Some(uvs) = uvs {
-                let _ = write!(line, "{}", uv_stretch(mesh, uvs, &result, &mut json));
+                let _ = write!(
+                    line,
+                    "{}{}",
+                    uv_stretch(mesh, uvs, &result, &mut json),
+                    super::attributes::meshopt_reference(
+                        mesh,
+                        uvs,
+                        &result,
+                        &attributes,
+                        &mut json
+                    )
+                );
             }
         }
         out.push(Part {
@@ -351,7 +381,12 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
             )
         })
         .collect();
-    let done = simplify_parts(args, &parts)?;
+    let normals: Vec<_> = file
+        .primitives
+        .iter()
+        .map(super::attributes::gltf_normals)
+        .collect();
+    let done = simplify_parts(args, &parts, &normals)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
     crate::io::gltf::save(&args.output, &file, &results)?;
     let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
@@ -415,7 +450,11 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
             (name, file.mesh(g), obj_texture_coordinates(&file, g))
         })
         .collect();
-    let done = simplify_parts(args, &parts)?;
+    let normals: Vec<_> = (0..file.groups.len())
+        .filter(|&g| !file.groups[g].triangles.is_empty())
+        .map(|g| super::attributes::obj_normals(&file, g))
+        .collect();
+    let done = simplify_parts(args, &parts, &normals)?;
     let mut results = Vec::new();
     let mut k = 0;
     for g in &file.groups {
