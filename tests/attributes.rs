@@ -201,3 +201,129 @@ fn error_limit_is_geometric() {
         .run();
     assert_eq!(r.over_limit, 0, "{r:?}");
 }
+
+/// The kinked grid with a UV seam at column `SEAM` (left of the kink): the right chart's
+/// vertices on the seam are copies, and its `u` is shifted by 5. Returns the mesh, UVs and each
+/// vertex's chart.
+#[cfg(feature = "seams")]
+fn kinked_grid_with_seam() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>, Vec<u8>) {
+    const SEAM: usize = 4;
+    let (mut p, mut t, mut uv) = kinked_grid();
+    let w = N + 1;
+    let mut chart: Vec<u8> = (0..p.len()).map(|v| u8::from(v % w > SEAM)).collect();
+    let mut copy = vec![u32::MAX; p.len()];
+    for j in 0..w {
+        let v = j * w + SEAM;
+        copy[v] = p.len() as u32;
+        p.push(p[v]);
+        uv.push([uv[v][0] + 5.0, uv[v][1]]);
+        chart.push(1);
+    }
+    for tri in &mut t {
+        // A triangle right of the seam column takes the copies.
+        if tri.iter().any(|&v| v as usize % w > SEAM) {
+            for v in tri.iter_mut() {
+                if copy[*v as usize] != u32::MAX {
+                    *v = copy[*v as usize];
+                }
+            }
+        }
+    }
+    for (v, c) in uv.iter_mut().zip(&chart) {
+        if *c == 1 && v[0] < 5.0 {
+            v[0] += 5.0;
+        }
+    }
+    (p, t, uv, chart)
+}
+
+/// Welded seams: each triangle's gradient comes from its own wedges, so the seam's jump in `u`
+/// is not read as a gradient; the kink is still kept, and lost without the attribute term.
+#[cfg(feature = "seams")]
+#[test]
+fn uv_kink_is_kept_with_welded_seams() {
+    let (p, t0, uv, chart) = kinked_grid_with_seam();
+    let run = |weights: [f32; 2]| {
+        let mut t = t0.clone();
+        let mut wedges = vec![[0u32; 3]; t.len()];
+        let mut order = vec![0u32; p.len()];
+        let moved = tinydecimate::seam::weld(&p, &mut t, &mut wedges, &mut order).expect("weld");
+        assert!(moved > 0);
+        let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; p.len()];
+        let mut s = vec![AttributeState::<2>::ZERO; p.len()];
+        let mut ws = WS.lock().unwrap_or_else(|e| e.into_inner());
+        let r = ws
+            .start(
+                Positions::Read(&p),
+                &mut t,
+                &Config::stored().with_ratio(0.2),
+                AttributeQuadric::new(&mut q, &mut s, &uv, weights),
+                tinydecimate::NoBound,
+                EdgeCollapse,
+            )
+            .expect("start")
+            .with_wedges(&mut wedges)
+            .expect("wedges")
+            .run();
+        assert!(r.target_reached, "{r:?}");
+        t.truncate(r.triangles_out);
+        // The largest gap between the chart's true u and the interpolated one.
+        let mut worst = 0.0f32;
+        for tri in &t {
+            let [a, b, c] = tri.map(|v| v as usize);
+            assert!(
+                chart[a] == chart[b] && chart[b] == chart[c],
+                "a triangle across the seam"
+            );
+            let shift = 5.0 * f32::from(chart[a]);
+            for (wa, wb) in [(1.0 / 3.0, 1.0 / 3.0), (0.6, 0.2), (0.2, 0.6), (0.2, 0.2)] {
+                let wc = 1.0 - wa - wb;
+                let x = wa * p[a][0] + wb * p[b][0] + wc * p[c][0];
+                let u = wa * uv[a][0] + wb * uv[b][0] + wc * uv[c][0];
+                worst = worst.max((u - shift - u_of(x)).abs());
+            }
+        }
+        worst
+    };
+    let with = run([1.0, 1.0]);
+    let plain = run([0.0, 0.0]);
+    assert!(with < 1e-4, "gap with attributes {with}");
+    assert!(plain > 0.01, "gap without attributes {plain}");
+}
+
+/// Welded seams: the states hold the charts' own gradients (`u` rises at most 4 per unit of
+/// `x`, and the engine's normalisation does not scale this grid: 4 per normalised unit);
+/// reading the seam's jump of 5 across one cell as a gradient (the representative's `u` for a
+/// corner on the other chart) gives about 50.
+#[cfg(feature = "seams")]
+#[test]
+fn welded_gradients_are_the_charts_own() {
+    let (p, mut t, uv, _) = kinked_grid_with_seam();
+    let mut wedges = vec![[0u32; 3]; t.len()];
+    let mut order = vec![0u32; p.len()];
+    tinydecimate::seam::weld(&p, &mut t, &mut wedges, &mut order).expect("weld");
+    let mut q: Vec<VertexQuadric> = vec![[0.0; 10]; p.len()];
+    let mut s = vec![AttributeState::<2>::ZERO; p.len()];
+    {
+        let mut ws = WS.lock().unwrap_or_else(|e| e.into_inner());
+        ws.start(
+            Positions::Read(&p),
+            &mut t,
+            &Config::stored().with_ratio(0.9),
+            AttributeQuadric::new(&mut q, &mut s, &uv, [1.0, 1.0]),
+            tinydecimate::NoBound,
+            EdgeCollapse,
+        )
+        .expect("start")
+        .with_wedges(&mut wedges)
+        .expect("wedges")
+        .run();
+    }
+    let used = s.iter().filter(|s| s.w > 0.0).count();
+    assert!(used > 100, "{used} states");
+    for (v, s) in s.iter().enumerate().filter(|(_, s)| s.w > 0.0) {
+        let g = s.g[0];
+        let mean = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt() / s.w;
+        assert!(mean <= 4.01, "vertex {v}: mean u gradient {mean}");
+    }
+}
