@@ -25,8 +25,11 @@ fn u_of(x: f32) -> f32 {
     }
 }
 
+/// Positions, triangles and UVs.
+type Grid = (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>);
+
 /// A flat `N` x `N` grid on the unit square with UVs `(u_of(x), y)`.
-fn kinked_grid() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>) {
+fn kinked_grid() -> Grid {
     let w = N + 1;
     let mut p = Vec::new();
     let mut uv = Vec::new();
@@ -206,7 +209,7 @@ fn error_limit_is_geometric() {
 /// vertices on the seam are copies, and its `u` is shifted by 5. Returns the mesh, UVs and each
 /// vertex's chart.
 #[cfg(feature = "seams")]
-fn kinked_grid_with_seam() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>, Vec<u8>) {
+fn kinked_grid_with_seam() -> (Grid, Vec<u8>) {
     const SEAM: usize = 4;
     let (mut p, mut t, mut uv) = kinked_grid();
     let w = N + 1;
@@ -234,7 +237,7 @@ fn kinked_grid_with_seam() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>, Vec<
             v[0] += 5.0;
         }
     }
-    (p, t, uv, chart)
+    ((p, t, uv), chart)
 }
 
 /// Welded seams: each triangle's gradient comes from its own wedges, so the seam's jump in `u`
@@ -242,7 +245,7 @@ fn kinked_grid_with_seam() -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[f32; 2]>, Vec<
 #[cfg(feature = "seams")]
 #[test]
 fn uv_kink_is_kept_with_welded_seams() {
-    let (p, t0, uv, chart) = kinked_grid_with_seam();
+    let ((p, t0, uv), chart) = kinked_grid_with_seam();
     let run = |weights: [f32; 2]| {
         let mut t = t0.clone();
         let mut wedges = vec![[0u32; 3]; t.len()];
@@ -298,7 +301,7 @@ fn uv_kink_is_kept_with_welded_seams() {
 #[cfg(feature = "seams")]
 #[test]
 fn welded_gradients_are_the_charts_own() {
-    let (p, mut t, uv, _) = kinked_grid_with_seam();
+    let ((p, mut t, uv), _) = kinked_grid_with_seam();
     let mut wedges = vec![[0u32; 3]; t.len()];
     let mut order = vec![0u32; p.len()];
     tinydecimate::seam::weld(&p, &mut t, &mut wedges, &mut order).expect("weld");

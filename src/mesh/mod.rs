@@ -149,11 +149,9 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// with welded seams (what a corner's attributes are read by), else its vertices.
     #[inline]
     pub(crate) fn caller_corners(&self, t: usize, k: usize) -> [usize; 3] {
+        let c = self.tri(t);
         #[cfg(feature = "seams")]
-        let w = self.wedges.get(t).map(|w| w.map(|x| x.to_usize()));
-        #[cfg(not(feature = "seams"))]
-        let w: Option<[usize; 3]> = None;
-        let c = w.unwrap_or_else(|| self.tri(t));
+        let c = self.wedges.get(t).map_or(c, |w| w.map(|x| x.to_usize()));
         [k, next3(k), prev3(k)].map(|i| c.get(i).copied().unwrap_or(NIL))
     }
 
