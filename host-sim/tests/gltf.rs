@@ -608,6 +608,71 @@ fn simplify_command_writes_glb_and_refuses_optimal_placement() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("only as glTF"));
 }
 
+/// `--attribute-weights`: the attribute-aware stored quadric runs on a glTF and prints
+/// meshoptimizer's `simplifyWithAttributes` beside it; refused without `--quadric stored`, with
+/// a name other than uv and normal, and on a mesh without attributes.
+#[test]
+fn simplify_command_takes_attribute_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let (json, bin) = document();
+    let input = dir.path().join("in.glb");
+    std::fs::write(&input, glb(&json, &bin)).unwrap();
+    let run = |input: &std::path::Path, output: &str, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_host-sim"))
+            .arg("simplify")
+            .arg(input)
+            .arg(dir.path().join(output))
+            .args(["--ratio", "0.25"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(
+        &input,
+        "out.glb",
+        &[
+            "--quadric",
+            "stored",
+            "--attribute-weights",
+            "uv=10,normal=1",
+        ],
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("simplifyWithAttributes"), "{text}");
+    assert!(
+        text.contains("valid") && !text.contains("NOT valid"),
+        "{text}"
+    );
+    let o = run(&input, "out.glb", &["--attribute-weights", "uv=10"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs --quadric stored"));
+    let o = run(
+        &input,
+        "out.glb",
+        &["--quadric", "stored", "--attribute-weights", "colour=1"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("uv and normal"));
+    let plain = dir.path().join("plain.obj");
+    std::fs::write(
+        &plain,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n",
+    )
+    .unwrap();
+    let o = run(
+        &plain,
+        "out.obj",
+        &["--quadric", "stored", "--attribute-weights", "uv=1"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs vertex attributes"));
+}
+
 #[test]
 fn obj_keeps_texture_coordinates_normals_and_materials() {
     // The seam grid as OBJ: positions shared across the seam, texture coordinates split.
