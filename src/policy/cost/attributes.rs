@@ -383,6 +383,14 @@ mod tests {
         assert!((e - a.error(x, &[0.5]) - b.error(x, &[0.5])).abs() < 1e-5);
     }
 
+    /// The bytes per vertex the rustdoc states.
+    #[test]
+    fn state_sizes() {
+        assert_eq!(core::mem::size_of::<AttributeState<2>>(), 76);
+        assert_eq!(core::mem::size_of::<AttributeState<3>>(), 92);
+        assert_eq!(core::mem::size_of::<AttributeState<5>>(), 124);
+    }
+
     /// A triangle without area adds nothing.
     #[test]
     fn degenerate_triangle_is_skipped() {
