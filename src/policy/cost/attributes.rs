@@ -128,7 +128,8 @@ impl<const N: usize> AttributeState<N> {
 ///
 /// **Attributes.** One `[f32; N]` per position (the slice must be at least as long as the
 /// positions), read only: texture coordinates (`N = 2`), a normal (`N = 3`), both (`N = 5`),
-/// colours. Attribute `k` is multiplied by `weights[k]` (zero switches it off); as in
+/// colours; a non-finite value makes the collapses its triangles price non-finite, so they
+/// are never made. Attribute `k` is multiplied by `weights[k]` (zero switches it off); as in
 /// meshoptimizer, a weighted change of 1 across a triangle of size `d` is priced about like
 /// moving it by `d`: each triangle's squared deviation is weighted by its squared doubled area
 /// (length⁴, as the plane terms' `area · distance²`), in the engine's normalised units. The
@@ -144,7 +145,7 @@ impl<const N: usize> AttributeState<N> {
 /// [`Error::InvalidConfig`] for [`ConfigField::Placement`].
 ///
 /// **Seams.** One attribute state per engine vertex. Where vertices at one position are
-/// welded ([`seam::weld`](crate::seam::weld)), the engine vertex is the position's
+/// welded (`seam::weld`, crate feature `seams`), the engine vertex is the position's
 /// representative: each triangle's gradient is taken from its own wedges
 /// ([`Cost::triangle`]), but only the triangles whose wedge at the position carries the
 /// representative's attributes enter its state (the far side of a UV seam is not measured),

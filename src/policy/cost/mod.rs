@@ -118,7 +118,7 @@ pub trait Cost {
     /// Hands a storing cost one triangle of `v`'s fan when the planes are initialised (only
     /// if [`Cost::stores`]), beside [`Cost::plane`]: its three corners as the caller's vertices
     /// in winding order from `v`'s corner (`corners[0]` is `v` itself, or with welded seams
-    /// ([`crate::seam`]) the wedge the triangle has at `v`'s position), and `e1`, `e2` the
+    /// (`seam`, crate feature `seams`) the wedge the triangle has at `v`'s position), and `e1`, `e2` the
     /// other two corners' positions relative to `v` (normalised units). A plane does not say
     /// which vertices span it: a cost that reads per-vertex data besides positions (attribute
     /// gradients, [`AttributeQuadric`]) needs the corners. Nothing by default.
