@@ -89,6 +89,15 @@ pub struct Run {
     pub prune: bool,
 }
 
+/// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
+/// otherwise welding renumbers nothing, and its sort is skipped.
+fn shares_positions(positions: &[[f32; 3]]) -> bool {
+    let mut seen = std::collections::HashSet::with_capacity(positions.len());
+    positions
+        .iter()
+        .any(|p| !seen.insert(p.map(|x| if x == 0.0 { 0 } else { x.to_bits() })))
+}
+
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
 /// prunes in (the greedy schedule, no error bound).
 pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
@@ -140,7 +149,7 @@ pub fn simplify_with(
     // bound's control points are taken from.
     let mut wedges: Vec<[u32; 3]> = Vec::new();
     let mut welded = Vec::new();
-    if weld {
+    if weld && shares_positions(&positions) {
         let mut w = vec![[0u32; 3]; tris.len()];
         let mut order = vec![0u32; positions.len()];
         if tinydecimate::seam::weld(&positions, &mut tris, &mut w, &mut order)
