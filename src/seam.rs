@@ -15,9 +15,13 @@
 //! side of `a`'s fan (the wedge that the removed triangle's `a` shared an attribute region
 //! with, where there is one). When the run finishes, the output triangles name wedges again.
 //!
-//! This is meshoptimizer's `remap`/`wedge` idea (`simplifier.cpp`), where a vertex with more
-//! than two wedges is locked; here any number of wedges moves together, since the engine sees
-//! only positions.
+//! This is meshoptimizer's `remap`/`wedge` idea (`simplifier.cpp`). Where more than two
+//! wedges meet (a corner where seams meet, or a vertex shaded flat, one wedge per face) no
+//! single wedge of the kept vertex belongs to every region, so a corner of a third region would
+//! take a wedge from another texture chart: [`SeamCorners::Lock`] keeps such a vertex where it
+//! is (it still accepts collapses onto it), as meshoptimizer locks its complex vertices;
+//! [`SeamCorners::Move`] moves all its wedges with the removed triangles' neighbours, for
+//! wedges that carry nothing a seam corner could tear (positions only).
 //!
 //! Memory: the wedge buffer holds one triangle per triangle (`3·size_of::<I>()` bytes per
 //! triangle: 6 B with `u16` indices), and [`weld`] sorts in one caller slice of one index per
@@ -28,6 +32,21 @@
 
 use crate::index::Index;
 use crate::Error;
+
+/// What a welded vertex where more than two wedges meet may do
+/// ([`Simplifier::with_wedges`](crate::Simplifier::with_wedges)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum SeamCorners {
+    /// It never moves (other vertices may still collapse onto it): each region around it keeps
+    /// its own wedge, so no triangle takes corners from two texture charts. meshoptimizer's
+    /// rule for its complex vertices, and the one for real attributes.
+    Lock,
+    /// It moves like any other vertex, each corner taking a wedge of the kept vertex from the
+    /// removed triangle on its side: for wedges that carry nothing to tear (a split index
+    /// buffer whose attributes are not kept), where locking would freeze a mesh shaded flat.
+    Move,
+}
 
 /// The bits a position is compared by: `-0.0` is `0.0` (equal positions are one position).
 #[inline]

@@ -113,7 +113,7 @@ fn welded_backs_keep_their_own_vertices() {
             EdgeCollapse,
         )
         .expect("start")
-        .with_wedges(&mut wedges)
+        .with_wedges(&mut wedges, tinydecimate::seam::SeamCorners::Lock)
         .expect("wedges")
         .run();
     assert_eq!(r.twins, one.triangles.len());

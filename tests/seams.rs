@@ -7,18 +7,22 @@
 //!   seam's positions stay on the seam, and no output triangle takes corners from both charts
 //!   (the `seam` rule of `legality::RULES`).
 //! * `flat_shaded_faces_simplify_whole`: a box whose every face has its own vertices (a
-//!   flat-shaded export) reaches its target as one closed surface.
+//!   flat-shaded export) reaches its target as one closed surface when its seam corners move.
+//! * `locked_seam_corners_keep_every_chart_whole`: a grid in four charts meeting at one
+//!   position: with the corners locked no output triangle takes corners from two charts, and
+//!   with them moving some do (so the lock is what keeps them).
 #![cfg(feature = "seams")]
 
 mod common;
 use std::collections::BTreeSet;
 
 use common::*;
+use tinydecimate::seam::SeamCorners;
 use tinydecimate::{seam, Builtin, Config, EdgeCollapse, NoBound, Positions, Report, Stop};
 
-/// Welds, simplifies (default configuration at `ratio`) and returns the output in the input's
-/// numbering.
-fn simplify_welded(m: &MeshData, ratio: f32) -> (MeshData, Report) {
+/// Welds, simplifies (default configuration at `ratio`, seam corners as `corners` say) and
+/// returns the output in the input's numbering.
+fn simplify_welded(m: &MeshData, ratio: f32, corners: SeamCorners) -> (MeshData, Report) {
     let mut tris = m.triangles.clone();
     let mut wedges = vec![[0u32; 3]; tris.len()];
     let mut order = vec![0u32; m.positions.len()];
@@ -36,10 +40,24 @@ fn simplify_welded(m: &MeshData, ratio: f32) -> (MeshData, Report) {
             EdgeCollapse,
         )
         .expect("start")
-        .with_wedges(&mut wedges)
+        .with_wedges(&mut wedges, corners)
         .expect("wedges")
         .run();
     output(&m.positions, tris, report)
+}
+
+/// [`simplify_welded`] with seam corners locked, checked: the target reached, the output a
+/// valid simplification with no crack, and every wedge of a kept seam position still used.
+fn simplify_locked(m: &MeshData, ratio: f32, what: &str) -> MeshData {
+    let (out, report) = simplify_welded(m, ratio, SeamCorners::Lock);
+    assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
+    let v = welded_verdict(m, &out);
+    v.assert_valid(what);
+    assert_eq!(
+        v.lost_wedges, 0,
+        "{what}: wedges of kept seam positions lost"
+    );
+    out
 }
 
 fn welded_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
@@ -105,14 +123,7 @@ fn seams_keep_their_shape_and_sides() {
     }
     for ratio in [0.5, 0.25, 0.1] {
         let what = format!("two charts at {ratio}");
-        let (out, report) = simplify_welded(&m, ratio);
-        assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
-        let v = welded_verdict(&m, &out);
-        v.assert_valid(&what);
-        assert_eq!(
-            v.lost_wedges, 0,
-            "{what}: wedges of kept seam positions lost"
-        );
+        let out = simplify_locked(&m, ratio, &what);
         for t in &out.triangles {
             let sides: BTreeSet<u8> = t.iter().map(|&x| chart[x as usize]).collect();
             assert_eq!(sides.len(), 1, "{what}: triangle {t:?} takes both charts");
@@ -165,11 +176,82 @@ fn flat_shaded_faces_simplify_whole() {
     let m = flat_box(6);
     for ratio in [0.5, 0.1] {
         let what = format!("flat-shaded box at {ratio}");
-        let (out, report) = simplify_welded(&m, ratio);
+        let (out, report) = simplify_welded(&m, ratio, SeamCorners::Move);
         assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
         let v = welded_verdict(&m, &out);
         v.assert_valid(&what);
         assert_eq!(v.components, (1, 1), "{what}");
         assert_eq!(v.boundary_loops, (0, 0), "{what}: a crack");
     }
+}
+
+/// A wavy `n` x `n` grid (`n` even) in four texture charts, its quarters: every position on a
+/// chart border has one vertex per chart around it, and the middle of the grid has four.
+/// Returns the mesh and each vertex's chart.
+fn four_charts(n: u32) -> (MeshData, Vec<u8>) {
+    let g = grid(n, n, 0.25);
+    let mut m = MeshData::default();
+    let mut chart = Vec::new();
+    let mut copy = std::collections::HashMap::new();
+    for t in &g.triangles {
+        let c = t.map(|v| g.positions[v as usize]);
+        let (x, y) = (
+            (c[0][0] + c[1][0] + c[2][0]) / 3.0,
+            (c[0][1] + c[1][1] + c[2][1]) / 3.0,
+        );
+        let mid = |k: usize| {
+            let (lo, hi) = g
+                .positions
+                .iter()
+                .fold((f32::MAX, f32::MIN), |(lo, hi), p| {
+                    (lo.min(p[k]), hi.max(p[k]))
+                });
+            (lo + hi) / 2.0
+        };
+        let ch = u8::from(x >= mid(0)) + 2 * u8::from(y >= mid(1));
+        m.triangles.push(t.map(|v| {
+            *copy.entry((ch, v)).or_insert_with(|| {
+                m.positions.push(g.positions[v as usize]);
+                chart.push(ch);
+                m.positions.len() as u32 - 1
+            })
+        }));
+    }
+    (m, chart)
+}
+
+#[test]
+fn locked_seam_corners_keep_every_chart_whole() {
+    let (m, chart) = four_charts(16);
+    let torn = |out: &MeshData| {
+        out.triangles
+            .iter()
+            .filter(|t| {
+                t.iter()
+                    .map(|&x| chart[x as usize])
+                    .collect::<BTreeSet<u8>>()
+                    .len()
+                    > 1
+            })
+            .count()
+    };
+    for ratio in [0.25, 0.1, 0.05] {
+        let what = format!("four charts at {ratio}");
+        let out = simplify_locked(&m, ratio, &what);
+        assert_eq!(
+            torn(&out),
+            0,
+            "{what}: triangles take corners from two charts"
+        );
+    }
+    let mut torn_moving = Vec::new();
+    for ratio in [0.25, 0.1, 0.05] {
+        let (out, _) = simplify_welded(&m, ratio, SeamCorners::Move);
+        welded_verdict(&m, &out).assert_valid("four charts, corners moving");
+        torn_moving.push(torn(&out));
+    }
+    assert!(
+        torn_moving.iter().any(|&n| n > 0),
+        "moving seam corners tore no chart: the test cannot fail"
+    );
 }

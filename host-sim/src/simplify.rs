@@ -82,9 +82,22 @@ pub struct Run {
     /// Weld seams first (`tinydecimate::seam::weld`: the vertices at one position collapse
     /// together, each keeping its own wedge), when the mesh has any.
     pub weld: bool,
+    /// With welded seams, lock the vertices where more than two wedges meet
+    /// (`SeamCorners::Lock`, for carried attributes) instead of moving all their wedges
+    /// (`SeamCorners::Move`, the default: positions only, nothing to tear).
+    pub lock_seam_corners: bool,
     /// Let parts cheaper than the next collapse vanish whole (`Simplifier::with_parts`, two
     /// `u32` links per vertex) in the runs where the library prunes ([`prunes`]).
     pub prune: bool,
+}
+
+/// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
+/// otherwise welding renumbers nothing, and its sort is skipped.
+fn shares_positions(positions: &[[f32; 3]]) -> bool {
+    let mut seen = std::collections::HashSet::with_capacity(positions.len());
+    positions
+        .iter()
+        .any(|p| !seen.insert(p.map(|x| if x == 0.0 { 0 } else { x.to_bits() })))
 }
 
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
@@ -132,6 +145,7 @@ pub fn simplify_with_attributes(
         bounded,
         progress,
         weld,
+        lock_seam_corners,
         prune,
     } = *run;
     let prune = prunes(prune, config, bounded);
@@ -164,7 +178,7 @@ pub fn simplify_with_attributes(
     // bound's control points are taken from.
     let mut wedges: Vec<[u32; 3]> = Vec::new();
     let mut welded = Vec::new();
-    if weld {
+    if weld && shares_positions(&positions) {
         let mut w = vec![[0u32; 3]; tris.len()];
         let mut order = vec![0u32; positions.len()];
         if tinydecimate::seam::weld(&positions, &mut tris, &mut w, &mut order)
@@ -185,7 +199,12 @@ pub fn simplify_with_attributes(
             let s = if wedges.is_empty() {
                 s
             } else {
-                s.with_wedges(&mut wedges).map_err(library_error)?
+                let corners = if lock_seam_corners {
+                    tinydecimate::seam::SeamCorners::Lock
+                } else {
+                    tinydecimate::seam::SeamCorners::Move
+                };
+                s.with_wedges(&mut wedges, corners).map_err(library_error)?
             };
             let mut s = if prune {
                 s.with_parts(&mut part_links).map_err(library_error)?

@@ -19,6 +19,9 @@
 //! Manocha, "Appearance-preserving simplification", SIGGRAPH 1998, which the survey of
 //! simplification methods cites). Stretch can fall when simplification removes small, badly
 //! mapped triangles; deviation cannot hide a texture that moved.
+//!
+//! A third, [`torn_triangles`], counts the defect a user sees at once: result triangles whose
+//! corners come from two texture charts, which show a piece of another chart's texture.
 
 type V3 = [f64; 3];
 
@@ -75,6 +78,57 @@ pub fn l2_stretch(positions: &[[f32; 3]], uvs: &[[f32; 2]], triangles: &[[u32; 3
         area += area3(q);
     }
     (uv_area > 0.0 && area > 0.0).then(|| (sum / uv_area).sqrt() * (uv_area / area).sqrt())
+}
+
+/// How many of `result`'s triangles take corners from two or more texture charts of
+/// `original`. A chart is a connected piece of the original surface with continuous texture
+/// coordinates: its triangles joined across edges whose two ends have one position and one
+/// texture coordinate on both sides (vertices split only by a normal do not separate charts).
+/// Corners past `positions` or `uvs` are their own chart.
+pub fn torn_triangles(
+    positions: &[[f32; 3]],
+    uvs: &[[f32; 2]],
+    original: &[[u32; 3]],
+    result: &[[u32; 3]],
+) -> usize {
+    let key = |v: u32| {
+        let p = positions.get(v as usize).map(|p| p.map(f32::to_bits));
+        let t = uvs.get(v as usize).map(|t| t.map(f32::to_bits));
+        (p, t, if p.is_none() || t.is_none() { v } else { 0 })
+    };
+    // Union-find over (position, texture coordinate) keys, joined along triangle edges.
+    let mut id = std::collections::HashMap::new();
+    let mut parent: Vec<usize> = Vec::new();
+    let mut node = |v: u32, parent: &mut Vec<usize>| {
+        *id.entry(key(v)).or_insert_with(|| {
+            parent.push(parent.len());
+            parent.len() - 1
+        })
+    };
+    fn root(parent: &mut [usize], mut x: usize) -> usize {
+        while parent[x] != x {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+        }
+        x
+    }
+    for t in original {
+        let n = t.map(|v| node(v, &mut parent));
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, n[0]), root(&mut parent, n[k]));
+            parent[a] = b;
+        }
+    }
+    result
+        .iter()
+        .filter(|t| {
+            let c = t.map(|v| {
+                let n = node(v, &mut parent);
+                root(&mut parent, n)
+            });
+            c[0] != c[1] || c[1] != c[2]
+        })
+        .count()
 }
 
 /// Texture deviation of `result` against `original` (both over `positions` and `uvs`, one per
@@ -272,5 +326,42 @@ mod tests {
         let (_, _, lost) = texture_deviation(&p, &uv, &full, &half).unwrap();
         assert!(lost > 4 && lost < 28, "{lost}");
         assert_eq!(texture_deviation(&p, &uv, &full, &[[0, 1, 99]]), None);
+    }
+
+    #[test]
+    fn torn_triangles_count_corners_from_two_charts() {
+        // A strip of two squares; the second square's texture is another chart (its left
+        // edge's vertices 4, 5 repeat 1, 2 with other coordinates). Vertices 6, 7 repeat 4, 5
+        // with another normal only: the same chart.
+        let p = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
+        let uv = vec![
+            [0.0, 0.0],
+            [0.5, 0.0],
+            [0.5, 1.0],
+            [0.0, 1.0],
+            [0.6, 0.0],
+            [0.6, 1.0],
+            [0.6, 0.0],
+            [0.6, 1.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+        ];
+        let original = [[0, 1, 2], [0, 2, 3], [4, 8, 9], [6, 9, 7]];
+        assert_eq!(torn_triangles(&p, &uv, &original, &original), 0);
+        // The first square's corner 0 with the second chart's 8, 9: torn; 4 with 6's chart-mate
+        // 9 is not.
+        let result = [[0, 8, 9], [4, 8, 9], [0, 2, 3], [6, 8, 5]];
+        assert_eq!(torn_triangles(&p, &uv, &original, &result), 1);
     }
 }

@@ -940,3 +940,105 @@ fn ply_keeps_extra_vertex_properties() {
     let faces = &b.payload["face"];
     assert!(faces.len() < 2 * n * n / 2);
 }
+
+/// A wavy `n`x`n` grid shaded flat: every triangle has its own three vertices with its face
+/// normal, and one continuous texture (u, v = x, y), as an exporter writes a flat-shaded model.
+fn flat_shaded_grid(n: usize) -> Vec<u8> {
+    let (mut pos, mut nrm, mut uv) = (Vec::new(), Vec::new(), Vec::new());
+    let p = |x: usize, y: usize| {
+        let (fx, fy) = (x as f32 / n as f32, y as f32 / n as f32);
+        [fx, fy, 0.1 * (fx * 6.0).sin() * (fy * 4.0).cos()]
+    };
+    for y in 0..n {
+        for x in 0..n {
+            for t in [
+                [p(x, y), p(x + 1, y), p(x + 1, y + 1)],
+                [p(x, y), p(x + 1, y + 1), p(x, y + 1)],
+            ] {
+                let (u, v) = (
+                    [t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]],
+                    [t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]],
+                );
+                let c = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+                for q in t {
+                    pos.extend_from_slice(&q);
+                    nrm.extend(c.map(|x| x / l));
+                    uv.extend_from_slice(&[q[0], q[1]]);
+                }
+            }
+        }
+    }
+    let mut b = Builder::default();
+    let pa = b.floats(&pos, "VEC3", 3);
+    let na = b.floats(&nrm, "VEC3", 3);
+    let ta = b.floats(&uv, "VEC2", 2);
+    let json = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": pa, "NORMAL": na, "TEXCOORD_0": ta}}]}],
+        "accessors": b.accessors,
+        "bufferViews": b.views,
+        "buffers": [{"byteLength": b.bin.len()}],
+    });
+    glb(&json, &b.bin)
+}
+
+/// Flat shading splits every vertex into one wedge per triangle: with `--hard-edges weld` (the
+/// default) the simplifier sees one continuous texture and reaches the target; with `keep`
+/// every interior vertex is a seam corner of six wedges and stays. Either way every vertex
+/// written is an input vertex, bit for bit, and the output is valid with no crack.
+#[test]
+fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("flat.glb");
+    std::fs::write(&input, flat_shaded_grid(12)).unwrap();
+    let inputs: HashSet<Vertex> = read_with_gltf_crate(&std::fs::read(&input).unwrap())[0]
+        .0
+        .iter()
+        .copied()
+        .collect();
+    let run = |hard_edges: &str| {
+        let output = dir.path().join(format!("out-{hard_edges}.glb"));
+        let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+            .arg("simplify")
+            .arg(&input)
+            .arg(&output)
+            .args(["--ratio", "0.25", "--hard-edges", hard_edges])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(
+            o.status.success(),
+            "{text}{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!text.contains("NOT valid"), "{text}");
+        let read = read_with_gltf_crate(&std::fs::read(&output).unwrap());
+        let (verts, idx) = &read[0];
+        for v in verts {
+            assert!(
+                inputs.contains(v),
+                "{hard_edges}: vertex {v:?} is no input vertex"
+            );
+        }
+        assert!(text.contains("0 triangles torn between charts"), "{text}");
+        idx.len() / 3
+    };
+    let welded = run("weld");
+    assert!(
+        welded <= 72,
+        "hard edges welded: {welded} of 288 triangles for 72"
+    );
+    let kept = run("keep");
+    assert!(
+        kept > 200,
+        "hard edges kept: {kept} of 288 triangles (the seam corners stay)"
+    );
+}

@@ -13,15 +13,21 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// triangles given to the run to one vertex per position). Call it before the first step.
     /// Collapses keep it up to date, and [`Simplifier::finish`] writes the result's triangles
     /// as wedges; until then [`Simplifier::triangles`] and [`Simplifier::buffer`] show the
-    /// welded numbering. [`Error::Capacity`](crate::Error::Capacity) (triangles) if it is
-    /// shorter than the triangle buffer.
+    /// welded numbering. `corners` says what a vertex where more than two wedges meet may do.
+    /// [`Error::Capacity`](crate::Error::Capacity) (triangles) if `wedges` is shorter than the
+    /// triangle buffer.
     #[cfg(feature = "seams")]
-    pub fn with_wedges(mut self, wedges: &'a mut [[I; 3]]) -> Result<Self, crate::Error> {
+    pub fn with_wedges(
+        mut self,
+        wedges: &'a mut [[I; 3]],
+        corners: crate::seam::SeamCorners,
+    ) -> Result<Self, crate::Error> {
         let n = self.mesh.triangle_count();
         let available = wedges.len();
         match wedges.get_mut(..n) {
             Some(w) => {
                 self.mesh.wedges = w;
+                self.mesh.lock_corners = corners == crate::seam::SeamCorners::Lock;
                 Ok(self)
             }
             None => Err(crate::Error::Capacity {

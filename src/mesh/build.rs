@@ -71,6 +71,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             valid_in: 0,
             #[cfg(feature = "seams")]
             wedges: &mut [],
+            #[cfg(feature = "seams")]
+            lock_corners: false,
         };
         // 2. Drop triangles with a repeated index.
         mesh.drop_degenerate();

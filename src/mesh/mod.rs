@@ -132,6 +132,10 @@ pub(crate) struct Mesh<'a, L: Index, I: Index> {
     /// empty otherwise.
     #[cfg(feature = "seams")]
     pub(crate) wedges: &'a mut [[I; 3]],
+    /// With welded seams: a vertex where more than two wedges meet never moves
+    /// ([`crate::seam::SeamCorners::Lock`]).
+    #[cfg(feature = "seams")]
+    pub(crate) lock_corners: bool,
 }
 
 impl<'a, L: Index, I: Index> Mesh<'a, L, I> {

@@ -27,7 +27,8 @@
 //!   collapse ([`Config::max_normal_turn_deg`]), and with welded seams ([`crate::seam`], crate
 //!   feature `seams`) keep a seam where it is, so that no triangle takes attributes from both
 //!   of its sides (meshoptimizer's vertex kinds: a seam vertex moves along its seam; a vertex
-//!   where more than two wedges meet moves all of them, like its complex kind).
+//!   where more than two wedges meet stays, like its complex kind, or with
+//!   [`SeamCorners::Move`](crate::seam::SeamCorners::Move) moves all of them).
 //! - **guarantee** (`bound`): the error bound of Zhu, Wang and Meng 2007, a promise the caller
 //!   asks for ([`Config::max_error`]); checked after the others, in `collapse`, and only on the
 //!   bounded entry points (see [`crate::bound`]).
@@ -752,9 +753,9 @@ pub(crate) fn check<L: Index, I: Index>(
 /// `a`, or one that ends on `a`'s boundary): only along the seam, onto the vertex of a spoke
 /// where the wedge changes (at a boundary that is never, since the boundary rule allows only
 /// boundary edges: meshoptimizer locks a seam's end too). More (a corner where seams meet, or
-/// a flat-shaded vertex, whose every face has its own wedge): the wedges go with the removed
-/// triangles' neighbours (`Mesh::move_wedges`), as meshoptimizer's complex vertices move all
-/// their wedges at once.
+/// a flat-shaded vertex, whose every face has its own wedge): never with
+/// [`SeamCorners::Lock`](crate::seam::SeamCorners::Lock) (meshoptimizer's complex vertices);
+/// with `Move` the wedges go with the removed triangles' neighbours (`Mesh::move_wedges`).
 #[cfg(feature = "seams")]
 #[inline(never)]
 fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
@@ -791,6 +792,9 @@ fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> 
     }
     // A boundary fan's wedges are one more than its changes, a disc's as many.
     let wedges = changes + usize::from(mesh.has(a, flag::BOUNDARY));
+    if wedges > 2 {
+        return !mesh.lock_corners;
+    }
     wedges != 2 || onto_b
 }
 

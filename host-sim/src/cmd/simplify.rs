@@ -21,6 +21,7 @@ use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BY
 
 mod advice;
 mod attributes;
+mod shading;
 mod textured;
 
 /// Which schedule, on the command line.
@@ -272,6 +273,15 @@ pub enum SeamsArg {
     Split,
 }
 
+/// How vertices split only by their normal or tangent are treated (`--hard-edges`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+pub enum HardEdgesArg {
+    /// One vertex per position and texture coordinates (and other non-shading attributes).
+    Weld,
+    /// Each vertex as the file has it (a hard edge is a seam).
+    Keep,
+}
+
 /// Whether small parts may vanish (`--parts`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 pub enum PartsArg {
@@ -309,6 +319,15 @@ pub struct Args {
     /// every seam is an open boundary that only shrinks along itself.
     #[arg(long, value_enum, default_value_t = SeamsArg::Weld)]
     pub seams: SeamsArg,
+    /// On inputs whose attributes are carried (glTF, OBJ with `vt`/`vn`): vertices that
+    /// differ only in their normal or tangent (hard edges, flat shading). `weld` (the default)
+    /// gives the simplifier one vertex per position and texture coordinates (and colours,
+    /// joints, weights), so the seams it keeps are the texture's; each output corner then
+    /// takes, among the input vertices of its position and texture coordinates, its own if the
+    /// triangle is unchanged, else the one whose normal is closest to its triangle's. `keep`
+    /// gives it the vertices as the file has them.
+    #[arg(long, value_enum, default_value_t = HardEdgesArg::Weld)]
+    pub hard_edges: HardEdgesArg,
     /// Parts (connected components): `prune` removes a part whole once it costs less than the
     /// collapse about to be made, and short of the target with no collapse left the smallest
     /// parts, never the last (the default; greedy schedule without --max-error only, else
@@ -561,6 +580,8 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         bounded,
         progress: true,
         weld: args.seams == SeamsArg::Weld,
+        // No attribute is carried here, so a seam corner has nothing to tear.
+        lock_seam_corners: false,
         prune: args.parts == PartsArg::Prune,
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;

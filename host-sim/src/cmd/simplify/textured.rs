@@ -13,10 +13,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
 use tinydecimate::{Config, Report, Target};
 
+use super::shading::{self, Shading};
 use super::{Args, PlacementArg, QuadricArg};
 use crate::io::MeshData;
 
@@ -28,7 +30,7 @@ fn run_library(
     config: &Config,
     args: &Args,
     attributes: Option<&crate::simplify::Attributes>,
-) -> Result<(Vec<[u32; 3]>, Report)> {
+) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
     let run = crate::simplify::Run {
@@ -36,11 +38,13 @@ fn run_library(
         placement,
         bounded: args.max_error.is_some(),
         weld: args.seams == super::SeamsArg::Weld,
+        // The attributes are carried: a corner where more than two of them meet stays.
+        lock_seam_corners: true,
         ..Default::default()
     };
-    let (out, report, _) =
+    let (out, report, elapsed) =
         crate::simplify::simplify_with_attributes(mesh, config, &run, attributes)?;
-    Ok((out.triangles, report))
+    Ok((out.triangles, report, elapsed))
 }
 
 /// Runs `simplify` here when the input or output is glTF, or the input is an OBJ with texture
@@ -80,10 +84,11 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && args.format.is_none_or(|f| f == crate::io::Format::Obj)
         && !args.keep_numbering
     {
+        let t0 = Instant::now();
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
         if crate::io::objattr::has_attributes(&bytes) {
             refuse_optimal(args)?;
-            return run_obj(args, &bytes).map(Some);
+            return run_obj(args, &bytes, t0).map(Some);
         }
     }
     let is_ply = |p: &Path| {
@@ -97,25 +102,32 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         && args.format.is_none_or(|f| f == crate::io::Format::Ply)
         && !args.keep_numbering
     {
+        let t0 = Instant::now();
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
         let extra = crate::io::plyattr::extra_properties(&bytes);
         if !extra.is_empty() {
             refuse_optimal(args)?;
-            return run_ply(args, &bytes, &extra).map(Some);
+            return run_ply(args, &bytes, &extra, t0).map(Some);
         }
     }
     Ok(None)
 }
 
-fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
+fn run_ply(args: &Args, bytes: &[u8], extra: &[String], t0: Instant) -> Result<ExitCode> {
     let file =
         crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
-    let parts = vec![("vertex element".to_string(), file.mesh.clone(), None)];
+    let parts = vec![("vertex element".to_string(), file.mesh.clone(), None, None)];
+    let mut times = Times {
+        read: t0.elapsed(),
+        ..Times::default()
+    };
     let done = simplify_parts(args, &parts, &[])?;
+    let t0 = Instant::now();
     let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
     std::fs::write(&args.output, out)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
+    times.write = t0.elapsed();
     let head = format!(
         "simplify {} -> {} (PLY, vertex properties {} kept per vertex): {} -> {} triangles\n",
         args.input.display(),
@@ -124,7 +136,7 @@ fn run_ply(args: &Args, bytes: &[u8], extra: &[String]) -> Result<ExitCode> {
         file.mesh.triangles.len(),
         done[0].triangles.len()
     );
-    finish(args, head, &done)
+    finish(args, head, &done, times)
 }
 
 fn refuse_optimal(args: &Args) -> Result<()> {
@@ -140,6 +152,9 @@ fn refuse_optimal(args: &Args) -> Result<()> {
 
 /// One part's outcome.
 struct Part {
+    /// Time in the library, and in welding hard edges and mapping the result back.
+    library: Duration,
+    welding: Duration,
     triangles: Vec<[u32; 3]>,
     /// The part's target, and whether it stopped short of it.
     target: usize,
@@ -149,9 +164,10 @@ struct Part {
     json: serde_json::Value,
 }
 
-/// One part to simplify: its label, its mesh and, when it has them, the texture coordinates
-/// its material reads (one per vertex), for the UV stretch figure.
-type Input = (String, MeshData, Option<Vec<[f32; 2]>>);
+/// One part to simplify: its label, its mesh, when it has them the texture coordinates its
+/// material reads (one per vertex, for the UV stretch figure), and its vertices grouped by
+/// position and non-shading attributes (for `--hard-edges weld`).
+type Input = (String, MeshData, Option<Vec<[f32; 2]>>, Option<Shading>);
 
 /// Simplifies each mesh of `parts` with `args`' configuration; `normals` (per part, may be
 /// shorter) are only read by `--attribute-weights`.
@@ -160,9 +176,9 @@ fn simplify_parts(
     parts: &[Input],
     normals: &[Option<Vec<[f32; 3]>>],
 ) -> Result<Vec<Part>> {
-    let total: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
+    let total: usize = parts.iter().map(|(_, m, _, _)| m.triangles.len()).sum();
     let mut out = Vec::new();
-    for (k, (label, mesh, uvs)) in parts.iter().enumerate() {
+    for (k, (label, mesh, uvs, shading)) in parts.iter().enumerate() {
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
@@ -175,6 +191,15 @@ fn simplify_parts(
         config
             .validate()
             .map_err(|e| anyhow!("configuration: {e}"))?;
+        // Hard edges welded: the library and meshoptimizer's anchor see the keyed mesh.
+        let shading = shading
+            .as_ref()
+            .filter(|s| args.hard_edges == super::HardEdgesArg::Weld && s.welds());
+        let t0 = Instant::now();
+        let keyed = shading.map(|s| s.keyed(mesh));
+        let mut welding = t0.elapsed();
+        let lib_mesh = keyed.as_ref().unwrap_or(mesh);
+        // The keyed mesh keeps the positions' numbering: the attributes are the input's.
         let attributes = super::attributes::for_part(
             args,
             label,
@@ -182,8 +207,14 @@ fn simplify_parts(
             uvs.as_deref(),
             normals.get(k).and_then(Option::as_deref),
         )?;
-        let (tris, report) = run_library(mesh, &config, args, attributes.as_ref())
+        let (tris, report, library) = run_library(lib_mesh, &config, args, attributes.as_ref())
             .map_err(|e| anyhow!("{label}: {e}"))?;
+        let t0 = Instant::now();
+        let tris = match shading {
+            Some(s) => s.restore(mesh, &tris),
+            None => tris,
+        };
+        welding += t0.elapsed();
         let result = MeshData {
             positions: mesh.positions.clone(),
             triangles: tris.clone(),
@@ -243,7 +274,7 @@ fn simplify_parts(
                 let _ = write!(
                     line,
                     "{}{}",
-                    uv_stretch(mesh, uvs, &result, &mut json),
+                    uv_stretch(mesh, keyed.as_ref(), uvs, &result, &mut json),
                     super::attributes::meshopt_reference(
                         mesh,
                         uvs,
@@ -255,6 +286,8 @@ fn simplify_parts(
             }
         }
         out.push(Part {
+            library,
+            welding,
             triangles: tris,
             target: report.target_triangles,
             short: advice.is_some(),
@@ -266,52 +299,129 @@ fn simplify_parts(
     Ok(out)
 }
 
-/// The UV stretch of the input, the result and meshoptimizer's `simplify` at the result's
-/// triangle count (see [`crate::uvstretch`]), as text for the part's line and into `json`.
+/// The texture figures ([`crate::uvstretch`]: UV stretch, texture deviation, triangles torn
+/// between charts) of the input, the result and meshoptimizer's `simplify` at the result's
+/// triangle count: on the input's vertices as the file has them, and, when `keyed` is given
+/// (hard edges welded), on the mesh ours saw too. As text for the part's line and into `json`.
 fn uv_stretch(
     mesh: &MeshData,
+    keyed: Option<&MeshData>,
     uvs: &[[f32; 2]],
     result: &MeshData,
     json: &mut serde_json::Value,
 ) -> String {
     let stretch = |t: &[[u32; 3]]| crate::uvstretch::l2_stretch(&mesh.positions, uvs, t);
-    let (Some(input), Some(ours)) = (stretch(&mesh.triangles), stretch(&result.triangles)) else {
+    let (Some(input), Some(_)) = (stretch(&mesh.triangles), stretch(&result.triangles)) else {
         return String::new();
     };
-    let (anchor, _, _) = crate::bench::meshopt::meshopt_simplify(mesh, result.triangles.len());
-    let theirs = stretch(&anchor.triangles);
     let diag = mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
-    let deviation = |t: &[[u32; 3]]| {
-        crate::uvstretch::texture_deviation(&mesh.positions, uvs, &mesh.triangles, t)
-            .map(|(mean, max, lost)| (100.0 * mean / diag, 100.0 * max / diag, lost))
-    };
-    let (dev_ours, dev_theirs) = (deviation(&result.triangles), deviation(&anchor.triangles));
-    json["uv_stretch"] = serde_json::json!({
-        "input": input,
-        "result": ours,
-        "meshopt": theirs,
-        "meshopt_triangles": anchor.triangles.len(),
-        "texture_deviation_pct": dev_ours.map(|d| [d.0, d.1]),
-        "texture_samples_lost": dev_ours.map(|d| d.2),
-        "meshopt_texture_deviation_pct": dev_theirs.map(|d| [d.0, d.1]),
-        "meshopt_texture_samples_lost": dev_theirs.map(|d| d.2),
-    });
-    let dev = |d: Option<(f64, f64, usize)>| {
-        d.map_or(String::new(), |(mean, max, lost)| {
-            format!(", texture deviation mean {mean:.4} % max {max:.4} %, {lost} samples lost")
+    let figures = |t: &[[u32; 3]]| {
+        let dev = crate::uvstretch::texture_deviation(&mesh.positions, uvs, &mesh.triangles, t)
+            .map(|(mean, max, lost)| (100.0 * mean / diag, 100.0 * max / diag, lost));
+        let torn = crate::uvstretch::torn_triangles(&mesh.positions, uvs, &mesh.triangles, t);
+        serde_json::json!({
+            "triangles": t.len(),
+            "uv_stretch": stretch(t),
+            "texture_deviation_pct": dev.map(|d| [d.0, d.1]),
+            "texture_samples_lost": dev.map(|d| d.2),
+            "torn_triangles": torn,
         })
     };
-    format!(
-        "\n    UV stretch {ours:.4} (input {input:.4}){}\n    meshoptimizer at {} triangles: UV \
-         stretch {}{}",
-        dev(dev_ours),
-        anchor.triangles.len(),
-        theirs.map_or("-".into(), |t| format!("{t:.4}")),
-        dev(dev_theirs)
-    )
+    let text = |j: &serde_json::Value| {
+        let mut s = format!(
+            "UV stretch {}",
+            j["uv_stretch"]
+                .as_f64()
+                .map_or("-".into(), |t| format!("{t:.4}"))
+        );
+        if let (Some(d), Some(lost)) = (
+            j["texture_deviation_pct"].as_array(),
+            j["texture_samples_lost"].as_u64(),
+        ) {
+            let _ = write!(
+                s,
+                ", texture deviation mean {:.4} % max {:.4} %, {lost} samples lost",
+                d[0].as_f64().unwrap_or(f64::NAN),
+                d[1].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+        let _ = write!(
+            s,
+            ", {} triangles torn between charts",
+            j["torn_triangles"].as_u64().unwrap_or(0)
+        );
+        s
+    };
+    let mine = figures(&result.triangles);
+    let mut out = format!("\n    {} (input {input:.4})", text(&mine));
+    let mut anchors = Vec::new();
+    for (what, m) in [
+        ("the file's vertices", Some(mesh)),
+        ("hard edges welded", keyed),
+    ] {
+        let Some(m) = m else { continue };
+        let (anchor, _, _) = crate::bench::meshopt::meshopt_simplify(m, result.triangles.len());
+        let j = figures(&anchor.triangles);
+        let _ = write!(
+            out,
+            "\n    meshoptimizer on {what}, at {} triangles: {}",
+            anchor.triangles.len(),
+            text(&j)
+        );
+        anchors.push(serde_json::json!({"mesh": what, "figures": j}));
+    }
+    json["texture"] = serde_json::json!({
+        "input_uv_stretch": input,
+        "result": mine,
+        "meshopt": anchors,
+    });
+    out
 }
 
-fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
+/// Where a run's time went, outside the checks and measurements.
+#[derive(Clone, Copy, Debug, Default)]
+struct Times {
+    /// Reading and parsing the input file.
+    read: Duration,
+    /// Grouping vertices by position and non-shading attributes, renaming corners and
+    /// mapping the result back (`--hard-edges weld`), over all parts.
+    welding: Duration,
+    /// In the library, over all parts.
+    library: Duration,
+    /// Compacting and writing the output file.
+    write: Duration,
+}
+
+impl Times {
+    fn text(&self) -> String {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        let all = ms(self.read) + ms(self.welding) + ms(self.library) + ms(self.write);
+        format!(
+            "time: reading {:.1} ms, hard edges {:.1} ms, library {:.1} ms, writing {:.1} ms (reading and writing {:.0} % of the four)",
+            ms(self.read),
+            ms(self.welding),
+            ms(self.library),
+            ms(self.write),
+            100.0 * (ms(self.read) + ms(self.write)) / all.max(f64::MIN_POSITIVE)
+        )
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        serde_json::json!({
+            "read_ms": ms(self.read),
+            "hard_edges_ms": ms(self.welding),
+            "library_ms": ms(self.library),
+            "write_ms": ms(self.write),
+        })
+    }
+}
+
+fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result<ExitCode> {
+    for p in parts {
+        times.library += p.library;
+        times.welding += p.welding;
+    }
     let valid = parts.iter().all(|p| p.valid);
     // A part stopped short: clustering reaches the file's count (on positions only; it reads
     // no glTF).
@@ -331,6 +441,7 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
             "triangles_out": parts.iter().map(|p| p.triangles.len()).sum::<usize>(),
             "valid": valid,
             "fallback": fallback.as_ref().map(|f| [&f.0, &f.1]),
+            "time": times.json(),
         });
         if let [p] = parts {
             // One part: its report where the plain path puts it.
@@ -342,6 +453,7 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
         for p in parts {
             let _ = writeln!(text, "{}", p.line);
         }
+        let _ = writeln!(text, "  {}", times.text());
         if let Some((alone, then)) = &fallback {
             let _ = writeln!(
                 text,
@@ -360,7 +472,13 @@ fn finish(args: &Args, head: String, parts: &[Part]) -> Result<ExitCode> {
 }
 
 fn run_gltf(args: &Args) -> Result<ExitCode> {
+    let t0 = Instant::now();
     let file = crate::io::gltf::load(&args.input)?;
+    let mut times = Times {
+        read: t0.elapsed(),
+        ..Times::default()
+    };
+    let t0 = Instant::now();
     for p in &file.passed_through {
         eprintln!(
             "note: {}: {p} is not triangles: passed through unsimplified",
@@ -378,9 +496,11 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
                     triangles: p.triangles.clone(),
                 },
                 texture_coordinates(&file, p),
+                Some(shading::gltf(p)),
             )
         })
         .collect();
+    times.welding = t0.elapsed();
     let normals: Vec<_> = file
         .primitives
         .iter()
@@ -388,8 +508,10 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         .collect();
     let done = simplify_parts(args, &parts, &normals)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
+    let t0 = Instant::now();
     crate::io::gltf::save(&args.output, &file, &results)?;
-    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
+    times.write = t0.elapsed();
+    let tin: usize = parts.iter().map(|(_, m, _, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (glTF, {} triangle primitive(s), attributes {} kept per vertex): \
@@ -399,7 +521,7 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         parts.len(),
         crate::io::gltf::attribute_summary(&file)
     );
-    finish(args, head, &done)
+    finish(args, head, &done, times)
 }
 
 /// The texture coordinates primitive `p`'s material reads (`TEXCOORD_n` of its
@@ -437,9 +559,14 @@ fn obj_texture_coordinates(file: &crate::io::objattr::ObjFile, g: usize) -> Opti
         .collect()
 }
 
-fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
+fn run_obj(args: &Args, bytes: &[u8], t0: Instant) -> Result<ExitCode> {
     let file =
         crate::io::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    let mut times = Times {
+        read: t0.elapsed(),
+        ..Times::default()
+    };
+    let t0 = Instant::now();
     let parts: Vec<Input> = (0..file.groups.len())
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| {
@@ -447,14 +574,21 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
                 .material
                 .as_deref()
                 .map_or("no material".to_string(), |m| format!("material {m}"));
-            (name, file.mesh(g), obj_texture_coordinates(&file, g))
+            (
+                name,
+                file.mesh(g),
+                obj_texture_coordinates(&file, g),
+                Some(shading::obj(&file, g)),
+            )
         })
         .collect();
+    times.welding = t0.elapsed();
     let normals: Vec<_> = (0..file.groups.len())
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| super::attributes::obj_normals(&file, g))
         .collect();
     let done = simplify_parts(args, &parts, &normals)?;
+    let t0 = Instant::now();
     let mut results = Vec::new();
     let mut k = 0;
     for g in &file.groups {
@@ -468,7 +602,8 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
     let text = crate::io::objattr::write(&file, &results);
     std::fs::write(&args.output, text)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
-    let tin: usize = parts.iter().map(|(_, m, _)| m.triangles.len()).sum();
+    times.write = t0.elapsed();
+    let tin: usize = parts.iter().map(|(_, m, _, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
         "simplify {} -> {} (OBJ with {} texture coordinates, {} normals kept per vertex, {} \
@@ -479,5 +614,5 @@ fn run_obj(args: &Args, bytes: &[u8]) -> Result<ExitCode> {
         file.vn_text.len(),
         parts.len()
     );
-    finish(args, head, &done)
+    finish(args, head, &done, times)
 }
