@@ -992,8 +992,9 @@ fn flat_shaded_grid(n: usize) -> Vec<u8> {
 
 /// Flat shading splits every vertex into one wedge per triangle: with `--hard-edges weld` (the
 /// default) the simplifier sees one continuous texture and reaches the target; with `keep`
-/// every interior vertex is a seam corner of six wedges and stays. Either way every vertex
-/// written is an input vertex, bit for bit, and the output is valid with no crack.
+/// every interior vertex is a seam corner of six wedges and stays, and so it does with split
+/// seams. Every vertex written is an input vertex, bit for bit, and the output is valid with no
+/// crack.
 #[test]
 fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
     let dir = tempfile::tempdir().unwrap();
@@ -1004,13 +1005,20 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
         .iter()
         .copied()
         .collect();
-    let run = |hard_edges: &str| {
-        let output = dir.path().join(format!("out-{hard_edges}.glb"));
+    let run = |hard_edges: &str, seams: &str| {
+        let output = dir.path().join(format!("out-{hard_edges}-{seams}.glb"));
         let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
             .arg("simplify")
             .arg(&input)
             .arg(&output)
-            .args(["--ratio", "0.25", "--hard-edges", hard_edges])
+            .args([
+                "--ratio",
+                "0.25",
+                "--hard-edges",
+                hard_edges,
+                "--seams",
+                seams,
+            ])
             .output()
             .unwrap();
         let text = String::from_utf8_lossy(&o.stdout).to_string();
@@ -1031,14 +1039,18 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
         assert!(text.contains("0 triangles torn between charts"), "{text}");
         idx.len() / 3
     };
-    let welded = run("weld");
+    let welded = run("weld", "weld");
     assert!(
         welded <= 72,
         "hard edges welded: {welded} of 288 triangles for 72"
     );
-    let kept = run("keep");
+    let kept = run("keep", "weld");
     assert!(
         kept > 200,
         "hard edges kept: {kept} of 288 triangles (the seam corners stay)"
     );
+    // Split seams: every split vertex is its own (hard edges are not welded), and the output
+    // is a valid simplification of the file's vertices.
+    let split = run("weld", "split");
+    assert!(split > 200, "seams split: {split} of 288 triangles");
 }

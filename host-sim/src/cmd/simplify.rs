@@ -325,7 +325,8 @@ pub struct Args {
     /// joints, weights), so the seams it keeps are the texture's; each output corner then
     /// takes, among the input vertices of its position and texture coordinates, its own if the
     /// triangle is unchanged, else the one whose normal is closest to its triangle's. `keep`
-    /// gives it the vertices as the file has them.
+    /// gives it the vertices as the file has them. Only with `--seams weld`: with `split`
+    /// every split vertex is its own, hard edges too.
     #[arg(long, value_enum, default_value_t = HardEdgesArg::Weld)]
     pub hard_edges: HardEdgesArg,
     /// Parts (connected components): `prune` removes a part whole once it costs less than the

@@ -192,9 +192,13 @@ fn simplify_parts(
             .validate()
             .map_err(|e| anyhow!("configuration: {e}"))?;
         // Hard edges welded: the library and meshoptimizer's anchor see the keyed mesh.
-        let shading = shading
-            .as_ref()
-            .filter(|s| args.hard_edges == super::HardEdgesArg::Weld && s.welds());
+        let shading = shading.as_ref().filter(|s| {
+            // With split seams every split is a boundary the user asked for, hard edges too
+            // (and the check compares the file's vertices, which welding would pinch).
+            args.hard_edges == super::HardEdgesArg::Weld
+                && args.seams == super::SeamsArg::Weld
+                && s.welds()
+        });
         let t0 = Instant::now();
         let keyed = shading.map(|s| s.keyed(mesh));
         let mut welding = t0.elapsed();
