@@ -109,7 +109,9 @@ fn mean_distance2(input: &MeshData, output: &MeshData) -> f64 {
                     ];
                     dot(c, n) >= 0.0
                 };
-                side(sub(b, a), sub(x, a)) && side(sub(c, b), sub(x, b)) && side(sub(a, c), sub(x, c))
+                side(sub(b, a), sub(x, a))
+                    && side(sub(c, b), sub(x, b))
+                    && side(sub(a, c), sub(x, c))
             };
             let d = if inside {
                 let h = dot(ax, n);
@@ -164,7 +166,10 @@ fn the_distance_keeps_the_surface() {
     let (springs, _) = energy(&wavy, 0.15, 0.0, 1.0);
     let (both, r) = energy(&wavy, 0.15, 1.0, Energy::KAPPA);
     common::assert_valid("wavy grid", &wavy, &both, &r);
-    let (e0, e1) = (mean_distance2(&wavy, &springs), mean_distance2(&wavy, &both));
+    let (e0, e1) = (
+        mean_distance2(&wavy, &springs),
+        mean_distance2(&wavy, &both),
+    );
     eprintln!("wavy grid mean squared distance: spring alone {e0:.3e}, with distance {e1:.3e}");
     assert!(e1 < 0.5 * e0, "spring alone {e0}, with distance {e1}");
 }

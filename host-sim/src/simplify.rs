@@ -170,7 +170,8 @@ pub fn simplify_with_attributes(
         0
     };
     let mut links = vec![0u32; n];
-    let mut samples: Vec<Samples> = vec![[0.0; 10]; if energy.is_some() { positions.len() } else { 0 }];
+    let mut samples: Vec<Samples> =
+        vec![[0.0; 10]; if energy.is_some() { positions.len() } else { 0 }];
     let mut ws = HostWorkspace::for_mesh(mesh);
     let bar = progress.then(|| {
         crate::progress::Progress::new(
@@ -275,7 +276,11 @@ pub fn simplify_with_attributes(
                 Controls::new(original, &mut links)
             )
         } else {
-            drive!(Positions::Read(&positions), Energy::new(&mut samples).with_weights(1.0, kappa), NoBound)
+            drive!(
+                Positions::Read(&positions),
+                Energy::new(&mut samples).with_weights(1.0, kappa),
+                NoBound
+            )
         }
     } else {
         match (placement, bounded) {
