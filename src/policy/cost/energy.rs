@@ -262,7 +262,7 @@ impl Cost for Energy<'_> {
         }
     }
 
-    /// `r2 · area2` ([`quadric_part`](super::quadric_part)): a part's samples at about its
+    /// `r2 · area2`, as the quadric costs price a part: its samples at about its
     /// radius from any plane.
     fn part(&self, r2: f32, area2: f32) -> f32 {
         super::quadric_part(r2, area2)
