@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, Result};
 use tinydecimate::bound::Controls;
 use tinydecimate::cost::{
-    AttributeQuadric, AttributeState, Placement, StoredQuadric, VertexQuadric,
+    AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::{Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse};
 
@@ -89,6 +89,9 @@ pub struct Run {
     /// Let parts cheaper than the next collapse vanish whole (`Simplifier::with_parts`, two
     /// `u32` links per vertex) in the runs where the library prunes ([`prunes`]).
     pub prune: bool,
+    /// Hoppe's energy with this κ (`tinydecimate::cost::Energy`, subset placement) instead of
+    /// the configuration's built-in cost; one `Samples` per vertex.
+    pub energy: Option<f32>,
 }
 
 /// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
@@ -147,6 +150,7 @@ pub fn simplify_with_attributes(
         weld,
         lock_seam_corners,
         prune,
+        energy,
     } = *run;
     let prune = prunes(prune, config, bounded);
     let mut part_links = vec![[0u32; 2]; if prune { mesh.positions.len() } else { 0 }];
@@ -166,6 +170,8 @@ pub fn simplify_with_attributes(
         0
     };
     let mut links = vec![0u32; n];
+    let mut samples: Vec<Samples> =
+        vec![[0.0; 10]; if energy.is_some() { positions.len() } else { 0 }];
     let mut ws = HostWorkspace::for_mesh(mesh);
     let bar = progress.then(|| {
         crate::progress::Progress::new(
@@ -256,6 +262,23 @@ pub fn simplify_with_attributes(
             drive!(
                 Positions::Read(&positions),
                 cost(&mut quadrics, &mut states)?,
+                NoBound
+            )
+        }
+    } else if let Some(kappa) = energy {
+        if placement.is_some() {
+            return Err(anyhow!("--cost energy replaces --quadric stored"));
+        }
+        if bounded {
+            drive!(
+                Positions::Read(&positions),
+                Energy::new(&mut samples).with_weights(1.0, kappa),
+                Controls::new(original, &mut links)
+            )
+        } else {
+            drive!(
+                Positions::Read(&positions),
+                Energy::new(&mut samples).with_weights(1.0, kappa),
                 NoBound
             )
         }

@@ -111,6 +111,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 ([0.0; 3], 0.0)
             };
             self.cost.add(&mut w.fan, unit, area2);
+            self.cost.corner(&mut w.fan, dx, dy);
             w.variation.add(unit);
             w.area2 += area2;
         }

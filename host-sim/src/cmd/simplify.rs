@@ -47,12 +47,17 @@ pub enum CostArg {
     /// schedule (`Config::paper()`): keeps flat regions flat rather than minimising distance;
     /// for comparison with the paper, higher Metro error than `quadric`.
     Normal,
+    /// Hoppe's energy, E_dist + E_spring (`tinydecimate::cost::Energy`): per vertex the
+    /// moments of the original surface's samples merged into it (40 bytes), subset placement,
+    /// greedy only.
+    Energy,
 }
 
 impl From<CostArg> for CostKind {
     fn from(c: CostArg) -> CostKind {
         match c {
-            CostArg::Quadric => CostKind::Quadric,
+            // The energy is its own cost, not a built-in one: the configuration's is unused.
+            CostArg::Quadric | CostArg::Energy => CostKind::Quadric,
             CostArg::Normal => CostKind::NormalVariation,
         }
     }
@@ -397,6 +402,9 @@ pub struct Args {
     /// Zhu, Wang and Meng 2007 (greedy schedule only).
     #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
     pub operator: OperatorArg,
+    /// κ, the spring constant of `--cost energy` (0: distance alone).
+    #[arg(long, default_value_t = tinydecimate::cost::Energy::KAPPA)]
+    pub spring: f32,
     /// Quadric: `stored` keeps a quadric per vertex, replacing --cost.
     #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
     pub quadric: QuadricArg,
@@ -584,6 +592,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         // No attribute is carried here, so a seam corner has nothing to tear.
         lock_seam_corners: false,
         prune: args.parts == PartsArg::Prune,
+        energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
@@ -641,6 +650,12 @@ fn run_text(args: &Args, run: &Run) -> String {
             text,
             "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
             config.schedule, args.placement, config.boundary_weight
+        );
+    } else if args.cost == Some(CostArg::Energy) {
+        let _ = writeln!(
+            text,
+            "  schedule, cost, op     {:?}, Hoppe's energy (κ {}), {:?} collapse",
+            config.schedule, args.spring, args.operator
         );
     } else {
         let _ = writeln!(
