@@ -10,7 +10,9 @@ pub enum Capacity {
     Vertices,
     /// More triangles than the [`Storage`](crate::Storage) (or its link type) can number.
     Triangles,
-    /// Fewer stored quadrics than positions ([`StoredQuadric`](crate::StoredQuadric)).
+    /// Fewer stored quadrics than positions ([`StoredQuadric`](crate::StoredQuadric)), or
+    /// fewer attribute states or attribute values
+    /// ([`AttributeQuadric`](crate::cost::AttributeQuadric)).
     Quadrics,
     /// Fewer control links than [`bound::control_len`](crate::bound::control_len), or more control points than the
     /// link type numbers ([`Controls`](crate::Controls)).

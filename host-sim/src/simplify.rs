@@ -6,7 +6,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
 use tinydecimate::bound::Controls;
-use tinydecimate::cost::{Placement, StoredQuadric, VertexQuadric};
+use tinydecimate::cost::{
+    AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
+};
 use tinydecimate::{
     Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse, VertexDecimation,
 };
@@ -95,6 +97,18 @@ pub struct Run {
     /// Let parts cheaper than the next collapse vanish whole (`Simplifier::with_parts`, two
     /// `u32` links per vertex) in the runs where the library prunes ([`prunes`]).
     pub prune: bool,
+    /// Hoppe's energy with this κ (`tinydecimate::cost::Energy`, subset placement) instead of
+    /// the configuration's built-in cost; one `Samples` per vertex.
+    pub energy: Option<f32>,
+}
+
+/// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
+/// otherwise welding renumbers nothing, and its sort is skipped.
+fn shares_positions(positions: &[[f32; 3]]) -> bool {
+    let mut seen = std::collections::HashSet::with_capacity(positions.len());
+    positions
+        .iter()
+        .any(|p| !seen.insert(p.map(|x| if x == 0.0 { 0 } else { x.to_bits() })))
 }
 
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
@@ -102,6 +116,20 @@ pub struct Run {
 pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
     prune && !bounded && config.schedule == tinydecimate::Schedule::Greedy
 }
+
+/// Vertex attributes for the attribute-aware stored quadric
+/// (`tinydecimate::cost::AttributeQuadric`): per vertex, texture coordinates then a normal
+/// (zeros where a mesh has none), and a weight per component (zero switches it off).
+#[derive(Clone, Debug, Default)]
+pub struct Attributes {
+    /// `[u, v, nx, ny, nz]` per vertex.
+    pub values: Vec<[f32; ATTRIBUTES]>,
+    /// One weight per component.
+    pub weights: [f32; ATTRIBUTES],
+}
+
+/// Components per vertex in [`Attributes`]: UV and normal.
+pub const ATTRIBUTES: usize = 5;
 
 /// Runs the library on `mesh` with the policies of `run`. The library refuses combinations
 /// it cannot run. The result carries the positions as the library left them (moved by optimal
@@ -111,6 +139,17 @@ pub fn simplify_with(
     config: &Config,
     run: &Run,
 ) -> Result<(MeshData, Report, Duration)> {
+    simplify_with_attributes(mesh, config, run, None)
+}
+
+/// [`simplify_with`], and with `attributes` the stored quadric with their attribute term
+/// (`AttributeQuadric`: stored quadrics with subset placement only, refused otherwise).
+pub fn simplify_with_attributes(
+    mesh: &MeshData,
+    config: &Config,
+    run: &Run,
+    attributes: Option<&Attributes>,
+) -> Result<(MeshData, Report, Duration)> {
     let Run {
         operator,
         placement,
@@ -119,6 +158,7 @@ pub fn simplify_with(
         weld,
         lock_seam_corners,
         prune,
+        energy,
     } = *run;
     // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
     // its run is welded by position, and the output keeps the welded numbering.
@@ -133,12 +173,16 @@ pub fn simplify_with(
         0
     };
     let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; n];
+    let mut states =
+        vec![AttributeState::<ATTRIBUTES>::ZERO; if attributes.is_some() { n } else { 0 }];
     let n = if bounded {
         tinydecimate::bound::control_len(tris.len(), positions.len())
     } else {
         0
     };
     let mut links = vec![0u32; n];
+    let mut samples: Vec<Samples> =
+        vec![[0.0; 10]; if energy.is_some() { positions.len() } else { 0 }];
     let mut ws = HostWorkspace::for_mesh(mesh);
     let bar = progress.then(|| {
         crate::progress::Progress::new(
@@ -151,7 +195,7 @@ pub fn simplify_with(
     // bound's control points are taken from.
     let mut wedges: Vec<[u32; 3]> = Vec::new();
     let mut welded = Vec::new();
-    if weld {
+    if weld && shares_positions(&positions) {
         let mut w = vec![[0u32; 3]; tris.len()];
         let mut order = vec![0u32; positions.len()];
         if tinydecimate::seam::weld(&positions, &mut tris, &mut w, &mut order)
@@ -214,33 +258,76 @@ pub fn simplify_with(
         }};
     }
     // Optimal placement writes the positions; every other run only reads them.
-    let report = match (placement, bounded) {
-        (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
-        (None, true) => drive!(
-            Positions::Read(&positions),
-            Builtin::new(),
-            Controls::new(original, &mut links)
-        ),
-        (Some(Placement::Subset), false) => drive!(
-            Positions::Read(&positions),
-            StoredQuadric::new(&mut quadrics, Placement::Subset),
-            NoBound
-        ),
-        (Some(Placement::Subset), true) => drive!(
-            Positions::Read(&positions),
-            StoredQuadric::new(&mut quadrics, Placement::Subset),
-            Controls::new(original, &mut links)
-        ),
-        (Some(Placement::Optimal), false) => drive!(
-            Positions::Write(&mut positions),
-            StoredQuadric::new(&mut quadrics, Placement::Optimal),
-            NoBound
-        ),
-        (Some(Placement::Optimal), true) => drive!(
-            Positions::Write(&mut positions),
-            StoredQuadric::new(&mut quadrics, Placement::Optimal),
-            Controls::new(original, &mut links)
-        ),
+    let report = if let Some(a) = attributes {
+        let cost = |q, s| {
+            AttributeQuadric::new(q, s, &a.values, a.weights)
+                .with_placement(placement.unwrap_or(Placement::Optimal))
+                .map_err(|e| {
+                    anyhow!(
+                        "{} (attribute weights need --quadric stored --placement subset)",
+                        e
+                    )
+                })
+        };
+        if bounded {
+            drive!(
+                Positions::Read(&positions),
+                cost(&mut quadrics, &mut states)?,
+                Controls::new(original, &mut links)
+            )
+        } else {
+            drive!(
+                Positions::Read(&positions),
+                cost(&mut quadrics, &mut states)?,
+                NoBound
+            )
+        }
+    } else if let Some(kappa) = energy {
+        if placement.is_some() {
+            return Err(anyhow!("--cost energy replaces --quadric stored"));
+        }
+        if bounded {
+            drive!(
+                Positions::Read(&positions),
+                Energy::new(&mut samples).with_weights(1.0, kappa),
+                Controls::new(original, &mut links)
+            )
+        } else {
+            drive!(
+                Positions::Read(&positions),
+                Energy::new(&mut samples).with_weights(1.0, kappa),
+                NoBound
+            )
+        }
+    } else {
+        match (placement, bounded) {
+            (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
+            (None, true) => drive!(
+                Positions::Read(&positions),
+                Builtin::new(),
+                Controls::new(original, &mut links)
+            ),
+            (Some(Placement::Subset), false) => drive!(
+                Positions::Read(&positions),
+                StoredQuadric::new(&mut quadrics, Placement::Subset),
+                NoBound
+            ),
+            (Some(Placement::Subset), true) => drive!(
+                Positions::Read(&positions),
+                StoredQuadric::new(&mut quadrics, Placement::Subset),
+                Controls::new(original, &mut links)
+            ),
+            (Some(Placement::Optimal), false) => drive!(
+                Positions::Write(&mut positions),
+                StoredQuadric::new(&mut quadrics, Placement::Optimal),
+                NoBound
+            ),
+            (Some(Placement::Optimal), true) => drive!(
+                Positions::Write(&mut positions),
+                StoredQuadric::new(&mut quadrics, Placement::Optimal),
+                Controls::new(original, &mut links)
+            ),
+        }
     };
     let elapsed = start.elapsed();
     if let Some(b) = bar {

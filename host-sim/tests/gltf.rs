@@ -608,6 +608,71 @@ fn simplify_command_writes_glb_and_refuses_optimal_placement() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("only as glTF"));
 }
 
+/// `--attribute-weights`: the attribute-aware stored quadric runs on a glTF and prints
+/// meshoptimizer's `simplifyWithAttributes` beside it; refused without `--quadric stored`, with
+/// a name other than uv and normal, and on a mesh without attributes.
+#[test]
+fn simplify_command_takes_attribute_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let (json, bin) = document();
+    let input = dir.path().join("in.glb");
+    std::fs::write(&input, glb(&json, &bin)).unwrap();
+    let run = |input: &std::path::Path, output: &str, args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_host-sim"))
+            .arg("simplify")
+            .arg(input)
+            .arg(dir.path().join(output))
+            .args(["--ratio", "0.25"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(
+        &input,
+        "out.glb",
+        &[
+            "--quadric",
+            "stored",
+            "--attribute-weights",
+            "uv=10,normal=1",
+        ],
+    );
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(text.contains("simplifyWithAttributes"), "{text}");
+    assert!(
+        text.contains("valid") && !text.contains("NOT valid"),
+        "{text}"
+    );
+    let o = run(&input, "out.glb", &["--attribute-weights", "uv=10"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs --quadric stored"));
+    let o = run(
+        &input,
+        "out.glb",
+        &["--quadric", "stored", "--attribute-weights", "colour=1"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("uv and normal"));
+    let plain = dir.path().join("plain.obj");
+    std::fs::write(
+        &plain,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n",
+    )
+    .unwrap();
+    let o = run(
+        &plain,
+        "out.obj",
+        &["--quadric", "stored", "--attribute-weights", "uv=1"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("needs vertex attributes"));
+}
+
 #[test]
 fn obj_keeps_texture_coordinates_normals_and_materials() {
     // The seam grid as OBJ: positions shared across the seam, texture coordinates split.
@@ -927,8 +992,9 @@ fn flat_shaded_grid(n: usize) -> Vec<u8> {
 
 /// Flat shading splits every vertex into one wedge per triangle: with `--hard-edges weld` (the
 /// default) the simplifier sees one continuous texture and reaches the target; with `keep`
-/// every interior vertex is a seam corner of six wedges and stays. Either way every vertex
-/// written is an input vertex, bit for bit, and the output is valid with no crack.
+/// every interior vertex is a seam corner of six wedges and stays, and so it does with split
+/// seams. Every vertex written is an input vertex, bit for bit, and the output is valid with no
+/// crack.
 #[test]
 fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
     let dir = tempfile::tempdir().unwrap();
@@ -939,13 +1005,20 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
         .iter()
         .copied()
         .collect();
-    let run = |hard_edges: &str| {
-        let output = dir.path().join(format!("out-{hard_edges}.glb"));
+    let run = |hard_edges: &str, seams: &str| {
+        let output = dir.path().join(format!("out-{hard_edges}-{seams}.glb"));
         let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
             .arg("simplify")
             .arg(&input)
             .arg(&output)
-            .args(["--ratio", "0.25", "--hard-edges", hard_edges])
+            .args([
+                "--ratio",
+                "0.25",
+                "--hard-edges",
+                hard_edges,
+                "--seams",
+                seams,
+            ])
             .output()
             .unwrap();
         let text = String::from_utf8_lossy(&o.stdout).to_string();
@@ -966,14 +1039,18 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
         assert!(text.contains("0 triangles torn between charts"), "{text}");
         idx.len() / 3
     };
-    let welded = run("weld");
+    let welded = run("weld", "weld");
     assert!(
         welded <= 72,
         "hard edges welded: {welded} of 288 triangles for 72"
     );
-    let kept = run("keep");
+    let kept = run("keep", "weld");
     assert!(
         kept > 200,
         "hard edges kept: {kept} of 288 triangles (the seam corners stay)"
     );
+    // Split seams: every split vertex is its own (hard edges are not welded), and the output
+    // is a valid simplification of the file's vertices.
+    let split = run("weld", "split");
+    assert!(split > 200, "seams split: {split} of 288 triangles");
 }

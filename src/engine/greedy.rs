@@ -254,9 +254,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// boundary ends stay (the boundary is kept), so the least of the old key and the new
     /// price onto `b` is a lower bound of `x`'s cheapest collapse, found exactly when it
     /// reaches the top (the old key may have been the price onto `a`, now gone, or onto `b`
-    /// before it grew: too low is allowed, too high is not).
+    /// before it grew: too low is allowed, too high is not). Not for a cost whose price reads
+    /// the fan ([`Cost::needs_fan`]): `x`'s fan changed.
     pub(super) fn keys_only_fall(&self) -> bool {
-        self.cost.stores() && !self.config.features
+        self.cost.stores() && !self.cost.needs_fan() && !self.config.features
     }
 
     /// [`Self::rekey`] for [`Self::keys_only_fall`]: one price instead of `x`'s whole fan. A

@@ -111,6 +111,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 ([0.0; 3], 0.0)
             };
             self.cost.add(&mut w.fan, unit, area2);
+            self.cost.corner(&mut w.fan, dx, dy);
             w.variation.add(unit);
             w.area2 += area2;
         }
@@ -120,7 +121,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         w
     }
 
-    /// Hands the cost `v`'s planes (costs that store per-vertex state): each triangle's plane
+    /// Hands the cost `v`'s planes (costs that store per-vertex state): each triangle (its
+    /// corners, [`Cost::triangle`]) and its plane
     /// weighted by twice its area, and for a boundary vertex the plane through each of its two
     /// boundary edges perpendicular to the edge's triangle (Cheng, Pan and Shi 1998 §3.3).
     pub(super) fn init_vertex(&mut self, v: usize) {
@@ -137,7 +139,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             let tri = self.mesh.tri(c >> 2);
             let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
             let (px, py) = (self.mesh.p(x), self.mesh.p(y));
-            let n = math::cross(math::sub(px, pv), math::sub(py, pv));
+            let (ex, ey) = (math::sub(px, pv), math::sub(py, pv));
+            self.cost
+                .triangle(v, self.mesh.caller_corners(c >> 2, c & 3), ex, ey);
+            let n = math::cross(ex, ey);
             let l2 = math::dot(n, n);
             if l2 > math::TINY2 && l2.is_finite() {
                 let r = math::rsqrt(l2);

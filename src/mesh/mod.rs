@@ -150,6 +150,16 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         self.tris.len()
     }
 
+    /// Triangle `t`'s corners as the caller's vertices, starting at corner `k`: its wedges
+    /// with welded seams (what a corner's attributes are read by), else its vertices.
+    #[inline]
+    pub(crate) fn caller_corners(&self, t: usize, k: usize) -> [usize; 3] {
+        let c = self.tri(t);
+        #[cfg(feature = "seams")]
+        let c = self.wedges.get(t).map_or(c, |w| w.map(|x| x.to_usize()));
+        [k, next3(k), prev3(k)].map(|i| c.get(i).copied().unwrap_or(NIL))
+    }
+
     /// The vertices of triangle `t` (all `NIL` if out of range).
     #[inline]
     pub(crate) fn tri(&self, t: usize) -> [usize; 3] {

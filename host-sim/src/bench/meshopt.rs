@@ -101,6 +101,45 @@ pub fn meshopt_simplify(mesh: &MeshData, target_triangles: usize) -> (MeshData, 
     (result, elapsed, peak)
 }
 
+/// `meshopt::simplify_with_attributes_and_locks` (no vertex locked) on `mesh` down to
+/// `target_triangles`, with `attributes` (one row of `N` floats per vertex) weighted by
+/// `weights`: the triangles (the positions are not moved).
+pub fn meshopt_simplify_with_attributes<const N: usize>(
+    mesh: &MeshData,
+    target_triangles: usize,
+    attributes: &[[f32; N]],
+    weights: &[f32; N],
+) -> MeshData {
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let bytes = meshopt::utilities::typed_to_bytes(&mesh.positions);
+    let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<[f32; 3]>(), 0)
+        .expect("12-byte vertices");
+    let flat: Vec<f32> = attributes.iter().flatten().copied().collect();
+    let locks = vec![false; mesh.positions.len()];
+    assert_eq!(
+        attributes.len(),
+        mesh.positions.len(),
+        "one attribute row per vertex"
+    );
+    let _lock = MESHOPT.lock().unwrap_or_else(|p| p.into_inner());
+    let out = meshopt::simplify_with_attributes_and_locks(
+        &indices,
+        &adapter,
+        &flat,
+        weights,
+        std::mem::size_of::<[f32; N]>(),
+        &locks,
+        3 * target_triangles,
+        1.0,
+        meshopt::SimplifyOptions::None,
+        None,
+    );
+    MeshData {
+        positions: mesh.positions.clone(),
+        triangles: out.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+    }
+}
+
 /// `meshopt::simplify_with_update` (positions only, no attributes) on `mesh` down to
 /// `target_triangles`: result (with the moved positions), wall time and peak scratch bytes.
 pub fn meshopt_simplify_with_update(

@@ -20,6 +20,7 @@ use crate::simplify::{format_report, report_json, simplify_with};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
 mod advice;
+mod attributes;
 mod shading;
 mod textured;
 
@@ -46,12 +47,17 @@ pub enum CostArg {
     /// schedule (`Config::paper()`): keeps flat regions flat rather than minimising distance;
     /// for comparison with the paper, higher Metro error than `quadric`.
     Normal,
+    /// Hoppe's energy, E_dist + E_spring (`tinydecimate::cost::Energy`): per vertex the
+    /// moments of the original surface's samples merged into it (40 bytes), subset placement,
+    /// greedy only.
+    Energy,
 }
 
 impl From<CostArg> for CostKind {
     fn from(c: CostArg) -> CostKind {
         match c {
-            CostArg::Quadric => CostKind::Quadric,
+            // The energy is its own cost, not a built-in one: the configuration's is unused.
+            CostArg::Quadric | CostArg::Energy => CostKind::Quadric,
             CostArg::Normal => CostKind::NormalVariation,
         }
     }
@@ -194,6 +200,31 @@ fn parse_weight(v: &str) -> std::result::Result<f32, String> {
     ranged(v, |x| x >= 0.0, "0 or more", "a weight")
 }
 
+/// `--attribute-weights`: a weight for texture coordinates and one for normals.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AttributeWeights {
+    /// Both texture coordinates' weight.
+    pub uv: f32,
+    /// The normal's three components' weight.
+    pub normal: f32,
+}
+
+fn parse_attribute_weights(v: &str) -> std::result::Result<AttributeWeights, String> {
+    let mut w = AttributeWeights::default();
+    for item in v.split(',') {
+        let (name, value) = item
+            .split_once('=')
+            .ok_or_else(|| format!("`{item}`: give name=weight (uv=W,normal=W)"))?;
+        let x = parse_weight(value.trim())?;
+        match name.trim() {
+            "uv" => w.uv = x,
+            "normal" => w.normal = x,
+            n => return Err(format!("`{n}`: the attributes are uv and normal")),
+        }
+    }
+    Ok(w)
+}
+
 fn parse_samples(v: &str) -> std::result::Result<f64, String> {
     ranged(v, |x| x > 0.0, "above 0", "samples per triangle").map(f64::from)
 }
@@ -299,7 +330,8 @@ pub struct Args {
     /// joints, weights), so the seams it keeps are the texture's; each output corner then
     /// takes, among the input vertices of its position and texture coordinates, its own if the
     /// triangle is unchanged, else the one whose normal is closest to its triangle's. `keep`
-    /// gives it the vertices as the file has them.
+    /// gives it the vertices as the file has them. Only with `--seams weld`: with `split`
+    /// every split vertex is its own, hard edges too.
     #[arg(long, value_enum, default_value_t = HardEdgesArg::Weld)]
     pub hard_edges: HardEdgesArg,
     /// Parts (connected components): `prune` removes a part whole once it costs less than the
@@ -370,12 +402,22 @@ pub struct Args {
     /// Zhu, Wang and Meng 2007 (greedy schedule only).
     #[arg(long, value_enum, default_value_t = OperatorArg::Edge)]
     pub operator: OperatorArg,
+    /// κ, the spring constant of `--cost energy` (0: distance alone).
+    #[arg(long, default_value_t = tinydecimate::cost::Energy::KAPPA)]
+    pub spring: f32,
     /// Quadric: `stored` keeps a quadric per vertex, replacing --cost.
     #[arg(long, value_enum, default_value_t = QuadricArg::Memoryless)]
     pub quadric: QuadricArg,
     /// Placement of the kept vertex with `--quadric stored`.
     #[arg(long, value_enum, default_value_t = PlacementArg::Subset)]
     pub placement: PlacementArg,
+    /// Attribute weights for the stored quadric (`tinydecimate::cost::AttributeQuadric`,
+    /// meshoptimizer's `simplifyWithAttributes` term): `uv=W,normal=W` (either or both). A
+    /// weighted attribute change of 1 across a triangle of size d is priced like moving it by
+    /// d. Needs `--quadric stored` with `--placement subset` and a mesh with attributes (glTF,
+    /// OBJ with vt/vn); with welded seams each position's first vertex's attributes are used.
+    #[arg(long, value_parser = parse_attribute_weights)]
+    pub attribute_weights: Option<AttributeWeights>,
     /// Skip the validity check and the Metro measurement afterwards.
     #[arg(long)]
     pub no_measure: bool,
@@ -519,6 +561,13 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     config
         .validate()
         .map_err(|e| anyhow!("configuration: {e}"))?;
+    if args.attribute_weights.is_some() {
+        bail!(
+            "{}: --attribute-weights needs vertex attributes: a glTF, or an OBJ with vt or vn \
+             written to OBJ",
+            args.input.display()
+        );
+    }
     let stored = args.quadric == QuadricArg::Stored;
     // Optimal placement moves vertices: only their numbering says which input vertex each
     // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
@@ -543,6 +592,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         // No attribute is carried here, so a seam corner has nothing to tear.
         lock_seam_corners: false,
         prune: args.parts == PartsArg::Prune,
+        energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
@@ -600,6 +650,12 @@ fn run_text(args: &Args, run: &Run) -> String {
             text,
             "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
             config.schedule, args.placement, config.boundary_weight
+        );
+    } else if args.cost == Some(CostArg::Energy) {
+        let _ = writeln!(
+            text,
+            "  schedule, cost, op     {:?}, Hoppe's energy (κ {}), {:?} collapse",
+            config.schedule, args.spring, args.operator
         );
     } else {
         let _ = writeln!(

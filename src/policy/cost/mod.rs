@@ -17,13 +17,17 @@
 use crate::math::V3;
 pub use crate::quadric::{error, VertexQuadric};
 
+mod attributes;
 mod builtin;
+mod energy;
 mod memoryless;
 mod stored;
 mod variation;
 
 use crate::{Config, ConfigField, Error};
+pub use attributes::{AttributeQuadric, AttributeState};
 pub use builtin::Builtin;
+pub use energy::{Energy, EnergyFan, Samples, RING};
 pub use memoryless::{Quadric, QuadricFan};
 pub use stored::{Placement, StoredQuadric};
 pub use variation::NormalVariation;
@@ -79,6 +83,12 @@ pub trait Cost {
     /// Adds one triangle of the moving vertex's fan: its unit normal (zero if it has no area)
     /// and twice its area.
     fn add(&self, fan: &mut Self::Fan, normal: V3, area2: f32);
+    /// Beside [`Cost::add`], the same triangle's two other corners as offsets from the moving
+    /// vertex, in winding order (`dx`, then `dy`); in fan order, one triangle's `dy` is the
+    /// next one's `dx`. For a cost that reads the fan's neighbours ([`Energy`]'s springs and
+    /// new planes). Nothing by default (the call is dropped).
+    #[inline]
+    fn corner(&self, _fan: &mut Self::Fan, _dx: V3, _dy: V3) {}
     /// The price of one move of the vertex whose fan was summarised.
     fn price(&self, fan: &Self::Fan, m: &Move) -> f32;
     /// The move's own geometric error, squared, in the normalised units of [`Move`]'s positions,
@@ -90,9 +100,10 @@ pub trait Cost {
     }
     /// Whether [`Move::turn`] must be computed (one more fan walk per candidate).
     fn needs_turn(&self) -> bool;
-    /// Whether [`Cost::add`] and [`Cost::round`] use what they are given (the fan's normals
-    /// and areas). `false` lets the engine skip a cross product and a 1/√ per triangle of
-    /// every walk when the feature rule is off too. `true` by default.
+    /// Whether [`Cost::add`], [`Cost::corner`] and [`Cost::round`] use what they are given
+    /// (the fan's normals, areas and corners). `false` lets the engine skip a cross product
+    /// and a 1/√ per triangle of every walk when the feature rule is off too. `true` by
+    /// default.
     fn needs_fan(&self) -> bool {
         true
     }
@@ -101,9 +112,10 @@ pub trait Cost {
     fn round(&mut self, _mean_area2: f32) {}
     /// Whether the cost keeps state per vertex (stored quadrics). If so the engine, once before
     /// the first keys, hands it every used vertex's planes ([`Cost::plane`]); after each
-    /// collapse it calls [`Cost::merge`]. Such a cost's price of `x -> y` must depend only on
-    /// the two vertices' states and positions: without the feature rule the engine then
-    /// re-keys a collapse's neighbours by their one changed price, onto the kept vertex.
+    /// collapse it calls [`Cost::merge`]. Unless it [`Cost::needs_fan`], such a cost's price
+    /// of `x -> y` must depend only on the two vertices' states and positions: without the
+    /// feature rule the engine then re-keys a collapse's neighbours by their one changed
+    /// price, onto the kept vertex (a storing cost that reads the fan is re-keyed in full).
     fn stores(&self) -> bool {
         false
     }
@@ -113,6 +125,14 @@ pub trait Cost {
     /// each vertex's state in a frame centred on it, which keeps `f32` sums of nearby planes
     /// free of the cancellation a global origin causes.
     fn plane(&mut self, _v: usize, _n: V3, _d: f32, _weight: f32) {}
+    /// Hands a storing cost one triangle of `v`'s fan when the planes are initialised (only
+    /// if [`Cost::stores`]), beside [`Cost::plane`]: its three corners as the caller's vertices
+    /// in winding order from `v`'s corner (`corners[0]` is `v` itself, or with welded seams
+    /// (`seam`, crate feature `seams`) the wedge the triangle has at `v`'s position), and `e1`, `e2` the
+    /// other two corners' positions relative to `v` (normalised units). A plane does not say
+    /// which vertices span it: a cost that reads per-vertex data besides positions (attribute
+    /// gradients, [`AttributeQuadric`]) needs the corners. Nothing by default.
+    fn triangle(&mut self, _v: usize, _corners: [usize; 3], _e1: V3, _e2: V3) {}
     /// Adds the plane through one of `v`'s boundary edges, perpendicular to its triangle (Cheng,
     /// Pan and Shi 1998 §3.3); `weight` is the squared edge length, the cost applies its own
     /// factor.

@@ -20,7 +20,8 @@ use tinydecimate::cluster::{
     Quadrics, Scratch, SliceSource, Source, ThenCollapseError, KEY_LANES,
 };
 use tinydecimate::cost::{
-    error, Builtin, Cost, Move, NormalVariation, Placement, Quadric, StoredQuadric, VertexQuadric,
+    error, AttributeQuadric, AttributeState, Builtin, Cost, Move, NormalVariation, Placement,
+    Quadric, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::operator::Operator;
 use tinydecimate::progressive::{Split, Storage};
@@ -286,6 +287,29 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
             Err(e) => display(&e),
         }
         black_box(&moving);
+        // Stored quadrics with attributes (UV and normal), subset placement.
+        let mut states: [AttributeState<5>; V] = black_box([AttributeState::ZERO; V]);
+        let values: [[f32; 5]; V] = black_box([[0.0; 5]; V]);
+        let (ns, na) = (input(13) as usize, input(14) as usize);
+        if let (Some(st), Some(a)) = (states.get_mut(..ns), values.get(..na)) {
+            let w = [
+                opaque_f32(1),
+                opaque_f32(1),
+                opaque_f32(2),
+                opaque_f32(2),
+                opaque_f32(2),
+            ];
+            match AttributeQuadric::new(q, st, a, w).with_placement(placement_of(input(16))) {
+                Ok(cost) => {
+                    black_box((cost.state(input(15) as usize), cost.geometry().placement()));
+                    match ws.start(Positions::Read(p), t, &config, cost, NoBound, EdgeCollapse) {
+                        Ok(s) => drive(s),
+                        Err(e) => display(&e),
+                    }
+                }
+                Err(e) => display(&e),
+            }
+        }
     }
     // The error bound: control points over the original triangles, u16 and u32 links.
     let original: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);

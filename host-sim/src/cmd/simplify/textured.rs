@@ -24,10 +24,12 @@ use crate::io::MeshData;
 
 /// The one call into the library: `mesh`'s triangles simplified (input numbering) and the
 /// report.
+/// `attributes`: `--attribute-weights`' attribute term (`super::attributes`).
 fn run_library(
     mesh: &MeshData,
     config: &Config,
     args: &Args,
+    attributes: Option<&crate::simplify::Attributes>,
 ) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
@@ -40,7 +42,8 @@ fn run_library(
         lock_seam_corners: true,
         ..Default::default()
     };
-    let (out, report, elapsed) = crate::simplify::simplify_with(mesh, config, &run)?;
+    let (out, report, elapsed) =
+        crate::simplify::simplify_with_attributes(mesh, config, &run, attributes)?;
     Ok((out.triangles, report, elapsed))
 }
 
@@ -118,7 +121,7 @@ fn run_ply(args: &Args, bytes: &[u8], extra: &[String], t0: Instant) -> Result<E
         read: t0.elapsed(),
         ..Times::default()
     };
-    let done = simplify_parts(args, &parts)?;
+    let done = simplify_parts(args, &parts, &[])?;
     let t0 = Instant::now();
     let out = crate::io::plyattr::write(&file, &done[0].triangles)
         .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
@@ -166,11 +169,16 @@ struct Part {
 /// position and non-shading attributes (for `--hard-edges weld`).
 type Input = (String, MeshData, Option<Vec<[f32; 2]>>, Option<Shading>);
 
-/// Simplifies each mesh of `parts` with `args`' configuration.
-fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
+/// Simplifies each mesh of `parts` with `args`' configuration; `normals` (per part, may be
+/// shorter) are only read by `--attribute-weights`.
+fn simplify_parts(
+    args: &Args,
+    parts: &[Input],
+    normals: &[Option<Vec<[f32; 3]>>],
+) -> Result<Vec<Part>> {
     let total: usize = parts.iter().map(|(_, m, _, _)| m.triangles.len()).sum();
     let mut out = Vec::new();
-    for (label, mesh, uvs, shading) in parts {
+    for (k, (label, mesh, uvs, shading)) in parts.iter().enumerate() {
         let mut config = args.config();
         if let Some(n) = args.target_triangles {
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
@@ -184,15 +192,27 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
             .validate()
             .map_err(|e| anyhow!("configuration: {e}"))?;
         // Hard edges welded: the library and meshoptimizer's anchor see the keyed mesh.
-        let shading = shading
-            .as_ref()
-            .filter(|s| args.hard_edges == super::HardEdgesArg::Weld && s.welds());
+        let shading = shading.as_ref().filter(|s| {
+            // With split seams every split is a boundary the user asked for, hard edges too
+            // (and the check compares the file's vertices, which welding would pinch).
+            args.hard_edges == super::HardEdgesArg::Weld
+                && args.seams == super::SeamsArg::Weld
+                && s.welds()
+        });
         let t0 = Instant::now();
         let keyed = shading.map(|s| s.keyed(mesh));
         let mut welding = t0.elapsed();
         let lib_mesh = keyed.as_ref().unwrap_or(mesh);
-        let (tris, report, library) =
-            run_library(lib_mesh, &config, args).map_err(|e| anyhow!("{label}: {e}"))?;
+        // The keyed mesh keeps the positions' numbering: the attributes are the input's.
+        let attributes = super::attributes::for_part(
+            args,
+            label,
+            mesh.positions.len(),
+            uvs.as_deref(),
+            normals.get(k).and_then(Option::as_deref),
+        )?;
+        let (tris, report, library) = run_library(lib_mesh, &config, args, attributes.as_ref())
+            .map_err(|e| anyhow!("{label}: {e}"))?;
         let t0 = Instant::now();
         let tris = match shading {
             Some(s) => s.restore(mesh, &tris),
@@ -257,8 +277,15 @@ fn simplify_parts(args: &Args, parts: &[Input]) -> Result<Vec<Part>> {
             if let Some(uvs) = uvs {
                 let _ = write!(
                     line,
-                    "{}",
-                    uv_stretch(mesh, keyed.as_ref(), uvs, &result, &mut json)
+                    "{}{}",
+                    uv_stretch(mesh, keyed.as_ref(), uvs, &result, &mut json),
+                    super::attributes::meshopt_reference(
+                        mesh,
+                        uvs,
+                        &result,
+                        &attributes,
+                        &mut json
+                    )
                 );
             }
         }
@@ -478,7 +505,12 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         })
         .collect();
     times.welding = t0.elapsed();
-    let done = simplify_parts(args, &parts)?;
+    let normals: Vec<_> = file
+        .primitives
+        .iter()
+        .map(super::attributes::gltf_normals)
+        .collect();
+    let done = simplify_parts(args, &parts, &normals)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
     let t0 = Instant::now();
     crate::io::gltf::save(&args.output, &file, &results)?;
@@ -555,7 +587,11 @@ fn run_obj(args: &Args, bytes: &[u8], t0: Instant) -> Result<ExitCode> {
         })
         .collect();
     times.welding = t0.elapsed();
-    let done = simplify_parts(args, &parts)?;
+    let normals: Vec<_> = (0..file.groups.len())
+        .filter(|&g| !file.groups[g].triangles.is_empty())
+        .map(|g| super::attributes::obj_normals(&file, g))
+        .collect();
+    let done = simplify_parts(args, &parts, &normals)?;
     let t0 = Instant::now();
     let mut results = Vec::new();
     let mut k = 0;
