@@ -135,11 +135,14 @@ pub enum Method {
     /// tinydecimate, `VertexDecimation` (Schroeder, Zarge and Lorensen 1992) with
     /// `Config::new()`.
     VertexDecimation,
+    /// tinydecimate, Hoppe's energy (`tinydecimate::cost::Energy`, κ =
+    /// `Energy::KAPPA`) with `Config::new()`.
+    Energy,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -148,6 +151,7 @@ impl Method {
         Method::StoredOptimal,
         Method::MeshoptUpdate,
         Method::VertexDecimation,
+        Method::Energy,
     ];
 
     /// The operator of our modes.
@@ -184,13 +188,14 @@ impl Method {
             Method::StoredOptimal => "stored quadric, optimal",
             Method::MeshoptUpdate => "meshoptimizer simplifyWithUpdate",
             Method::VertexDecimation => "vertex decimation",
+            Method::Energy => "energy (Hoppe)",
         }
     }
 
     /// The library configuration (before the ratio); `None` for meshoptimizer.
     pub fn config(self) -> Option<Config> {
         match self {
-            Method::Default | Method::VertexDecimation => Some(Config::new()),
+            Method::Default | Method::VertexDecimation | Method::Energy => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
@@ -209,6 +214,7 @@ impl Method {
             Method::StoredOptimal => "`StoredQuadric` (optimal placement) with `Config::stored()`",
             Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
             Method::VertexDecimation => "`VertexDecimation::new()` with `Config::new()`",
+            Method::Energy => "`Energy` (κ = 0.01) with `Config::new()`",
         }
     }
 
@@ -586,6 +592,7 @@ fn run_method(
                     placement,
                     weld: true,
                     prune,
+                    energy: (method == Method::Energy).then_some(tinydecimate::cost::Energy::KAPPA),
                     ..Default::default()
                 };
                 // The error limit measures a collapse: edge collapse only.
@@ -595,7 +602,8 @@ fn run_method(
                     config.with_ratio(ratio)
                 };
                 let (out, report, elapsed) = crate::simplify::simplify_with(mesh, &config, &run)?;
-                let quadrics = if placement.is_some() {
+                // Stored quadrics, or the energy's sample moments: 40 B per vertex either way.
+                let quadrics = if placement.is_some() || method == Method::Energy {
                     v * crate::workspace::QUADRIC_BYTES
                 } else {
                     0
