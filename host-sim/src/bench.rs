@@ -188,7 +188,7 @@ impl Method {
             Method::StoredOptimal => "stored quadric, optimal",
             Method::MeshoptUpdate => "meshoptimizer simplifyWithUpdate",
             Method::VertexDecimation => "vertex decimation",
-            Method::Energy => "energy (Hoppe)",
+            Method::Energy => "Hoppe's energy",
         }
     }
 
@@ -987,7 +987,7 @@ mod tests {
         );
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 6);
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 7);
     }
 
     #[test]
