@@ -180,9 +180,10 @@ impl<'a, L: Index> Storage<'a, L> {
             });
         }
         if config.error_limit.is_finite()
-            && (!matches!(O::KIND, Kind::Edge) || config.schedule != Schedule::Greedy)
+            && (matches!(O::KIND, Kind::Triangle) || config.schedule != Schedule::Greedy)
         {
-            // Only the greedy edge collapse measures each collapse's own error.
+            // Only the greedy edge collapse and vertex removal measure each operation's own
+            // error.
             return Err(Error::InvalidConfig {
                 field: ConfigField::ErrorLimit,
             });

@@ -437,7 +437,9 @@ impl Args {
     pub fn error_limit(&self) -> ErrorLimit {
         match self.error_limit {
             Some(e) => e,
-            None if self.schedule == ScheduleArg::Greedy && self.operator == OperatorArg::Edge => {
+            None if self.schedule == ScheduleArg::Greedy
+                && self.operator != OperatorArg::Triangle =>
+            {
                 ErrorLimit::At(MaxError::Fraction(DEFAULT_ERROR_LIMIT))
             }
             None => ErrorLimit::None,
