@@ -128,12 +128,16 @@ const MICROBIT_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-grid8",
     "pm-cow-quantised",
 ];
 /// No RAM for stored quadrics on the micro:bit and the lm3s6965evb (firmware
-/// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases either (they borrow it); the
-/// cow's progressive stream needs the 4 MB boards.
+/// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases (they borrow it) or the
+/// energy's samples either; the cow's cases need the 4 MB boards or the 400 KB RISC-V.
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
     "tray-new-u16",
@@ -146,13 +150,18 @@ const LM3S_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-cow-quantised",
 ];
 
 /// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream).
 const RISCV_400K_SKIPS: &[&str] = &[];
 /// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
-/// no RAM for stored quadrics or bounds, and the plate and the cow are too big.
+/// no RAM for stored quadrics, bounds or the energy's samples, and the plate and the cow are
+/// too big.
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
@@ -166,6 +175,10 @@ const RISCV_32K_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-cow-quantised",
 ];
 
@@ -341,7 +354,7 @@ mod tests {
                     let fit = (t * 3 * link / per).min(t);
                     c.positions.len() > v
                         || c.triangles.len() > fit
-                        || (c.stored.is_some() && c.positions.len() > qv)
+                        || (c.per_vertex_storage() && c.positions.len() > qv)
                         || (c.config.max_error.is_finite()
                             && c.triangles.len() * 3 * c.index_type.bytes()
                                 + tinydecimate::bound::control_len(

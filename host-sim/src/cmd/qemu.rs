@@ -218,5 +218,6 @@ pub fn mesh_case(path: &Path, ratio: f32, passes: bool, u32: bool) -> Result<Cas
         index_type: if u32 { IndexType::U32 } else { IndexType::U16 },
         config,
         stored: None,
+        method: None,
     })
 }
