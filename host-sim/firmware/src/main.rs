@@ -168,11 +168,17 @@ fn read_case(
         nt,
         h.index_type.bytes() * 8
     );
+    // A board without quadric storage runs none of the cases that borrow it, an empty one
+    // included, nor one without the stack for vertex decimation any of its cases:
+    // `run_library` leaves their code out of its image.
+    let entry = h.entry();
     if nv > board::MAX_VERTICES
         || nt > board::triangle_capacity(h.index_type)
-        || (h.entry().per_vertex_storage() && nv > board::QUADRIC_VERTICES)
-        || (h.bounded()
-            && board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES)
+        || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
+        || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
+        || (entry == meshfmt::Entry::Bounded
+            && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
+                || !board::HAS_QUADRICS))
     {
         defmt::warn!("the mesh does not fit this board");
         *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
@@ -422,6 +428,21 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use meshfmt::Entry;
     use tinydecimate::Placement;
+    // A board without quadric storage leaves out the entry points that borrow it (`read_case`
+    // skips their cases): the micro:bit's and the lm3s6965evb's 256 KB of flash do not hold
+    // them beside vertex decimation.
+    let left_out = match entry {
+        Entry::Simplify => false,
+        Entry::VertexDecimation => !board::VERTEX_DECIMATION,
+        _ => !board::HAS_QUADRICS,
+    };
+    if left_out {
+        return Err(tinydecimate::Error::Capacity {
+            what: tinydecimate::Capacity::Quadrics,
+            needed: positions.len(),
+            available: 0,
+        });
+    }
     match entry {
         Entry::Simplify => ws.simplify(positions, triangles, config),
         Entry::Bounded => run_bounded(ws, positions, triangles, config, quadrics),

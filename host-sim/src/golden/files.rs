@@ -307,6 +307,8 @@ pub fn judge(
             h.capacity_triangles,
             if case.per_vertex_storage() {
                 " (stored quadrics or energy samples: the firmware's QUADRIC_VERTICES may be lower)"
+            } else if case.method == Some(super::case::MethodName::VertexDecimation) {
+                " (vertex decimation: the firmware's VERTEX_DECIMATION, stack for a removal's buffers)"
             } else if case.config.max_error.is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {
