@@ -168,9 +168,9 @@ fn read_case(
         nt,
         h.index_type.bytes() * 8
     );
-    // A board without quadric storage runs none of the cases that borrow it, an empty one
-    // included, nor one without the stack for vertex decimation any of its cases:
-    // `run_library` leaves their code out of its image.
+    // A board without quadric storage skips every case that borrows it (an empty one too), a
+    // board without the stack for vertex decimation every vertex-decimation case:
+    // `run_library` leaves their code out of the image.
     let entry = h.entry();
     if nv > board::MAX_VERTICES
         || nt > board::triangle_capacity(h.index_type)
@@ -428,9 +428,10 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use meshfmt::Entry;
     use tinydecimate::Placement;
-    // A board without quadric storage leaves out the entry points that borrow it (`read_case`
-    // skips their cases): the micro:bit's and the lm3s6965evb's 256 KB of flash do not hold
-    // them beside vertex decimation.
+    // A board leaves out the entry points it cannot run (`read_case` skips their cases): the
+    // ones that borrow the quadric storage where there is none, vertex decimation where the
+    // stack is too small. With all of them the micro:bit's and the lm3s6965evb's images
+    // overflow their 256 KB of flash.
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
