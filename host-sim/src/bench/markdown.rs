@@ -139,11 +139,11 @@ fn header(s: &mut String, r: &Results) {
     let _ = writeln!(
         s,
         "* tinydecimate modes, each `.with_ratio(ratio)`: {}. As `host-sim simplify` runs \
-         them: vertices at one position welded (`--seams weld`), the greedy modes with the \
-         error limit of 2 % of the diagonal (`--error-limit`) and, unless the bench was given \
-         `--parts keep`, parts pruned (`--parts prune`); vertex decimation welded by position \
-         without wedges (positions only), without error limit or part pruning (none of them can \
-         describe a removal).",
+         them: vertices at one position welded (`--seams weld`), the greedy modes (vertex \
+         decimation too) with the error limit of 2 % of the diagonal (`--error-limit`) and, \
+         unless the bench was given `--parts keep`, parts pruned (`--parts prune`); vertex \
+         decimation welded by position without wedges (positions only) and without part \
+         pruning (a removal has no collapse cost to weigh a part against).",
         modes.join("; ")
     );
     let ratios: Vec<String> = r.ratios.iter().map(|x| fmt_pct(*x)).collect();
