@@ -139,7 +139,7 @@ impl core::fmt::Display for Error {
                 ),
                 ConfigField::Schedule => write!(
                     f,
-                    "configuration field Schedule: stored quadrics run the greedy schedule only"
+                    "configuration field Schedule: stored quadrics run the greedy or batched schedule only"
                 ),
                 ConfigField::Placement => write!(
                     f,

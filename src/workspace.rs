@@ -180,9 +180,9 @@ impl<'a, L: Index> Storage<'a, L> {
             });
         }
         if config.error_limit.is_finite()
-            && (!matches!(O::KIND, Kind::Edge) || config.schedule != Schedule::Greedy)
+            && (!matches!(O::KIND, Kind::Edge) || !config.schedule.is_ordered())
         {
-            // Only the greedy edge collapse measures each collapse's own error.
+            // Only the greedy and batched edge collapse measure each collapse's own error.
             return Err(Error::InvalidConfig {
                 field: ConfigField::ErrorLimit,
             });

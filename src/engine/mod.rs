@@ -10,6 +10,8 @@
 //!                   ^             in cost order, collapse, re-key the vertices whose fan changed
 //!                   └── when the mesh has halved (fresh feature threshold) or the queue is empty
 //! Passes: Mean ─> Flags ─> Pairs: sweep vertices in index order, pair, collapse ─> next pass
+//! Batched: Mean ─> Price ─> Batch: pop in price order, skip stale, collapse ─> next pass
+//!                    ^                  (Mean again first when the mesh has halved)
 //! ```
 //!
 //! A vertex's key is a lower bound: the price of its cheapest candidate under the flag and
@@ -38,6 +40,7 @@ use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
 use heap::Heap;
 
+mod batched;
 mod greedy;
 pub(crate) mod heap;
 mod log;
@@ -63,6 +66,10 @@ enum Phase {
     Queue,
     /// Passes: pairing vertices in index order.
     Pairs,
+    /// Batched: pricing every vertex's cheapest candidate into the pass's order.
+    Price,
+    /// Batched: collapsing in the pass's order.
+    Batch,
     /// Finished.
     Done(Stop),
 }
@@ -120,6 +127,12 @@ pub struct Simplifier<
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
     refresh_only: bool,
+    /// Batched: candidates taken from this pass's order so far.
+    pops: usize,
+    /// Batched: collapses this pass needs to reach the target (each removes two triangles).
+    pass_goal: usize,
+    /// Batched: the pass's own price limit, once the order has reached `pass_goal`.
+    pass_limit: f32,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
     /// Collapse log (`[removed, kept]`), written only once `record_into` gave one.
@@ -210,6 +223,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             reached2: 0.0,
             refresh_at: 0,
             refresh_only: false,
+            pops: 0,
+            pass_goal: 0,
+            pass_limit: f32::INFINITY,
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
             log: &mut [],
@@ -330,10 +346,16 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                         0.0
                     });
                     self.v = 0;
+                    if self.config.schedule == Schedule::Batched {
+                        self.refresh_at = self.mesh.live / 2;
+                    }
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.
                         self.refresh_only = false;
                         self.refresh_at = self.mesh.live / 2;
+                        if self.config.schedule == Schedule::Batched {
+                            return self.start_pass();
+                        }
                         self.phase = Phase::Queue;
                         return;
                     }
@@ -384,15 +406,17 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             }
             Phase::Queue => self.pop(),
             Phase::Pairs => self.pair(),
+            Phase::Price => self.price_next(),
+            Phase::Batch => self.batch(),
         }
     }
 
     /// The phase that starts a round's work.
     fn after_init(&self) -> Phase {
-        if self.config.schedule == Schedule::Passes {
-            Phase::Flags
-        } else {
-            Phase::Keys
+        match self.config.schedule {
+            Schedule::Passes => Phase::Flags,
+            Schedule::Greedy => Phase::Keys,
+            Schedule::Batched => Phase::Price,
         }
     }
 

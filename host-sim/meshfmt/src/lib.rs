@@ -132,6 +132,8 @@ pub enum ScheduleCode {
     Greedy = 0,
     /// `Schedule::Passes`.
     Passes = 1,
+    /// `Schedule::Batched`.
+    Batched = 2,
 }
 
 /// Cost code.
@@ -299,6 +301,7 @@ impl CaseHeader {
         let schedule = match r.u8() {
             0 => ScheduleCode::Greedy,
             1 => ScheduleCode::Passes,
+            2 => ScheduleCode::Batched,
             _ => return Err(FormatError::Code),
         };
         let vertices = r.u32();
@@ -641,6 +644,7 @@ pub mod lib {
             .with_schedule(match h.schedule {
                 ScheduleCode::Greedy => Schedule::Greedy,
                 ScheduleCode::Passes => Schedule::Passes,
+                ScheduleCode::Batched => Schedule::Batched,
             })
             .with_target(target(h.target_ratio, h.target_triangles))
             .with_lambda(h.lambda)
@@ -709,6 +713,7 @@ pub mod lib {
             schedule: match config.schedule {
                 Schedule::Greedy => ScheduleCode::Greedy,
                 Schedule::Passes => ScheduleCode::Passes,
+                Schedule::Batched => ScheduleCode::Batched,
             },
             cost: match config.cost {
                 CostKind::Quadric => CostCode::Quadric,

@@ -34,6 +34,10 @@ pub enum ScheduleArg {
     /// collapses in sweeps over the mesh, each vertex at most once per pass. For comparison
     /// with the paper; its error is higher than greedy's at the same triangle count.
     Passes,
+    /// Greedy in batches (meshoptimizer's passes): every vertex priced once per pass, the
+    /// pass collapsed in price order, skipping vertices an earlier collapse of the pass
+    /// touched; `Config::new()` otherwise.
+    Batched,
 }
 
 /// Which cost, on the command line (`Config::with_cost`).
@@ -437,7 +441,7 @@ impl Args {
     pub fn error_limit(&self) -> ErrorLimit {
         match self.error_limit {
             Some(e) => e,
-            None if self.schedule == ScheduleArg::Greedy && self.operator == OperatorArg::Edge => {
+            None if self.schedule != ScheduleArg::Passes && self.operator == OperatorArg::Edge => {
                 ErrorLimit::At(MaxError::Fraction(DEFAULT_ERROR_LIMIT))
             }
             None => ErrorLimit::None,
@@ -450,6 +454,7 @@ impl Args {
         let base = match self.schedule {
             ScheduleArg::Greedy => Config::new().with_schedule(Schedule::Greedy),
             ScheduleArg::Passes => Config::paper(),
+            ScheduleArg::Batched => Config::new().with_schedule(Schedule::Batched),
         };
         let base = match self.cost {
             Some(cost) => base.with_cost(cost.into()),

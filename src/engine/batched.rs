@@ -1,0 +1,217 @@
+//! The batched schedule (meshoptimizer's `simplifier.cpp` pass structure): each pass prices
+//! every vertex's cheapest candidate once, orders the vertices by that price and collapses in
+//! that order, skipping any vertex whose price an earlier collapse of the pass made stale.
+//!
+//! Memory: none of its own. The pass's order is a binary heap in the queue's arrays (one
+//! vertex slot and one key per vertex, the greedy queue's `heap` and `key`; the per-vertex
+//! slot array stays unused), and the per-pass lock is the `DONE` flag bit, which only the
+//! passes schedule uses otherwise.
+//!
+//! Staleness: the price of `x -> y` reads `x`'s fan (memoryless costs, the feature rule) or
+//! only the two vertices' states and positions (stored costs without the feature rule,
+//! [`Simplifier::keys_only_fall`]). A collapse `a -> b` changes the fans of `b` and of `a`'s
+//! other neighbours, and moves `b` if the cost places it, which changes the fans of `b`'s
+//! neighbours too; those vertices are locked for the rest of the pass. A popped vertex is
+//! walked and priced again, so a price that rose (a stored cost whose `y` grew, a refused
+//! cheapest candidate) sends it back into the order at its new price, as the greedy queue
+//! does; the legality rules run at commit, on the mesh as it is then.
+//!
+//! A pass ends when the order is empty, when the price popped is above the pass's limit
+//! (1.5 times the price of the candidate at the position in the order that would reach the
+//! target if every collapse before it were made: meshoptimizer's error goal) once the pass
+//! has made a collapse, or when a price is above [`Config::max_cost`](crate::Config::max_cost).
+//! A pass without a collapse ends the run (after pruning parts, if any may go): the next pass
+//! would price the same mesh the same way. Each pass walks every live vertex twice at most
+//! (pricing and its pop), and the feature threshold is taken afresh when the mesh has halved.
+
+use super::price::take_cheapest;
+use super::walk::MAX_CANDIDATES;
+use super::{Phase, Simplifier};
+use crate::index::Index;
+use crate::math::V3;
+use crate::mesh::{flag, NIL};
+use crate::operator::Operator;
+use crate::policy::bound::Bound;
+use crate::policy::cost::Cost;
+use crate::policy::legality::on;
+use crate::report::Stop;
+
+/// The pass's limit over the price of the candidate that would reach the target
+/// (meshoptimizer's `1.5f * edge_collapses[collapse_order[edge_collapse_goal]].error`).
+const PASS_LIMIT: f32 = 1.5;
+
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
+    /// Batched: prices the vertex under the cursor into the pass's order (its feature flag is
+    /// set against the threshold on the way), or ends the sweep.
+    pub(super) fn price_next(&mut self) {
+        if self.v == 0 {
+            self.heap.batch_clear();
+            self.pops = 0;
+            self.pass_limit = f32::INFINITY;
+            self.pass_goal = self.mesh.live.saturating_sub(self.target) / 2;
+        }
+        let nv = self.mesh.vertex_count();
+        if self.v >= nv {
+            self.v = 0;
+            self.phase = Phase::Batch;
+            return;
+        }
+        let v = self.v;
+        self.v += 1;
+        self.mesh.set_flag(v, flag::DONE, false);
+        let f = self.mesh.flags(v);
+        if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
+            return;
+        }
+        let mut w = self.unwalked();
+        let w = self.walk(v, &mut w);
+        let is = self.config.features && self.is_feature_now(w);
+        self.mesh.set_flag(v, flag::FEATURE, is);
+        self.features += is as usize;
+        if is && on!(Feature) {
+            return;
+        }
+        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
+        let n = self.candidates(v, w, &mut cand);
+        let mut key = f32::INFINITY;
+        for &(c, _) in cand.iter().take(n) {
+            if c < key {
+                key = c;
+            }
+        }
+        if n > 0 {
+            self.heap.batch_push(v, key);
+        }
+    }
+
+    /// Batched: one vertex from the pass's order, collapsed at its cheapest legal candidate
+    /// if its price is still that of the pass's pricing.
+    pub(super) fn batch(&mut self) {
+        if self.mesh.live <= self.target {
+            if self.twins_over() {
+                return;
+            }
+            return self.done(Stop::Target);
+        }
+        let Some((v, key)) = self.heap.batch_pop() else {
+            return self.end_pass();
+        };
+        self.pops += 1;
+        if self.pops == self.pass_goal + 1 {
+            // The candidate that would reach the target: the pass goes up to 1.5 times it.
+            self.pass_limit = PASS_LIMIT * key;
+        }
+        if key > self.pass_limit && self.pass_collapses > 0 {
+            return self.end_pass();
+        }
+        if self.mesh.has(v, flag::DONE) || !self.mesh.has(v, flag::USED) {
+            // Its fan changed in this pass: priced afresh in the next.
+            return;
+        }
+        if self.prune_below(key) {
+            // A part cheaper than this collapse went first (`with_parts`); `v` goes back.
+            self.heap.batch_push(v, key);
+            return;
+        }
+        if key > self.config.max_cost {
+            self.over_cost = true;
+            return self.end_pass();
+        }
+        let mut w = self.unwalked();
+        let w = self.walk(v, &mut w);
+        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
+        let n = self.candidates(v, w, &mut cand);
+        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        while let Some((c, to)) = take_cheapest(cand) {
+            if c > key {
+                // Its cheapest candidate was refused, or its price rose (a stored cost's
+                // kept vertex grew): back into the order at this price.
+                self.heap.batch_push(v, c);
+                return;
+            }
+            match self.legal(v, w, to, c) {
+                Ok((c, at)) => {
+                    if c > key {
+                        // Placement refused: at the kept vertex's own, higher price.
+                        self.heap.batch_push(v, c);
+                    } else if !self.over_error_limit(v, w, to, c) {
+                        self.collapse_batched(v, to, at);
+                    } else {
+                        // Not cut to reach a count: the next candidate, if any.
+                        continue;
+                    }
+                    return;
+                }
+                Err(r) => self.rejected.count(r),
+            }
+        }
+    }
+
+    /// Batched: collapses `a -> b` and locks the vertices whose prices it made stale for
+    /// the rest of the pass.
+    fn collapse_batched(&mut self, a: usize, b: usize, at: Option<([f32; 3], V3)>) {
+        if !self.log_collapse(a, b) {
+            return;
+        }
+        // Fans that change: `b`'s and those of `a`'s neighbours; a price that reads only the
+        // two vertices' states changes only onto `b` (see `keys_only_fall`), which is checked
+        // at the pop.
+        let fans = !self.keys_only_fall();
+        let mesh = &self.mesh;
+        if fans {
+            mesh.for_each_neighbour(a, |x| mesh.set_flag(x, flag::DONE, true));
+        }
+        mesh.set_flag(a, flag::DONE, true);
+        mesh.set_flag(b, flag::DONE, true);
+        self.apply(a, b, at);
+        if fans && at.is_some() {
+            // `b` moved: its neighbours' fans changed too.
+            let mesh = &self.mesh;
+            mesh.for_each_neighbour(b, |x| mesh.set_flag(x, flag::DONE, true));
+        }
+        self.collapses += 1;
+        self.pass_collapses += 1;
+    }
+
+    /// Batched: the end of a pass; the next one, or the end of the run.
+    fn end_pass(&mut self) {
+        self.heap.batch_clear();
+        if self.pass_collapses == 0 {
+            // Short of the target: the smallest parts may still go (`with_parts`).
+            if self.prune_below(f32::INFINITY) {
+                return self.start_pass();
+            }
+            let stop = if self.over_cost {
+                Stop::MaxCost
+            } else if self.round_over_limit {
+                Stop::ErrorLimit
+            } else {
+                Stop::NoLegalCollapse
+            };
+            return self.done(stop);
+        }
+        self.log_pass();
+        if self.passes >= self.config.max_passes {
+            self.phase = Phase::Done(Stop::MaxPasses);
+            return;
+        }
+        self.start_pass();
+    }
+
+    /// Batched: starts a pass, after a fresh feature threshold if the mesh has halved since
+    /// the last.
+    pub(super) fn start_pass(&mut self) {
+        self.v = 0;
+        self.over_cost = false;
+        self.round_over_limit = false;
+        if self.mesh.live <= self.refresh_at {
+            self.refresh_only = true;
+            self.phase = Phase::Mean;
+            return;
+        }
+        self.features = 0;
+        self.passes += 1;
+        self.pass_collapses = 0;
+        self.phase = Phase::Price;
+    }
+}
