@@ -727,7 +727,12 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
     let meshes = load_meshes(opts)?;
     let methods: Vec<Method> = Method::ALL
         .into_iter()
-        .filter(|m| !m.is_ours() || opts.modes.as_ref().is_none_or(|x| x.contains(m)))
+        .filter(|m| match (m, &opts.modes) {
+            (_, None) | (Method::Meshopt, _) => true,
+            // The reference of the modes that move vertices.
+            (Method::MeshoptUpdate, Some(x)) => x.contains(&Method::StoredOptimal),
+            (m, Some(x)) => x.contains(m),
+        })
         .collect();
     let steps = (meshes.len() * opts.ratios.len() * methods.len()) as u64;
     let bar = if opts.progress && std::io::stderr().is_terminal() {

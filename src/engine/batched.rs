@@ -96,16 +96,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let Some((v, key)) = self.heap.batch_pop() else {
             return self.end_pass();
         };
-        self.pops += 1;
-        if self.pops == self.pass_goal + 1 {
-            // The candidate that would reach the target: the pass goes up to 1.5 times it.
-            self.pass_limit = PASS_LIMIT * key;
-        }
         if key > self.pass_limit && self.pass_collapses > 0 {
             return self.end_pass();
         }
         if self.mesh.has(v, flag::DONE) || !self.mesh.has(v, flag::USED) {
             // Its fan changed in this pass: priced afresh in the next.
+            self.count_pop(key);
             return;
         }
         if self.prune_below(key) {
@@ -135,6 +131,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                         // Placement refused: at the kept vertex's own, higher price.
                         self.heap.batch_push(v, c);
                     } else if !self.over_error_limit(v, w, to, c) {
+                        self.count_pop(key);
                         self.collapse_batched(v, to, at);
                     } else {
                         // Not cut to reach a count: the next candidate, if any.
@@ -144,6 +141,18 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 }
                 Err(r) => self.rejected.count(r),
             }
+        }
+    }
+
+    /// Batched: counts a vertex of the order that was collapsed or skipped as stale; the one
+    /// that would reach the target if every one before it collapsed sets the pass's limit.
+    /// Vertices whose every candidate the rules refused do not count (unlike meshoptimizer's
+    /// count over its sorted edges): where the cheapest candidates are illegal, as on a messy
+    /// mesh near its target, they would set the limit so low that each pass made one collapse.
+    fn count_pop(&mut self, key: f32) {
+        self.pops += 1;
+        if self.pops == self.pass_goal + 1 {
+            self.pass_limit = PASS_LIMIT * key;
         }
     }
 
@@ -179,6 +188,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if self.pass_collapses == 0 {
             // Short of the target: the smallest parts may still go (`with_parts`).
             if self.prune_below(f32::INFINITY) {
+                return self.start_pass();
+            }
+            if self.mesh.live != self.mean_live && self.passes < self.config.max_passes {
+                // The feature threshold is older than the mesh: one more pass with it taken
+                // afresh (the greedy schedule's new round).
+                self.refresh_at = self.mesh.live;
                 return self.start_pass();
             }
             let stop = if self.over_cost {

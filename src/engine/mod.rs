@@ -127,8 +127,10 @@ pub struct Simplifier<
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
     refresh_only: bool,
-    /// Batched: candidates taken from this pass's order so far.
+    /// Batched: vertices of this pass's order collapsed or skipped as stale so far.
     pops: usize,
+    /// Batched: live triangles when the feature threshold was last taken.
+    mean_live: usize,
     /// Batched: collapses this pass needs to reach the target (each removes two triangles).
     pass_goal: usize,
     /// Batched: the pass's own price limit, once the order has reached `pass_goal`.
@@ -224,6 +226,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             refresh_at: 0,
             refresh_only: false,
             pops: 0,
+            mean_live: 0,
             pass_goal: 0,
             pass_limit: f32::INFINITY,
             pass_triangles: heapless::Vec::new(),
@@ -348,6 +351,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     self.v = 0;
                     if self.config.schedule == Schedule::Batched {
                         self.refresh_at = self.mesh.live / 2;
+                        self.mean_live = self.mesh.live;
                     }
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.

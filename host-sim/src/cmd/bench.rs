@@ -46,8 +46,8 @@ pub struct Args {
     /// cheaper than the next collapse vanish whole, `keep` keeps every part.
     #[arg(long, value_enum, default_value_t = super::simplify::PartsArg::Prune)]
     pub parts: super::simplify::PartsArg,
-    /// Only these of our modes, comma separated (default: every one); meshoptimizer and
-    /// simplifyWithUpdate always run, as the references.
+    /// Only these of our modes, comma separated (default: every one); meshoptimizer always
+    /// runs, as the reference (simplifyWithUpdate too with stored-optimal).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub modes: Option<Vec<crate::bench::Method>>,
 }
