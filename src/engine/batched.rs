@@ -53,14 +53,25 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let nv = self.mesh.vertex_count();
         if self.v >= nv {
             self.v = 0;
+            self.price_all = false;
             self.phase = Phase::Batch;
             return;
         }
         let v = self.v;
         self.v += 1;
-        self.mesh.set_flag(v, flag::DONE, false);
         let f = self.mesh.flags(v);
+        self.mesh.set_flag(v, flag::DONE | flag::RAISED, false);
         if f & flag::USED == 0 || (on!(Locked) && f & flag::LOCKED != 0) {
+            return;
+        }
+        if f & (flag::DONE | flag::RAISED) == 0 && self.reuses_keys() {
+            // Untouched since its last pricing: the same fan, flags and neighbours' positions
+            // give the same price (and the same feature flag under the same threshold).
+            self.features += (f & flag::FEATURE != 0) as usize;
+            let key = self.heap.batch_key(v);
+            if key.is_finite() {
+                self.heap.batch_push(v, key);
+            }
             return;
         }
         let mut w = self.unwalked();
@@ -69,7 +80,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         self.mesh.set_flag(v, flag::FEATURE, is);
         self.features += is as usize;
         if is && on!(Feature) {
-            return;
+            return self.heap.batch_set_key(v, f32::INFINITY);
         }
         let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
         let n = self.candidates(v, w, &mut cand);
@@ -81,7 +92,21 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         }
         if n > 0 {
             self.heap.batch_push(v, key);
+        } else {
+            self.heap.batch_set_key(v, f32::INFINITY);
         }
+    }
+
+    /// Batched: whether a vertex that no collapse touched since its last pricing keeps its
+    /// key: not in the first pass after a new feature threshold (whose pricing is a full one),
+    /// not for a cost whose price onto a vertex changes when that vertex grows (stored
+    /// quadrics: only the kept vertex is locked), and not when a candidate's price depends on
+    /// whether its kept vertex is a feature (the paper's rule), which can change with that
+    /// vertex's own fan.
+    fn reuses_keys(&self) -> bool {
+        !self.price_all
+            && !self.cost.stores()
+            && (!self.config.features || self.rules.feature_targets)
     }
 
     /// Batched: one vertex from the pass's order, collapsed at its cheapest legal candidate
@@ -121,8 +146,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         while let Some((c, to)) = take_cheapest(cand) {
             if c > key {
                 // Its cheapest candidate was refused, or its price rose (a stored cost's
-                // kept vertex grew): back into the order at this price.
+                // kept vertex grew): back into the order at this price, and priced in full
+                // in the next pass (the key is no longer its cheapest price).
                 self.heap.batch_push(v, c);
+                self.mesh.set_flag(v, flag::RAISED, true);
                 return;
             }
             match self.legal(v, w, to, c) {
@@ -130,6 +157,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     if c > key {
                         // Placement refused: at the kept vertex's own, higher price.
                         self.heap.batch_push(v, c);
+                        self.mesh.set_flag(v, flag::RAISED, true);
                     } else if !self.over_error_limit(v, w, to, c) {
                         self.count_pop(key);
                         self.collapse_batched(v, to, at);

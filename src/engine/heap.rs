@@ -195,6 +195,18 @@ impl<'a, L: Index> Heap<'a, L> {
         self.put(slot, v);
     }
 
+    /// Batched: `v`'s key, whether or not it is in the order.
+    pub(crate) fn batch_key(&self, v: usize) -> f32 {
+        self.key_of(v)
+    }
+
+    /// Batched: sets `v`'s key without putting it in the order.
+    pub(crate) fn batch_set_key(&mut self, v: usize, key: f32) {
+        if let Some(k) = self.key.get_mut(v) {
+            *k = key;
+        }
+    }
+
     /// Batched: takes the cheapest vertex of the pass's order and its key.
     pub(crate) fn batch_pop(&mut self) -> Option<(usize, f32)> {
         if self.len == 0 {

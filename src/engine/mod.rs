@@ -131,6 +131,8 @@ pub struct Simplifier<
     pops: usize,
     /// Batched: live triangles when the feature threshold was last taken.
     mean_live: usize,
+    /// Batched: the pricing under way prices every vertex (the first after a new threshold).
+    price_all: bool,
     /// Batched: collapses this pass needs to reach the target (each removes two triangles).
     pass_goal: usize,
     /// Batched: the pass's own price limit, once the order has reached `pass_goal`.
@@ -227,6 +229,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             refresh_only: false,
             pops: 0,
             mean_live: 0,
+            price_all: true,
             pass_goal: 0,
             pass_limit: f32::INFINITY,
             pass_triangles: heapless::Vec::new(),
@@ -352,6 +355,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     if self.config.schedule == Schedule::Batched {
                         self.refresh_at = self.mesh.live / 2;
                         self.mean_live = self.mesh.live;
+                        self.price_all = true;
                     }
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.
