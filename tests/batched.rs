@@ -95,12 +95,12 @@ fn the_error_limit_holds() {
     m.positions[apex][2] = 0.3;
     let config = batched().with_target(Target::Triangles(8));
     let limit = 0.05;
-    // A limit too high to refuse anything: the spike goes (the last few triangles of the
-    // square may be refused by the shape rules).
+    // A limit too high to refuse anything: the run cuts into the spike, with collapses over
+    // the limit below (the last few triangles of the square may be refused by the shape rules).
     let (_, r) = simplify(&m, &config.with_error_limit(1e6));
     assert_ne!(r.stop, Stop::ErrorLimit, "{r:?}");
     assert!(r.triangles_out <= 16, "{r:?}");
-    assert!(r.collapse_error > 2.0 * limit, "{}", r.collapse_error);
+    assert!(r.collapse_error > limit, "{}", r.collapse_error);
     let (out, r) = simplify(&m, &config.with_error_limit(limit));
     assert_eq!(r.stop, Stop::ErrorLimit, "{r:?}");
     assert!(!r.target_reached);
