@@ -17,7 +17,8 @@ pub enum Schedule {
     /// a vertex whose price a collapse earlier in the pass made stale; a pass ends at its error
     /// limit (1.5 times the price of the candidate that would reach the target) and the next
     /// pass prices afresh. Same rules, limits and stops as [`Schedule::Greedy`], with no
-    /// re-pricing after each collapse; the order is exact within a pass only.
+    /// re-pricing after each collapse; the order is exact within a pass only. Needs the crate
+    /// feature `batched` (else [`Storage::start`](crate::Storage::start) refuses it).
     Batched,
 }
 

@@ -172,6 +172,11 @@ impl<'a, L: Index> Storage<'a, L> {
             bound.prepare(triangles, nv, config)?;
         }
         config.validate()?;
+        if config.schedule == Schedule::Batched && !cfg!(feature = "batched") {
+            return Err(Error::InvalidConfig {
+                field: ConfigField::Schedule,
+            });
+        }
         if (!matches!(O::KIND, Kind::Edge) && config.schedule != Schedule::Greedy)
             || (matches!(O::KIND, Kind::Removal) && B::ON)
         {

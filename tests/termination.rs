@@ -44,13 +44,18 @@ fn operations_are_bounded_by_the_mesh_size() {
         ("grid", grid(40, 30, 0.2)),
     ] {
         let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
-        for config in [
+        let mut configs = vec![
             Config::new().with_ratio(0.0),
             Config::paper().with_ratio(0.0),
-            Config::new()
-                .with_ratio(0.0)
-                .with_schedule(Schedule::Batched),
-        ] {
+        ];
+        if cfg!(feature = "batched") {
+            configs.push(
+                Config::new()
+                    .with_ratio(0.0)
+                    .with_schedule(Schedule::Batched),
+            );
+        }
+        for config in configs {
             let (ops, collapses, passes) = operations(&m, &config);
             // Sweeps: 3 per pass/round over V vertices, and one per halving of the mesh
             // (greedy's threshold refresh); queue: pops per collapse.

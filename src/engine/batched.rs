@@ -32,18 +32,62 @@
 //! vertices the last pass locked. The feature threshold is taken afresh (a full sweep, then
 //! a full pricing) when the mesh has halved.
 
-use super::price::take_cheapest;
-use super::walk::MAX_CANDIDATES;
-use super::{Phase, Simplifier};
+use super::Simplifier;
 use crate::index::Index;
-use crate::math::V3;
-use crate::mesh::{flag, NIL};
 use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
-use crate::policy::legality::on;
-use crate::report::Stop;
+#[cfg(feature = "batched")]
+use {
+    super::price::take_cheapest,
+    super::walk::MAX_CANDIDATES,
+    super::Phase,
+    crate::math::V3,
+    crate::mesh::{flag, NIL},
+    crate::policy::legality::on,
+    crate::report::Stop,
+};
 
+/// The state of the pass under way.
+#[cfg(feature = "batched")]
+pub(super) struct Pass {
+    /// Vertices of this pass's order collapsed or skipped as stale so far.
+    pops: usize,
+    /// Collapses this pass needs to reach the target (each removes two triangles).
+    goal: usize,
+    /// The pass's own price limit, once the order has reached `goal`.
+    limit: f32,
+    /// Live triangles when the feature threshold was last taken.
+    mean_live: usize,
+    /// The pricing under way prices every vertex (the first after a new threshold).
+    price_all: bool,
+}
+
+#[cfg(feature = "batched")]
+impl Pass {
+    pub(super) const fn new() -> Self {
+        Pass {
+            pops: 0,
+            goal: 0,
+            limit: f32::INFINITY,
+            mean_live: 0,
+            price_all: true,
+        }
+    }
+}
+
+/// Without the `batched` feature: nothing (`Storage::start` refuses the schedule).
+#[cfg(not(feature = "batched"))]
+pub(super) struct Pass;
+
+#[cfg(not(feature = "batched"))]
+impl Pass {
+    pub(super) const fn new() -> Self {
+        Pass
+    }
+}
+
+#[cfg(feature = "batched")]
 /// The pass's limit over the price of the candidate that would reach the target.
 /// meshoptimizer takes 1.5 (`1.5f * edge_collapses[collapse_order[edge_collapse_goal]].error`);
 /// with the memoryless cost 1.0 gives a lower mean error against the greedy order over the
@@ -52,20 +96,28 @@ use crate::report::Stop;
 /// cow to 10 %: 12 passes against 10, 73.6 M against 72.6 M in the engine).
 const PASS_LIMIT: f32 = 1.0;
 
+#[cfg(feature = "batched")]
 impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
+    /// Batched: the feature threshold was just taken: the next pricing is a full one.
+    pub(super) fn threshold_taken(&mut self) {
+        self.refresh_at = self.mesh.live / 2;
+        self.batch.mean_live = self.mesh.live;
+        self.batch.price_all = true;
+    }
+
     /// Batched: prices the vertex under the cursor into the pass's order (its feature flag is
     /// set against the threshold on the way), or ends the sweep.
     pub(super) fn price_next(&mut self) {
         if self.v == 0 {
             self.heap.batch_clear();
-            self.pops = 0;
-            self.pass_limit = f32::INFINITY;
-            self.pass_goal = self.mesh.live.saturating_sub(self.target) / 2;
+            self.batch.pops = 0;
+            self.batch.limit = f32::INFINITY;
+            self.batch.goal = self.mesh.live.saturating_sub(self.target) / 2;
         }
         let nv = self.mesh.vertex_count();
         if self.v >= nv {
             self.v = 0;
-            self.price_all = false;
+            self.batch.price_all = false;
             self.phase = Phase::Batch;
             return;
         }
@@ -116,7 +168,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// whether its kept vertex is a feature (the paper's rule), which can change with that
     /// vertex's own fan.
     fn reuses_keys(&self) -> bool {
-        !self.price_all
+        !self.batch.price_all
             && !self.cost.stores()
             && (!self.config.features || self.rules.feature_targets)
     }
@@ -133,7 +185,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let Some((v, key)) = self.heap.batch_pop() else {
             return self.end_pass();
         };
-        if key > self.pass_limit && self.pass_collapses > 0 {
+        if key > self.batch.limit && self.pass_collapses > 0 {
             return self.end_pass();
         }
         if self.mesh.has(v, flag::DONE) || !self.mesh.has(v, flag::USED) {
@@ -190,9 +242,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// count over its sorted edges): where the cheapest candidates are illegal, as on a messy
     /// mesh near its target, they would set the limit so low that each pass made one collapse.
     fn count_pop(&mut self, key: f32) {
-        self.pops += 1;
-        if self.pops == self.pass_goal + 1 {
-            self.pass_limit = PASS_LIMIT * key;
+        self.batch.pops += 1;
+        if self.batch.pops == self.batch.goal + 1 {
+            self.batch.limit = PASS_LIMIT * key;
         }
     }
 
@@ -230,7 +282,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             if self.prune_below(f32::INFINITY) {
                 return self.start_pass();
             }
-            if self.mesh.live != self.mean_live && self.passes < self.config.max_passes {
+            if self.mesh.live != self.batch.mean_live && self.passes < self.config.max_passes {
                 // The feature threshold is older than the mesh: one more pass with it taken
                 // afresh (the greedy schedule's new round).
                 self.refresh_at = self.mesh.live;
@@ -269,4 +321,23 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         self.pass_collapses = 0;
         self.phase = Phase::Price;
     }
+}
+
+#[cfg(not(feature = "batched"))]
+impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'a, L, I, C, B, O> {
+    /// Without the feature no run reaches a batched phase.
+    #[inline(always)]
+    pub(super) fn threshold_taken(&mut self) {}
+
+    /// Without the feature no run reaches a batched phase.
+    #[inline(always)]
+    pub(super) fn price_next(&mut self) {}
+
+    /// Without the feature no run reaches a batched phase.
+    #[inline(always)]
+    pub(super) fn batch(&mut self) {}
+
+    /// Without the feature no run reaches a batched phase.
+    #[inline(always)]
+    pub(super) fn start_pass(&mut self) {}
 }

@@ -163,6 +163,7 @@ impl<'a, L: Index> Heap<'a, L> {
         }
     }
 
+    #[cfg(feature = "batched")]
     /// Batched: empties the queue for a pass's order. The batched schedule never uses the
     /// per-vertex slots (they stay unset), so [`Heap::remove`] and [`Heap::queued`] see no
     /// vertex queued.
@@ -170,6 +171,7 @@ impl<'a, L: Index> Heap<'a, L> {
         self.len = 0;
     }
 
+    #[cfg(feature = "batched")]
     /// Batched: puts `v` in the pass's order with `key` (a binary heap on the same arrays,
     /// without the slots: `v` must not be in it already).
     pub(crate) fn batch_push(&mut self, v: usize, key: f32) {
@@ -195,11 +197,13 @@ impl<'a, L: Index> Heap<'a, L> {
         self.put(slot, v);
     }
 
+    #[cfg(feature = "batched")]
     /// Batched: `v`'s key, whether or not it is in the order.
     pub(crate) fn batch_key(&self, v: usize) -> f32 {
         self.key_of(v)
     }
 
+    #[cfg(feature = "batched")]
     /// Batched: sets `v`'s key without putting it in the order.
     pub(crate) fn batch_set_key(&mut self, v: usize, key: f32) {
         if let Some(k) = self.key.get_mut(v) {
@@ -207,6 +211,7 @@ impl<'a, L: Index> Heap<'a, L> {
         }
     }
 
+    #[cfg(feature = "batched")]
     /// Batched: takes the cheapest vertex of the pass's order and its key.
     pub(crate) fn batch_pop(&mut self) -> Option<(usize, f32)> {
         if self.len == 0 {
@@ -239,6 +244,7 @@ impl<'a, L: Index> Heap<'a, L> {
         Some((top, self.key_of(top)))
     }
 
+    #[cfg(feature = "batched")]
     /// Writes `v` at `slot` of the order only (the batched heap keeps no slots).
     fn put(&mut self, slot: usize, v: usize) {
         if let Some(h) = self.heap.get_mut(slot) {

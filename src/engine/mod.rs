@@ -69,6 +69,7 @@ enum Phase {
     /// Batched: pricing every vertex's cheapest candidate into the pass's order.
     Price,
     /// Batched: collapsing in the pass's order.
+    #[cfg_attr(not(feature = "batched"), allow(dead_code))]
     Batch,
     /// Finished.
     Done(Stop),
@@ -127,16 +128,9 @@ pub struct Simplifier<
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
     refresh_only: bool,
-    /// Batched: vertices of this pass's order collapsed or skipped as stale so far.
-    pops: usize,
-    /// Batched: live triangles when the feature threshold was last taken.
-    mean_live: usize,
-    /// Batched: the pricing under way prices every vertex (the first after a new threshold).
-    price_all: bool,
-    /// Batched: collapses this pass needs to reach the target (each removes two triangles).
-    pass_goal: usize,
-    /// Batched: the pass's own price limit, once the order has reached `pass_goal`.
-    pass_limit: f32,
+    /// Batched: the pass under way (nothing without the `batched` feature).
+    #[cfg_attr(not(feature = "batched"), allow(dead_code))]
+    batch: batched::Pass,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
     /// Collapse log (`[removed, kept]`), written only once `record_into` gave one.
@@ -227,11 +221,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             reached2: 0.0,
             refresh_at: 0,
             refresh_only: false,
-            pops: 0,
-            mean_live: 0,
-            price_all: true,
-            pass_goal: 0,
-            pass_limit: f32::INFINITY,
+            batch: batched::Pass::new(),
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
             log: &mut [],
@@ -353,9 +343,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     });
                     self.v = 0;
                     if self.config.schedule == Schedule::Batched {
-                        self.refresh_at = self.mesh.live / 2;
-                        self.mean_live = self.mesh.live;
-                        self.price_all = true;
+                        self.threshold_taken();
                     }
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.
