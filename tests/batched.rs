@@ -11,6 +11,7 @@
 //! * `stored_quadrics_and_twins`: stored quadrics (both placements) and a double-sided
 //!   surface run under the batched schedule too.
 //! * `the_papers_feature_rule` and `passes_are_capped`.
+//! * `parts_vanish_whole` (with the `parts` feature): pruning under the batched schedule.
 
 mod common;
 
@@ -231,5 +232,84 @@ mod on {
         assert_eq!(r.passes, 2);
         assert!(!r.target_reached);
         assert_valid("cow, two passes", &m, &out, &r);
+    }
+
+    /// A wavy sheet and ten small octahedra beside it: with `with_parts` the batched run
+    /// reaches a target that needs parts to go, each part whole or gone, valid, and in steps
+    /// of one operation gives the one-shot bytes.
+    #[cfg(feature = "parts")]
+    #[test]
+    fn parts_vanish_whole() {
+        let mut m = grid(24, 24, 0.15);
+        for i in 0..10 {
+            let (b, r) = (m.positions.len() as u32, 0.01 + 0.002 * i as f32);
+            let c = [0.1 * i as f32, 1.2, 0.05];
+            for d in [
+                [r, 0.0, 0.0],
+                [-r, 0.0, 0.0],
+                [0.0, r, 0.0],
+                [0.0, -r, 0.0],
+                [0.0, 0.0, r],
+                [0.0, 0.0, -r],
+            ] {
+                m.positions.push([c[0] + d[0], c[1] + d[1], c[2] + d[2]]);
+            }
+            for [x, y, z] in [
+                [0, 2, 4],
+                [2, 1, 4],
+                [1, 3, 4],
+                [3, 0, 4],
+                [2, 0, 5],
+                [1, 2, 5],
+                [3, 1, 5],
+                [0, 3, 5],
+            ] {
+                m.triangles.push([b + x, b + y, b + z]);
+            }
+        }
+        let config = batched().with_ratio(0.05);
+        let run = |budget: u32| {
+            let mut tris = m.triangles.clone();
+            let mut links = vec![[0u32; 2]; m.positions.len()];
+            let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+            let mut s = ws
+                .start(
+                    Positions::Read(&m.positions),
+                    &mut tris,
+                    &config,
+                    Builtin::new(),
+                    NoBound,
+                    EdgeCollapse,
+                )
+                .expect("start")
+                .with_parts(&mut links)
+                .expect("parts");
+            while !s.step(budget) {}
+            let r = s.finish();
+            (tris, r)
+        };
+        let (one, r) = run(u32::MAX);
+        let (stepped, rs) = run(1);
+        assert_eq!(one, stepped);
+        assert_eq!(r, rs);
+        assert!(r.target_reached, "{r:?}");
+        assert!(r.parts_removed > 0, "{r:?}");
+        let (out, r) = output(&m.positions, one, r);
+        for i in 0..10u32 {
+            let part = 625 + 6 * i..625 + 6 * (i + 1);
+            let inside = |t: &&[u32; 3]| t.iter().all(|v| part.contains(v));
+            let kept = out.triangles.iter().filter(inside).count();
+            assert!(kept == 0 || kept == 8, "part {i}: {kept} of 8");
+        }
+        let v = verdict_opts(
+            &m,
+            &out,
+            &meshcheck::Options {
+                parts: true,
+                ..Default::default()
+            },
+        );
+        v.assert_valid("sheet and bolts, batched");
+        assert_eq!(v.parts_removed, r.parts_removed);
     }
 }
