@@ -120,7 +120,7 @@ pub use engine::Simplifier;
 pub use error::{Capacity, ConfigField, Error};
 pub use index::Index;
 pub use legality::{Reject, RULES};
-pub use operator::{EdgeCollapse, TriangleCollapse, VertexDecimation};
+pub use operator::{EdgeCollapse, Fill, TriangleCollapse, VertexDecimation};
 pub use progressive::Progressive;
 pub use report::{Rejections, Report, Stop, PASS_LOG};
 pub use workspace::{Positions, Storage, Workspace};

@@ -9,8 +9,8 @@
 
 mod decimate;
 
-pub use decimate::VertexDecimation;
-pub(crate) use decimate::{classify, triangulate, MAX_RING};
+pub(crate) use decimate::{classify, plan, Fan as RemovalFan, MAX_RING};
+pub use decimate::{Fill, VertexDecimation};
 
 mod sealed {
     pub trait Sealed {}

@@ -185,9 +185,10 @@ impl<'a, L: Index> Storage<'a, L> {
             });
         }
         if config.error_limit.is_finite()
-            && (!matches!(O::KIND, Kind::Edge) || !config.schedule.is_ordered())
+            && (matches!(O::KIND, Kind::Triangle) || !config.schedule.is_ordered())
         {
-            // Only the greedy and batched edge collapse measure each collapse's own error.
+            // Only the greedy and batched edge collapse and vertex removal measure each
+            // operation's own error.
             return Err(Error::InvalidConfig {
                 field: ConfigField::ErrorLimit,
             });

@@ -158,12 +158,6 @@ fn refused_combinations() {
             field: ConfigField::Operator
         })
     );
-    assert_eq!(
-        start(&Config::new().with_error_limit(0.1)),
-        Err(Error::InvalidConfig {
-            field: ConfigField::ErrorLimit
-        })
-    );
     // An error bound.
     let original = m.triangles.clone();
     let mut links = vec![0u32; tinydecimate::bound::control_len(original.len(), m.positions.len())];

@@ -8,7 +8,8 @@ mod common;
 use common::*;
 use tinydecimate::cost::VertexQuadric;
 use tinydecimate::{
-    Config, EdgeCollapse, NoBound, Placement, Positions, Report, Stop, StoredQuadric, Target,
+    Builtin, Config, EdgeCollapse, NoBound, Placement, Positions, Report, Stop, StoredQuadric,
+    Target, VertexDecimation,
 };
 
 const HEIGHT: f32 = 0.3;
@@ -39,6 +40,23 @@ fn stored(m: &MeshData, config: &Config) -> (MeshData, Report) {
             StoredQuadric::new(&mut q, Placement::Subset),
             NoBound,
             EdgeCollapse,
+        )
+        .expect("start")
+        .run();
+    output(&m.positions, tris, r)
+}
+
+fn decimate(m: &MeshData, config: &Config) -> (MeshData, Report) {
+    let mut ws = BIG.lock().unwrap_or_else(|e| e.into_inner());
+    let mut tris = m.triangles.clone();
+    let r = ws
+        .start(
+            Positions::Read(&m.positions),
+            &mut tris,
+            config,
+            Builtin::new(),
+            NoBound,
+            VertexDecimation::new(),
         )
         .expect("start")
         .run();
@@ -111,4 +129,35 @@ fn a_limit_nothing_reaches_changes_nothing() {
     assert_eq!(rb.stop, Stop::Target);
     assert_eq!(rb.over_limit, 0);
     assert!(rb.collapse_error > 0.0);
+}
+
+/// Vertex decimation measures each removal's own error too: the removed vertex's distance to
+/// the farthest plane of its new triangles (or the boundary's retreat). On the cow down to
+/// 2 %: without a limit some removal is over 1 % of the diagonal; with that limit the run
+/// stops on it, every removal under it, and the output valid.
+#[test]
+fn the_limit_holds_with_vertex_decimation() {
+    let m = load_obj("cow.obj");
+    let config = Config::new().with_ratio(0.02);
+    let limit = 0.01 * diagonal(&m);
+    let (_, r) = decimate(&m, &config.with_error_limit(1e6));
+    assert!(r.collapse_error > limit, "{r:?}");
+    let (out, r) = decimate(&m, &config.with_error_limit(limit));
+    assert_eq!(r.stop, Stop::ErrorLimit, "{r:?}");
+    assert!(r.over_limit > 0);
+    assert!(r.collapse_error <= limit, "{} > {limit}", r.collapse_error);
+    assert!(out.triangles.len() < m.triangles.len() / 4, "{r:?}");
+    assert_valid("cow", &m, &out, &r);
+}
+
+/// The bounding box's diagonal.
+fn diagonal(m: &MeshData) -> f32 {
+    let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+    for p in &m.positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>().sqrt()
 }

@@ -604,8 +604,8 @@ fn run_method(
                     energy: (method == Method::Energy).then_some(tinydecimate::cost::Energy::KAPPA),
                     ..Default::default()
                 };
-                // The error limit measures a collapse: edge collapse only.
-                let config = if method.operator() == crate::simplify::OperatorArg::Edge {
+                // The error limit measures a collapse or a removal (not a triangle collapse).
+                let config = if method.operator() != crate::simplify::OperatorArg::Triangle {
                     with_default_limit(config.with_ratio(ratio), mesh)
                 } else {
                     config.with_ratio(ratio)

@@ -6,7 +6,7 @@ use super::Simplifier;
 use crate::index::Index;
 use crate::math::V3;
 use crate::mesh::{flag, NIL};
-use crate::operator::{classify, triangulate, Operator, MAX_RING};
+use crate::operator::{classify, plan, Fill, Operator, MAX_RING};
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::legality::{self, on};
@@ -29,12 +29,24 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 return self.heap.remove(v);
             }
         }
-        match self
-            .operator
-            .removal()
-            .and_then(|op| classify(&self.mesh, v, &op))
-        {
-            Some(fan) => self.heap.set(v, fan.key),
+        let Some(op) = self.operator.removal() else {
+            return self.heap.remove(v);
+        };
+        let Some(fan) = classify(&self.mesh, v, &op) else {
+            return self.heap.remove(v);
+        };
+        if op.fill == Fill::Shape {
+            return self.heap.set(v, fan.key);
+        }
+        // The key is the fit of the fill the pop will make.
+        match self.fill(
+            v,
+            &fan,
+            &op,
+            &mut [[0; 3]; MAX_RING],
+            &mut [[0.0; 3]; MAX_RING],
+        ) {
+            Some((_, key, _)) => self.heap.set(v, key),
             None => self.heap.remove(v),
         }
     }
@@ -62,15 +74,20 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let Some(fan) = classify(&self.mesh, v, &op) else {
             return;
         };
-        let mut pos: [V3; MAX_RING] = [[0.0; 3]; MAX_RING];
-        for (p, &x) in pos.iter_mut().zip(fan.ring()) {
-            *p = self.mesh.p(x);
-        }
         let mut new = [[0u8; 3]; MAX_RING];
         let mut planes = [[0.0f32; 3]; MAX_RING];
-        let Ok(n) = triangulate(&fan, &pos, op.min_aspect, &mut new, &mut planes) else {
+        let Some((n, _, err2)) = self.fill(v, &fan, &op, &mut new, &mut planes) else {
             return;
         };
+        if self.limit2.is_finite() {
+            // Not cut to reach a count (`Config::error_limit`): the vertex waits until its
+            // fan changes.
+            if err2 > self.limit2 {
+                self.over_limit = self.over_limit.saturating_add(1);
+                self.round_over_limit = true;
+                return;
+            }
+        }
         let new = new.get(..n).unwrap_or(&[]);
         if let Err(r) = legality::check_fan(
             &self.mesh,
@@ -90,10 +107,36 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             // Nothing was replaced (cannot happen after `classify`): the vertex stays out.
             return;
         }
+        if self.limit2.is_finite() && err2 > self.reached2 {
+            self.reached2 = err2;
+        }
         self.collapses += 1;
         self.pass_collapses += 1;
         for &x in fan.ring() {
             self.rekey(x);
         }
+    }
+
+    /// `v`'s new fan (`operator::plan`) and its key, if it has one.
+    fn fill(
+        &self,
+        v: usize,
+        fan: &crate::operator::RemovalFan,
+        op: &crate::VertexDecimation,
+        new: &mut [[u8; 3]; MAX_RING],
+        planes: &mut [V3; MAX_RING],
+    ) -> Option<(usize, f32, f32)> {
+        let mut pos: [V3; MAX_RING] = [[0.0; 3]; MAX_RING];
+        for (p, &x) in pos.iter_mut().zip(fan.ring()) {
+            *p = self.mesh.p(x);
+        }
+        // Twice the mean triangle area of the last Mean sweep.
+        let live = self.mesh.live as f32;
+        let reference = if live > 0.0 {
+            self.area2 / (3.0 * live)
+        } else {
+            0.0
+        };
+        plan(fan, self.mesh.p(v), &pos, op, reference, new, planes).ok()
     }
 }

@@ -16,6 +16,9 @@ pub(crate) const MAX_RING: usize = 32;
 /// split plane over the split line's length): 1/25. At 0.1 the CAD meshes (long thin fans)
 /// stopped near half their triangles; at 0.01 they reach 10 % with thin triangles.
 const MIN_ASPECT: f32 = 0.04;
+/// cos 60°: with [`Fill::Fit`], a vertex with more than two spokes sharper than this is a
+/// corner (a CAD model's corner); softer ones (a coarse organic mesh has many) may move.
+const COS_HARD: f32 = 0.5;
 
 /// Vertex decimation (Schroeder, Zarge and Lorensen 1992): a vertex is removed with its
 /// triangles, and the hole is filled by triangulating the loop of its neighbours.
@@ -46,6 +49,20 @@ const MIN_ASPECT: f32 = 0.04;
 /// Order: the greedy queue, smallest distance first (ties by vertex index); `Config::max_cost`
 /// is Schroeder's threshold (no removal farther than it), the target count the stop.
 ///
+/// That is [`Fill::Shape`], the paper as written. The default, [`Fill::Fit`], keeps the
+/// classification and the loop splitting but chooses the fill by how well it fits: the
+/// candidates are the loop splitting's triangulation and the ring's fans (the fan from one
+/// ring vertex to the rest of the loop, which is the half-edge collapse of the removed vertex
+/// onto it), the fit of each is the area-weighted squared distance from the removed vertex to
+/// the planes of the new triangles (plus, on a boundary, its squared distance to the new
+/// boundary edge times their area), times the memoryless quadric's thin-part factor
+/// `1 + Ā / A_fan`, and the key is the best fit. Feature lines restrict the fans to those from
+/// the ends of feature spokes (a dart or a soft corner moves along one of its feature lines; an
+/// interior-edge vertex along its line), and only a vertex with more than two spokes sharper
+/// than 60° is a corner that never goes. Schroeder's distance orders by shape alone and the
+/// loop splitting fills for shape alone, so error piles up where vertices go in turn (the cow
+/// at 10 %: Metro mean 1.14 % of the diagonal as written, 0.26 % fitted; docs/decimation.md).
+///
 /// Triangulation: recursive loop splitting. A split line joins two loop vertices that are not
 /// neighbours; its split plane holds the line and the average plane's normal. A split is
 /// valid when the two halves of the loop lie strictly on opposite sides of the plane (each on
@@ -67,12 +84,17 @@ const MIN_ASPECT: f32 = 0.04;
 /// `k − 2` (`k − 1` on a boundary) written into the first of their own slots: fixed memory,
 /// triangles in the caller's buffer, positions only read.
 ///
-/// Greedy schedule only, without an error bound, an error limit, welded seams or a collapse
-/// log (none of these can describe a removal): [`Storage::start`](crate::Storage::start)
-/// refuses the first three with [`ConfigField::Operator`](crate::ConfigField::Operator) (the
-/// error limit with [`ConfigField::ErrorLimit`](crate::ConfigField::ErrorLimit)); a welded run
-/// removes nothing (every candidate counts as a `seam` refusal) and a logged one stops at once
-/// with [`Stop::LogFull`](crate::Stop::LogFull). The report's `collapses` counts removals.
+/// [`Config::error_limit`](crate::Config::error_limit) refuses a removal whose own error is
+/// over it: the removed vertex's distance to the farthest plane of its new triangles, or how
+/// far the boundary retreats ([`Fill::Shape`]: Schroeder's distance); such a vertex waits until
+/// its fan changes, and a run that ends short because of such refusals stops with
+/// [`Stop::ErrorLimit`](crate::Stop::ErrorLimit).
+///
+/// Greedy schedule only, without an error bound, welded seams or a collapse log (none of
+/// these can describe a removal): [`Storage::start`](crate::Storage::start) refuses the first
+/// two with [`ConfigField::Operator`](crate::ConfigField::Operator); a welded run removes
+/// nothing (every candidate counts as a `seam` refusal) and a logged one stops at once with
+/// [`Stop::LogFull`](crate::Stop::LogFull). The report's `collapses` counts removals.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct VertexDecimation {
@@ -86,6 +108,24 @@ pub struct VertexDecimation {
     pub(crate) max_deg: f32,
     /// Smallest aspect ratio of a split.
     pub(crate) min_aspect: f32,
+    /// How the hole is filled and the vertex keyed.
+    pub(crate) fill: Fill,
+}
+
+/// How [`VertexDecimation`] fills a vertex's hole and orders the vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Fill {
+    /// Schroeder's as written: recursive loop splitting chosen for shape (aspect ratio),
+    /// vertices ordered by their distance to the average plane (or boundary or feature line).
+    Shape,
+    /// The default: of the loop splitting's triangulation and the ring's fans (the fan from
+    /// a ring vertex to the rest of the loop: from either end of a boundary or feature line,
+    /// from any ring vertex of a simple vertex), the one that fits the removed vertex best,
+    /// and vertices ordered by that fit: the area-weighted squared distance from the removed
+    /// vertex to the planes of the new triangles, plus on a boundary its squared distance to
+    /// the new boundary edge times the new area. `Config::max_cost` bounds that fit.
+    Fit,
 }
 
 /// An angle in degrees clamped to `[0, 180]` (NaN: 0).
@@ -101,7 +141,7 @@ fn clamp_deg(deg: f32) -> f32 {
 
 impl VertexDecimation {
     /// Feature angle 30°, growing by 15° up to 60° when a round removes nothing; smallest
-    /// split aspect ratio 0.04.
+    /// split aspect ratio 0.04; the best-fitting fill ([`Fill::Fit`]).
     pub const fn new() -> Self {
         VertexDecimation {
             feature_deg: 30.0,
@@ -110,7 +150,14 @@ impl VertexDecimation {
             step_deg: 15.0,
             max_deg: 60.0,
             min_aspect: MIN_ASPECT,
+            fill: Fill::Fit,
         }
+    }
+
+    /// How the hole is filled and the vertices ordered ([`Fill::Fit`] by default).
+    pub fn with_fill(mut self, fill: Fill) -> Self {
+        self.fill = fill;
+        self
     }
 
     /// A spoke whose two triangles' normals differ by more than `deg` degrees (clamped to
@@ -176,6 +223,9 @@ pub(crate) struct Fan {
     pub(crate) key: f32,
     /// An interior-edge vertex: the ring positions of its two feature spokes' ends.
     pub(crate) line: Option<(usize, usize)>,
+    /// With [`Fill::Fit`], an interior vertex with one or more than two feature spokes: the
+    /// ring positions of their ends (bits), the only fans that keep a feature line where it was.
+    pub(crate) ends: u32,
 }
 
 impl Fan {
@@ -226,6 +276,7 @@ pub(crate) fn classify<L: Index, I: Index>(
         normal: [0.0; 3],
         key: f32::INFINITY,
         line: None,
+        ends: 0,
     };
     // Unit normals of the fan's triangles, in order.
     let mut units = [[0.0f32; 3]; MAX_RING];
@@ -282,13 +333,20 @@ pub(crate) fn classify<L: Index, I: Index>(
     // Feature spokes: spoke i (to ring[i]) lies between triangles i - 1 and i.
     let mut features = [0usize; 2];
     let mut nf = 0;
+    let mut ends = 0u32;
+    let mut hard = 0;
     let first_spoke = if boundary { 1 } else { 0 };
     for i in first_spoke..k {
         let before = if i == 0 { k - 1 } else { i - 1 };
         let (Some(&u), Some(&w)) = (units.get(before), units.get(i)) else {
             return None;
         };
-        if math::dot(u, w) < op.cos_feature {
+        let cos = math::dot(u, w);
+        if cos < COS_HARD {
+            hard += 1;
+        }
+        if cos < op.cos_feature {
+            ends |= 1 << i;
             if let Some(s) = features.get_mut(nf) {
                 *s = i;
             }
@@ -311,6 +369,14 @@ pub(crate) fn classify<L: Index, I: Index>(
         }
         // Boundary: the distance to the line through the boundary neighbours.
         (true, 0) => line_distance(pv, p(0), p(k)),
+        // A dart or a corner, when the fill is measured: onto a feature spoke's end, the
+        // fit deciding whether that is cheap.
+        (false, _) if op.fill == Fill::Fit && hard <= 2 => {
+            fan.ends = ends;
+            Some(0.0)
+        }
+        // A boundary vertex with a feature spoke: along the boundary, measured.
+        (true, _) if op.fill == Fill::Fit => Some(0.0),
         // Corner.
         _ => None,
     }?;
@@ -508,6 +574,205 @@ pub(crate) fn triangulate(
     }
 }
 
+/// The area-weighted squared distance from `pv` to the planes of the new triangles `tris`
+/// (ring positions into `pos`): `Σ (n·(pv − a))² / |n|`, `n` a triangle's unnormalised
+/// normal (twice its area); the new triangles' total of `|n|`; and the largest squared
+/// distance from `pv` to one of their planes.
+fn fit2(pv: V3, pos: &[V3; MAX_RING], tris: &[[u8; 3]]) -> (f32, f32, f32) {
+    let at = |k: u8| pos.get(k as usize).copied().unwrap_or([0.0; 3]);
+    let (mut e, mut area2, mut far2) = (0.0f32, 0.0f32, 0.0f32);
+    for t in tris {
+        let a = at(t[0]);
+        let n = math::cross(math::sub(at(t[1]), a), math::sub(at(t[2]), a));
+        let l2 = math::dot(n, n);
+        let l = sqrt(l2);
+        if l > 0.0 {
+            let d = math::dot(n, math::sub(pv, a));
+            e += d * d / l;
+            area2 += l;
+            let d2 = d * d / l2;
+            if d2 > far2 {
+                far2 = d2;
+            }
+        }
+    }
+    (e, area2, far2)
+}
+
+/// The fan of ring position `i` over `fan`'s loop: triangles `(i, j, j + 1)` around the loop
+/// (the half-edge collapse of the removed vertex onto `ring[i]`), each rotated to loop order,
+/// into `out`; how many. A boundary loop is open: only its ends have a fan.
+fn ring_fan(fan: &Fan, i: usize, out: &mut [[u8; 3]; MAX_RING]) -> usize {
+    let n = fan.n;
+    let mut made = 0;
+    for j in 1..n.saturating_sub(1) {
+        let (b, c) = ((i + j) % n, (i + j + 1) % n);
+        // Three ring positions in cyclic order from `i`, rotated so the smallest leads.
+        let t = [i as u8, b as u8, c as u8];
+        let r = if t[1] < t[0] && t[1] < t[2] {
+            [t[1], t[2], t[0]]
+        } else if t[2] < t[0] && t[2] < t[1] {
+            [t[2], t[0], t[1]]
+        } else {
+            t
+        };
+        if let Some(s) = out.get_mut(made) {
+            *s = r;
+            made += 1;
+        }
+    }
+    made
+}
+
+/// The new fan of `fan` (the removed vertex at `pv`, the ring at `pos`) into `out` and
+/// `planes` (as [`triangulate`]) and its key: with [`Fill::Shape`] the loop splitting and
+/// Schroeder's distance; with [`Fill::Fit`] the best-fitting of the loop splitting and the
+/// ring's fans (ties: the loop splitting, then the lower ring position) and its fit.
+pub(crate) fn plan(
+    fan: &Fan,
+    pv: V3,
+    pos: &[V3; MAX_RING],
+    op: &VertexDecimation,
+    reference: f32,
+    out: &mut [[u8; 3]; MAX_RING],
+    planes: &mut [V3; MAX_RING],
+) -> Result<(usize, f32, f32), NoSplit> {
+    let split = if fan.ends != 0 {
+        Err(NoSplit::Aspect)
+    } else {
+        triangulate(fan, pos, op.min_aspect, out, planes)
+    };
+    if op.fill == Fill::Shape {
+        return split.map(|n| (n, fan.key, fan.key * fan.key));
+    }
+    let n = fan.n;
+    // A boundary vertex's fill loses its place on the boundary: its distance to the new
+    // boundary edge, over the new area.
+    let retreat2 = if fan.boundary {
+        let (a, b) = (
+            pos.first().copied().unwrap_or([0.0; 3]),
+            pos.get(n.saturating_sub(1)).copied().unwrap_or([0.0; 3]),
+        );
+        math::segment_distance2(pv, a, b)
+    } else {
+        0.0
+    };
+    // The old fan's area (twice), for the thin-part factor of the memoryless quadric:
+    // `1 + Ā / A_fan` (`cost::Quadric`), so that small fans are not cheap however far
+    // their vertex stands out.
+    let mut old2 = 0.0f32;
+    let closed = if fan.boundary { n.saturating_sub(1) } else { n };
+    for k in 0..closed {
+        let (a, b) = (
+            pos.get(k).copied().unwrap_or(pv),
+            pos.get((k + 1) % n).copied().unwrap_or(pv),
+        );
+        let c = math::cross(math::sub(a, pv), math::sub(b, pv));
+        old2 += sqrt(math::dot(c, c));
+    }
+    let thin = if old2 > 0.0 {
+        1.0 + reference / old2
+    } else {
+        1.0
+    };
+    // The fit, and the removal's own error (squared): its distance to the farthest new
+    // plane, or the boundary's retreat.
+    let price = |tris: &[[u8; 3]]| {
+        let (e, area2, far2) = fit2(pv, pos, tris);
+        let err2 = if far2 > retreat2 { far2 } else { retreat2 };
+        ((e + retreat2 * area2) * thin, err2)
+    };
+    let best = match split {
+        Ok(k) => {
+            let (e, err2) = price(out.get(..k).unwrap_or(&[]));
+            Some((e, k, err2))
+        }
+        Err(_) => None,
+    };
+    // The two halves' planes of a feature line (each side a surface of its own).
+    let halves = match fan.line {
+        Some((i, j)) => {
+            let (i, j) = if i < j { (i, j) } else { (j, i) };
+            let mut inner = [0u8; MAX_RING];
+            let mut outer = [0u8; MAX_RING];
+            let (mut ni, mut no) = (0, 0);
+            for k in 0..n {
+                if (i..=j).contains(&k) {
+                    if let Some(s) = inner.get_mut(ni) {
+                        *s = k as u8;
+                        ni += 1;
+                    }
+                }
+                if k <= i || k >= j {
+                    if let Some(s) = outer.get_mut(no) {
+                        *s = k as u8;
+                        no += 1;
+                    }
+                }
+            }
+            let a = loop_normal(inner.get(..ni).unwrap_or(&[]), pos);
+            let b = loop_normal(outer.get(..no).unwrap_or(&[]), pos);
+            match (a, b) {
+                (Some(a), Some(b)) => Some((i, j, a, b)),
+                _ => {
+                    return split.map(|k| {
+                        let (e, err2) = price(out.get(..k).unwrap_or(&[]));
+                        (k, e, err2)
+                    })
+                }
+            }
+        }
+        None => None,
+    };
+    let mut cand = [[0u8; 3]; MAX_RING];
+    let mut best_fan: Option<(f32, usize, f32)> = None;
+    for i in 0..n {
+        let allowed = match (fan.boundary, halves) {
+            _ if fan.ends != 0 => fan.ends >> i & 1 != 0,
+            (true, _) => i == 0 || i + 1 == n,
+            (false, Some((a, b, _, _))) => i == a || i == b,
+            (false, None) => true,
+        };
+        if !allowed {
+            continue;
+        }
+        let k = ring_fan(fan, i, &mut cand);
+        let (e, err2) = price(cand.get(..k).unwrap_or(&[]));
+        let least = match (best, best_fan) {
+            (_, Some((f, _, _))) => f,
+            (Some((s, _, _)), None) => s,
+            (None, None) => f32::INFINITY,
+        };
+        if e < least || (least == f32::INFINITY && best_fan.is_none() && best.is_none()) {
+            best_fan = Some((e, i, err2));
+        }
+    }
+    if let Some((e, i, err2)) = best_fan {
+        let k = ring_fan(fan, i, out);
+        // Each new triangle (i, b, b + 1) takes the place of the old (v, b, b + 1): its
+        // normal is the reference, as for the collapse's own normal rules.
+        for (j, p) in planes.iter_mut().enumerate().take(k) {
+            let b = (i + j + 1) % n;
+            let (pb, pc) = (
+                pos.get(b).copied().unwrap_or(pv),
+                pos.get((b + 1) % n).copied().unwrap_or(pv),
+            );
+            let c = math::cross(math::sub(pb, pv), math::sub(pc, pv));
+            let l2 = math::dot(c, c);
+            *p = if l2 > math::TINY2 && l2.is_finite() {
+                math::scale(c, math::rsqrt(l2))
+            } else {
+                fan.normal
+            };
+        }
+        return Ok((k, e, err2));
+    }
+    match best {
+        Some((e, k, err2)) => Ok((k, e, err2)),
+        None => Err(NoSplit::Aspect),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -527,6 +792,7 @@ mod tests {
                 normal: [0.0, 0.0, 1.0],
                 key: 0.0,
                 line: None,
+                ends: 0,
             },
             pos,
         )
@@ -613,5 +879,37 @@ mod tests {
             Err(NoSplit::Aspect)
         );
         assert!(triangulate(&fan, &pos, 0.0, &mut out, &mut planes).is_ok());
+    }
+
+    /// A vertex on a fold (two planes meeting along the line through ring positions 0 and 3):
+    /// the fan from 0 keeps both planes exactly, so the fitted fill takes it at no cost, while
+    /// the loop splitting, chosen for shape, crosses the fold. Fails if the ring's fans are
+    /// not candidates or the fill is not chosen by fit.
+    #[test]
+    fn the_fitted_fill_keeps_a_fold() {
+        let p = [
+            [2.0, 0.0, 0.0],
+            [1.0, 1.5, 1.5],
+            [-1.0, 1.5, 1.5],
+            [-2.0, 0.0, 0.0],
+            [-1.0, -1.5, 0.0],
+            [1.0, -1.5, 0.0],
+        ];
+        let (mut fan, pos) = fan_of(&p);
+        fan.normal = math::scale([0.0, -1.0, 1.0 + 2.0f32.sqrt()], 1.0 / 2.613_126);
+        let pv = [0.0, 0.0, 0.0];
+        let mut out = [[0u8; 3]; MAX_RING];
+        let mut planes = [[0.0f32; 3]; MAX_RING];
+        let op = VertexDecimation::new();
+        let (n, key, _) = plan(&fan, pv, &pos, &op, 0.0, &mut out, &mut planes).expect("a fill");
+        assert_eq!(n, 4);
+        assert!(key.abs() < 1e-6, "{key}");
+        for t in &out[..n] {
+            assert!(t.contains(&0), "{t:?} is not the fan from 0");
+        }
+        let shape = op.with_fill(Fill::Shape);
+        let (n, _, _) = plan(&fan, pv, &pos, &shape, 0.0, &mut out, &mut planes).expect("a split");
+        let (e, _, _) = fit2(pv, &pos, &out[..n]);
+        assert!(e > 1e-3, "the loop splitting fits too: {e}");
     }
 }

@@ -365,8 +365,9 @@ pub struct Args {
     /// the kept vertex to the planes it replaces, plus any boundary retreat) is above it is not
     /// made, so the run stops short of the target (`stop: ErrorLimit`) rather than cut a corner
     /// to reach a count. `P%` of the bounding-box diagonal or a distance in the input's units;
-    /// `none` for no limit. Default: 2% with the greedy schedule and edge collapse (the only
-    /// ones that measure it), none otherwise. Not a guarantee (see --max-error for one).
+    /// `none` for no limit. Default: 2% with the greedy or batched schedule, except with the
+    /// triangle collapse (the runs that measure it), none otherwise. Not a guarantee (see
+    /// --max-error for one).
     #[arg(long, value_parser = parse_error_limit)]
     pub error_limit: Option<ErrorLimit>,
     /// Collapse schedule.
@@ -441,7 +442,9 @@ impl Args {
     pub fn error_limit(&self) -> ErrorLimit {
         match self.error_limit {
             Some(e) => e,
-            None if self.schedule != ScheduleArg::Passes && self.operator == OperatorArg::Edge => {
+            None if self.schedule != ScheduleArg::Passes
+                && self.operator != OperatorArg::Triangle =>
+            {
                 ErrorLimit::At(MaxError::Fraction(DEFAULT_ERROR_LIMIT))
             }
             None => ErrorLimit::None,
