@@ -104,7 +104,8 @@ pub static QEMU_RISCV32: Qemu = Qemu {
 /// buffers (host-sim/firmware/src/board.rs). `qemu --check` fails on any other skip (a board
 /// whose buffers shrank would otherwise pass with its cases skipped) and on a listed case that
 /// ran after all (the list is stale). The small-RAM boards (Cortex-M0 16 KB, Cortex-M3 64 KB,
-/// the 32 KB RISC-V) are the only ones that skip; docs/devices.md names their cases. Checked against
+/// the 32 KB RISC-V) are the only ones that skip (RAM, or stack for vertex decimation);
+/// docs/devices.md names their cases. Checked against
 /// the boards' capacities in the tests.
 pub const EXPECTED_SKIPS: &[(&str, &[&str])] = &[
     ("microbit", MICROBIT_SKIPS),
@@ -128,12 +129,21 @@ const MICROBIT_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "grid12-vertex-decimation-u16",
+    "box6-vertex-decimation-u16",
+    "sphere2-vertex-decimation-u16",
+    "grid8-vertex-decimation-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-grid8",
     "pm-cow-quantised",
 ];
 /// No RAM for stored quadrics on the micro:bit and the lm3s6965evb (firmware
-/// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases either (they borrow it); the
-/// cow's progressive stream needs the 4 MB boards.
+/// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases (they borrow it) or the
+/// energy's samples either, and no stack for vertex decimation (`board::VERTEX_DECIMATION`);
+/// the cow's cases need the 4 MB boards or the 400 KB RISC-V.
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
     "tray-new-u16",
@@ -146,13 +156,22 @@ const LM3S_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "grid12-vertex-decimation-u16",
+    "box6-vertex-decimation-u16",
+    "sphere2-vertex-decimation-u16",
+    "grid8-vertex-decimation-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-cow-quantised",
 ];
 
 /// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream).
 const RISCV_400K_SKIPS: &[&str] = &[];
 /// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
-/// no RAM for stored quadrics or bounds, and the plate and the cow are too big.
+/// no RAM for stored quadrics, bounds or the energy's samples, and the plate and the cow are
+/// too big, and vertex decimation overflows its stack.
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
@@ -166,6 +185,14 @@ const RISCV_32K_SKIPS: &[&str] = &[
     "sphere2-bound-u16",
     "icosphere3-bound-u32",
     "fin10-bound-paper-u32",
+    "grid12-vertex-decimation-u16",
+    "box6-vertex-decimation-u16",
+    "sphere2-vertex-decimation-u16",
+    "grid8-vertex-decimation-u32",
+    "cow-vertex-decimation-u16",
+    "grid12-energy-u16",
+    "sphere2-energy-u16",
+    "box4-energy-u32",
     "pm-cow-quantised",
 ];
 
@@ -321,19 +348,20 @@ mod tests {
     /// buffer of MAX_TRIANGLES triangles of the board's link type).
     #[test]
     fn expected_skips_match_the_board_capacities() {
-        // (board, MAX_VERTICES, MAX_TRIANGLES, bytes per link, QUADRIC_VERTICES)
+        // (board, MAX_VERTICES, MAX_TRIANGLES, bytes per link, QUADRIC_VERTICES,
+        // VERTEX_DECIMATION)
         let caps = [
-            ("microbit", 224, 432, 2, 0),
-            ("lm3s6965evb", 1_250, 2_400, 2, 0),
-            ("mps2-an386", 53_000, 106_000, 4, 1_024),
-            ("mps2-an500", 53_000, 106_000, 4, 1_024),
-            ("mps2-an505", 53_000, 106_000, 4, 1_024),
-            ("riscv32imc-virt-400k", 6_000, 13_000, 2, 1_024),
-            ("riscv32imac-virt-32k", 500, 1_000, 2, 0),
+            ("microbit", 224, 432, 2, 0, false),
+            ("lm3s6965evb", 1_250, 2_400, 2, 0, false),
+            ("mps2-an386", 53_000, 106_000, 4, 1_024, true),
+            ("mps2-an500", 53_000, 106_000, 4, 1_024, true),
+            ("mps2-an505", 53_000, 106_000, 4, 1_024, true),
+            ("riscv32imc-virt-400k", 6_000, 13_000, 2, 1_024, true),
+            ("riscv32imac-virt-32k", 500, 1_000, 2, 0, false),
         ];
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
         let streams = crate::golden::stream::load(&golden::default_dir()).unwrap();
-        for (board, v, t, link, qv) in caps {
+        for (board, v, t, link, qv, vd) in caps {
             let too_big: Vec<&str> = cases
                 .iter()
                 .filter(|c| {
@@ -341,7 +369,9 @@ mod tests {
                     let fit = (t * 3 * link / per).min(t);
                     c.positions.len() > v
                         || c.triangles.len() > fit
-                        || (c.stored.is_some() && c.positions.len() > qv)
+                        || (c.per_vertex_storage() && (c.positions.len() > qv || qv == 0))
+                        || (c.method == Some(golden::case::MethodName::VertexDecimation) && !vd)
+                        || (c.config.max_error.is_finite() && qv == 0)
                         || (c.config.max_error.is_finite()
                             && c.triangles.len() * 3 * c.index_type.bytes()
                                 + tinydecimate::bound::control_len(

@@ -20,6 +20,9 @@ mod sel {
     pub const MAX_TRIANGLES: usize = 432;
     /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
     pub const QUADRIC_VERTICES: usize = 0;
+    /// No stack for vertex decimation (a removal's fixed buffers overflow the Cortex-M3's
+    /// 5.8 KB and the 32 KB RISC-V's 7 KB): its cases are skipped here and its code left out.
+    pub const VERTEX_DECIMATION: bool = false;
     pub type Link = u16;
     /// Progressive streams (`pm-*` cases): 44 vertex splits (704 B) and an 80 B chunk buffer
     /// (chunks of up to 71 B), taken from the stack's slack; triangles, their links, the list
@@ -37,6 +40,9 @@ mod sel {
     pub const MAX_TRIANGLES: usize = 2_400;
     /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
     pub const QUADRIC_VERTICES: usize = 0;
+    /// Vertex decimation needs more stack than the ~5.8 KB left here (a removal's fixed
+    /// buffers): its cases are skipped and its code left out.
+    pub const VERTEX_DECIMATION: bool = false;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer.
     pub const PM_VERTICES: usize = 100;
@@ -69,6 +75,7 @@ mod sel {
     /// Stored quadrics (40 B per vertex) for meshes up to this many vertices: 40 960 B of
     /// the stack's ~110 KB.
     pub const QUADRIC_VERTICES: usize = 1_024;
+    pub const VERTEX_DECIMATION: bool = true;
     pub type Link = u32;
     /// Progressive streams: 3 000 vertex splits (48 000 B: the cow's 2 844 fit) and a 4 KB
     /// chunk buffer. With the quadrics that leaves ~20 KB of stack (the firmware needs ~4 KB).
@@ -91,6 +98,7 @@ mod sel {
     /// Stored quadrics (40 B per vertex) for meshes up to this many vertices, as on the 4 MB
     /// boards: every stored-quadric and bounded golden case fits.
     pub const QUADRIC_VERTICES: usize = 1_024;
+    pub const VERTEX_DECIMATION: bool = true;
     pub type Link = u16;
     /// Progressive streams: 3 000 vertex splits (48 000 B) and a 4 KB chunk buffer.
     pub const PM_VERTICES: usize = 3_000;
@@ -108,6 +116,9 @@ mod sel {
     pub const MAX_TRIANGLES: usize = 1_000;
     /// No room for stored quadrics (40 B per vertex): their cases are skipped here.
     pub const QUADRIC_VERTICES: usize = 0;
+    /// Vertex decimation overflows the ~7 KB of stack left here (a removal's fixed buffers):
+    /// its cases are skipped and its code left out.
+    pub const VERTEX_DECIMATION: bool = false;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer, as on the
     /// lm3s6965evb.
@@ -116,6 +127,11 @@ mod sel {
 }
 
 pub use sel::*;
+
+/// Whether the board has quadric storage at all. Without it the firmware skips every case that
+/// borrows it (stored quadrics, the energy's samples, the error bound) and leaves their code
+/// out of the image.
+pub const HAS_QUADRICS: bool = QUADRIC_VERTICES > 0;
 
 /// Bytes a bounded case (`Controls`) borrows from the quadric storage, which
 /// it does not use: a read-only copy of the input triangles and the control-point links

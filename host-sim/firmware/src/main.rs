@@ -51,7 +51,7 @@ static RESULT: ConstStaticCell<ResultHeader> = ConstStaticCell::new(ResultHeader
     Status::Ok,
     board::BOARD,
 ));
-/// Stored quadrics of the current case (stored-quadric cases only).
+/// Stored quadrics or the energy's samples of the current case; bounded cases borrow its bytes.
 #[cfg(feature = "lib")]
 static QUADRICS: ConstStaticCell<[[f32; 10]; board::QUADRIC_VERTICES]> =
     ConstStaticCell::new([[0.0; 10]; board::QUADRIC_VERTICES]);
@@ -168,15 +168,17 @@ fn read_case(
         nt,
         h.index_type.bytes() * 8
     );
-    let stored = matches!(
-        h.cost,
-        meshfmt::CostCode::StoredSubset | meshfmt::CostCode::StoredOptimal
-    );
+    // A board without quadric storage skips every case that borrows it (an empty one too), a
+    // board without the stack for vertex decimation every vertex-decimation case:
+    // `run_library` leaves their code out of the image.
+    let entry = h.entry();
     if nv > board::MAX_VERTICES
         || nt > board::triangle_capacity(h.index_type)
-        || (stored && nv > board::QUADRIC_VERTICES)
-        || (h.bounded()
-            && board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES)
+        || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
+        || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
+        || (entry == meshfmt::Entry::Bounded
+            && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
+                || !board::HAS_QUADRICS))
     {
         defmt::warn!("the mesh does not fit this board");
         *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
@@ -363,21 +365,20 @@ fn simplify(
     let ws = WORKSPACE.take();
     let quadrics = QUADRICS.take();
     let config = meshfmt::lib::config(h);
-    let placement = meshfmt::lib::stored_placement(h);
-    let bounded = meshfmt::lib::bounded(h);
+    let entry = h.entry();
 
     let sp = measure::paint();
     measure::start(syst);
     let outcome = match h.index_type {
         IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, placement, bounded, quadrics),
+            Ok(t) => run_library(ws, pos, t, &config, entry, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
             }
         },
         IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, placement, bounded, quadrics),
+            Ok(t) => run_library(ws, pos, t, &config, entry, quadrics),
             Err(_) => {
                 *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
                 return;
@@ -388,7 +389,7 @@ fn simplify(
     let low = measure::lowest_touched();
 
     *r = meshfmt::lib::result_header(h.index_type, &outcome, board::BOARD);
-    if placement == Some(tinydecimate::cost::Placement::Optimal) {
+    if entry == meshfmt::Entry::StoredOptimal {
         r.positions_hash = meshfmt::positions_hash(pos);
     }
     r.ticks = ticks;
@@ -422,16 +423,38 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     positions: &mut [[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
-    placement: Option<tinydecimate::cost::Placement>,
-    bounded: bool,
+    entry: meshfmt::Entry,
     quadrics: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    if bounded {
-        return run_bounded(ws, positions, triangles, config, quadrics);
+    use meshfmt::Entry;
+    use tinydecimate::Placement;
+    // A board leaves out the entry points it cannot run (`read_case` skips their cases): the
+    // ones that borrow the quadric storage where there is none, vertex decimation where the
+    // stack is too small. With all of them the micro:bit's and the lm3s6965evb's images
+    // overflow their 256 KB of flash.
+    let left_out = match entry {
+        Entry::Simplify => false,
+        Entry::VertexDecimation => !board::VERTEX_DECIMATION,
+        _ => !board::HAS_QUADRICS,
+    };
+    if left_out {
+        return Err(tinydecimate::Error::Capacity {
+            what: tinydecimate::Capacity::Quadrics,
+            needed: positions.len(),
+            available: 0,
+        });
     }
-    match placement {
-        None => ws.simplify(positions, triangles, config),
-        Some(placement) => run_stored(ws, positions, triangles, config, placement, quadrics),
+    match entry {
+        Entry::Simplify => ws.simplify(positions, triangles, config),
+        Entry::Bounded => run_bounded(ws, positions, triangles, config, quadrics),
+        Entry::StoredSubset => {
+            run_stored(ws, positions, triangles, config, Placement::Subset, quadrics)
+        }
+        Entry::StoredOptimal => {
+            run_stored(ws, positions, triangles, config, Placement::Optimal, quadrics)
+        }
+        Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
+        Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
     }
 }
 
@@ -453,6 +476,37 @@ fn run_stored<I: tinydecimate::Index>(
         Placement::Optimal => Positions::Write(positions),
     };
     let cost = StoredQuadric::new(quadrics, placement);
+    Ok(ws.start(p, triangles, config, cost, NoBound, EdgeCollapse)?.run())
+}
+
+/// A vertex decimation case (`VertexDecimation`, the built-in cost). Never inlined, for the
+/// same reason as [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_decimation<I: tinydecimate::Index>(
+    ws: &mut board::Workspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    use tinydecimate::{Builtin, NoBound, Positions, VertexDecimation};
+    let (p, op) = (Positions::Read(positions), VertexDecimation::new());
+    Ok(ws.start(p, triangles, config, Builtin::new(), NoBound, op)?.run())
+}
+
+/// A case of Hoppe's energy (`cost::Energy`, its samples in the quadric storage). Never
+/// inlined, for the same reason as [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_energy<I: tinydecimate::Index>(
+    ws: &mut board::Workspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+    samples: &mut [[f32; 10]],
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    use tinydecimate::{EdgeCollapse, NoBound, Positions};
+    let (p, cost) = (Positions::Read(positions), tinydecimate::cost::Energy::new(samples));
     Ok(ws.start(p, triangles, config, cost, NoBound, EdgeCollapse)?.run())
 }
 
@@ -558,7 +612,7 @@ fn selftest(
     let h = CaseHeader {
         index_type: IndexType::U16,
         schedule: meshfmt::ScheduleCode::Greedy,
-        cost: meshfmt::CostCode::Quadric,
+        method: meshfmt::MethodCode::Quadric,
         vertices: nv as u32,
         triangles: nt as u32,
         target_ratio: 0.25,

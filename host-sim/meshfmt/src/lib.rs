@@ -20,7 +20,7 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u8      | cost: 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement |
+//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy |
 //! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
@@ -136,9 +136,11 @@ pub enum ScheduleCode {
     Batched = 2,
 }
 
-/// Cost code.
+/// Method code: the cost and operator a case runs (header byte 30). Codes 0-3 name a cost of
+/// the edge collapse, 4 and 5 a plug-in; the byte was first the cost alone, so the codes are
+/// the ones it had.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CostCode {
+pub enum MethodCode {
     /// `CostKind::Quadric`.
     Quadric = 0,
     /// `CostKind::NormalVariation`.
@@ -147,6 +149,41 @@ pub enum CostCode {
     StoredSubset = 2,
     /// Stored quadrics, optimal placement (`StoredQuadric` with `Placement::Optimal`): positions move.
     StoredOptimal = 3,
+    /// Vertex decimation (`VertexDecimation::new()`, the built-in cost, positions read): the
+    /// workspace only.
+    VertexDecimation = 4,
+    /// Hoppe's energy (`cost::Energy::new`, edge collapse, positions read): one `[f32; 10]` of
+    /// samples per vertex.
+    Energy = 5,
+}
+
+/// The library entry point a case runs: its method and whether it is bounded, decided once
+/// for the firmware and the host reference ([`CaseHeader::entry`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Entry {
+    /// `Workspace::simplify` with the configuration's cost.
+    Simplify,
+    /// The built-in cost under the error bound (`Controls`), edge collapse.
+    Bounded,
+    /// `StoredQuadric` with `Placement::Subset`, positions read.
+    StoredSubset,
+    /// `StoredQuadric` with `Placement::Optimal`, positions written.
+    StoredOptimal,
+    /// `VertexDecimation::new()` with the built-in cost, no bound, positions read.
+    VertexDecimation,
+    /// `cost::Energy::new`, no bound, edge collapse, positions read.
+    Energy,
+}
+
+impl Entry {
+    /// Whether the run takes one `[f32; 10]` per vertex from the caller (stored quadrics, the
+    /// energy's samples): the firmware's quadric storage, `board::QUADRIC_VERTICES` of them.
+    pub const fn per_vertex_storage(self) -> bool {
+        matches!(
+            self,
+            Entry::StoredSubset | Entry::StoredOptimal | Entry::Energy
+        )
+    }
 }
 
 /// Feature mode code.
@@ -178,7 +215,7 @@ pub enum FormatError {
 pub struct CaseHeader {
     pub index_type: IndexType,
     pub schedule: ScheduleCode,
-    pub cost: CostCode,
+    pub method: MethodCode,
     pub vertices: u32,
     pub triangles: u32,
     pub target_ratio: f32,
@@ -277,7 +314,7 @@ impl CaseHeader {
         w.f32(self.lambda);
         w.u8(self.feature_mode as u8);
         w.u8(self.feature_targets as u8);
-        w.u8(self.cost as u8);
+        w.u8(self.method as u8);
         w.u8(0);
         w.u32(self.max_passes);
         w.f32(self.max_cost);
@@ -316,18 +353,20 @@ impl CaseHeader {
             _ => return Err(FormatError::Code),
         };
         let feature_targets = r.u8() != 0;
-        let cost = match r.u8() {
-            0 => CostCode::Quadric,
-            1 => CostCode::NormalVariation,
-            2 => CostCode::StoredSubset,
-            3 => CostCode::StoredOptimal,
+        let method = match r.u8() {
+            0 => MethodCode::Quadric,
+            1 => MethodCode::NormalVariation,
+            2 => MethodCode::StoredSubset,
+            3 => MethodCode::StoredOptimal,
+            4 => MethodCode::VertexDecimation,
+            5 => MethodCode::Energy,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
         Ok(CaseHeader {
             index_type,
             schedule,
-            cost,
+            method,
             vertices,
             triangles,
             target_ratio,
@@ -348,6 +387,21 @@ impl CaseHeader {
     /// a positive, finite `max_error`.
     pub fn bounded(&self) -> bool {
         self.max_error > 0.0 && self.max_error.is_finite()
+    }
+
+    /// The entry point the case runs: the error bound first (the built-in cost), else its
+    /// method.
+    pub fn entry(&self) -> Entry {
+        if self.bounded() {
+            return Entry::Bounded;
+        }
+        match self.method {
+            MethodCode::Quadric | MethodCode::NormalVariation => Entry::Simplify,
+            MethodCode::StoredSubset => Entry::StoredSubset,
+            MethodCode::StoredOptimal => Entry::StoredOptimal,
+            MethodCode::VertexDecimation => Entry::VertexDecimation,
+            MethodCode::Energy => Entry::Energy,
+        }
     }
 
     /// Bytes of the position array.
@@ -650,13 +704,15 @@ pub mod lib {
             .with_lambda(h.lambda)
             .with_max_passes(h.max_passes)
             .with_max_cost(h.max_cost)
-            .with_cost(match h.cost {
-                // Stored quadrics are not a `CostKind`: the runner picks the entry point
-                // (`stored_placement`).
-                CostCode::Quadric | CostCode::StoredSubset | CostCode::StoredOptimal => {
-                    CostKind::Quadric
-                }
-                CostCode::NormalVariation => CostKind::NormalVariation,
+            .with_cost(match h.method {
+                // Stored quadrics and the plug-ins are not a `CostKind`: the runner picks the
+                // entry point (`CaseHeader::entry`).
+                MethodCode::Quadric
+                | MethodCode::StoredSubset
+                | MethodCode::StoredOptimal
+                | MethodCode::VertexDecimation
+                | MethodCode::Energy => CostKind::Quadric,
+                MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c.features = h.feature_mode != FeatureCode::Off;
         if h.feature_mode == FeatureCode::ValenceNormalized {
@@ -696,11 +752,11 @@ pub mod lib {
         h.bounded()
     }
 
-    /// The stored-quadric placement a case asks for (`None`: `Workspace::simplify`).
+    /// The stored-quadric placement a case asks for (`None`: another entry point).
     pub fn stored_placement(h: &CaseHeader) -> Option<tinydecimate::cost::Placement> {
-        match h.cost {
-            CostCode::StoredSubset => Some(tinydecimate::cost::Placement::Subset),
-            CostCode::StoredOptimal => Some(tinydecimate::cost::Placement::Optimal),
+        match h.entry() {
+            Entry::StoredSubset => Some(tinydecimate::cost::Placement::Subset),
+            Entry::StoredOptimal => Some(tinydecimate::cost::Placement::Optimal),
             _ => None,
         }
     }
@@ -715,9 +771,9 @@ pub mod lib {
                 Schedule::Passes => ScheduleCode::Passes,
                 Schedule::Batched => ScheduleCode::Batched,
             },
-            cost: match config.cost {
-                CostKind::Quadric => CostCode::Quadric,
-                CostKind::NormalVariation => CostCode::NormalVariation,
+            method: match config.cost {
+                CostKind::Quadric => MethodCode::Quadric,
+                CostKind::NormalVariation => MethodCode::NormalVariation,
             },
             vertices: 0,
             triangles: 0,
@@ -938,7 +994,7 @@ mod tests {
         CaseHeader {
             index_type: IndexType::U16,
             schedule: ScheduleCode::Passes,
-            cost: CostCode::NormalVariation,
+            method: MethodCode::NormalVariation,
             vertices: 0,
             triangles: 0,
             target_ratio: 0.25,
@@ -972,7 +1028,7 @@ mod tests {
             assert_eq!(h2.vertices, 3);
             assert_eq!(h2.triangles, 2);
             assert_eq!(h2.schedule, ScheduleCode::Passes);
-            assert_eq!(h2.cost, CostCode::NormalVariation);
+            assert_eq!(h2.method, MethodCode::NormalVariation);
             assert_eq!(h2.max_cost, f32::INFINITY);
             assert_eq!(h2.feature_mode, FeatureCode::ValenceNormalized);
             assert!(h2.feature_targets);
@@ -1000,6 +1056,40 @@ mod tests {
         assert_eq!(b[28], 2);
         assert_eq!(&b[32..36], &9u32.to_le_bytes());
         assert_eq!(&b[48..52], &1.0f32.to_le_bytes());
+        assert_eq!(b[30], 1);
+    }
+
+    #[test]
+    fn method_codes_and_entries() {
+        let cases = [
+            (MethodCode::Quadric, 0, Entry::Simplify),
+            (MethodCode::NormalVariation, 1, Entry::Simplify),
+            (MethodCode::StoredSubset, 2, Entry::StoredSubset),
+            (MethodCode::StoredOptimal, 3, Entry::StoredOptimal),
+            (MethodCode::VertexDecimation, 4, Entry::VertexDecimation),
+            (MethodCode::Energy, 5, Entry::Energy),
+        ];
+        for (method, code, entry) in cases {
+            let mut h = case();
+            h.method = method;
+            h.max_error = 0.0;
+            let b = h.to_bytes();
+            assert_eq!(b[30], code);
+            let back = CaseHeader::from_bytes(&b).unwrap();
+            assert_eq!(back.method, method);
+            assert_eq!(back.entry(), entry);
+            assert_eq!(
+                entry.per_vertex_storage(),
+                matches!(code, 2 | 3 | 5),
+                "{method:?}"
+            );
+            // The bound comes first, as the firmware has always run it.
+            h.max_error = 0.25;
+            assert_eq!(h.entry(), Entry::Bounded);
+        }
+        let mut b = case().to_bytes();
+        b[30] = 6;
+        assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
     }
 
     #[test]

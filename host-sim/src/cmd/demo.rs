@@ -75,6 +75,7 @@ pub fn subset_that_fits(case: &Case, max_vertices: usize, max_triangles: usize) 
         index_type: case.index_type,
         config: case.config,
         stored: case.stored,
+        method: case.method,
     }
 }
 
@@ -203,6 +204,7 @@ fn demo_case(a: &Args) -> Result<Case> {
         index_type,
         config,
         stored: None,
+        method: None,
     })
 }
 
@@ -434,6 +436,7 @@ mod tests {
             index_type: IndexType::U16,
             config: Config::new(),
             stored: None,
+            method: None,
         };
         let s = subset_that_fits(&case, 30, 1000);
         assert!(s.positions.len() <= 30);

@@ -234,5 +234,6 @@ pub fn mesh_case(
         index_type: if u32 { IndexType::U32 } else { IndexType::U16 },
         config,
         stored: None,
+        method: None,
     })
 }

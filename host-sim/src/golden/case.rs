@@ -7,12 +7,13 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::file::{decode_result, encode_case, encode_result};
-use meshfmt::{Board, CostCode, IndexType, ResultHeader};
+use meshfmt::{Board, Entry, IndexType, MethodCode, ResultHeader};
 use serde::Deserialize;
 use tinydecimate::bound::Controls;
+use tinydecimate::cost::Energy;
 use tinydecimate::{
     Builtin, Config, EdgeCollapse, FeatureMode, NoBound, Placement, Positions, Schedule,
-    StoredQuadric,
+    StoredQuadric, VertexDecimation,
 };
 
 use super::MANIFEST;
@@ -59,6 +60,27 @@ pub enum QuadricName {
     StoredSubset,
     /// `StoredQuadric` with `Placement::Optimal`.
     StoredOptimal,
+}
+
+/// A plug-in as written in the manifest (`method = "vertex-decimation"`): the operator or the
+/// cost instead of the edge collapse with the config's cost.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodName {
+    /// The operator `VertexDecimation::new()` with the built-in cost.
+    VertexDecimation,
+    /// The cost `cost::Energy::new` (Hoppe's energy), edge collapse.
+    Energy,
+}
+
+impl MethodName {
+    /// The case file's method code.
+    pub fn code(self) -> MethodCode {
+        match self {
+            MethodName::VertexDecimation => MethodCode::VertexDecimation,
+            MethodName::Energy => MethodCode::Energy,
+        }
+    }
 }
 
 /// Index type as written in the manifest.
@@ -112,6 +134,10 @@ pub struct CaseSpec {
     /// cost; boundary planes weighted by the config's boundary weight).
     #[serde(default)]
     pub quadric: Option<QuadricName>,
+    /// Optional: `vertex-decimation` (the operator `VertexDecimation`) or `energy` (the cost
+    /// `cost::Energy`); neither with `quadric` or `max_error`.
+    #[serde(default)]
+    pub method: Option<MethodName>,
     /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
     /// `Controls`) as a fraction of the bounding-box diagonal; the case file
     /// carries it in input units.
@@ -204,6 +230,8 @@ pub struct Case {
     pub config: Config,
     /// Stored quadrics with this placement instead of `config.cost` (`None`: `simplify`).
     pub stored: Option<tinydecimate::cost::Placement>,
+    /// A plug-in instead of the edge collapse with `config.cost` (`None`: as `stored` says).
+    pub method: Option<MethodName>,
 }
 
 impl Case {
@@ -216,6 +244,9 @@ impl Case {
                 .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
         {
             bail!("case name {name:?}: use letters, digits, '-' and '_'");
+        }
+        if spec.method.is_some() && (spec.quadric.is_some() || spec.max_error.is_some()) {
+            bail!("case {name}: `method` goes with neither `quadric` nor `max_error`");
         }
         let mut mesh = load_mesh(name, &spec.mesh)?;
         let mut desc = spec.mesh.clone();
@@ -260,6 +291,7 @@ impl Case {
                 QuadricName::StoredSubset => tinydecimate::cost::Placement::Subset,
                 QuadricName::StoredOptimal => tinydecimate::cost::Placement::Optimal,
             }),
+            method: spec.method,
         })
     }
 
@@ -270,15 +302,25 @@ impl Case {
             .map_err(|e| anyhow!("case {}: {e:?}", self.name))
     }
 
-    /// The case file's header: the configuration, and the stored-quadric code if any.
+    /// The case file's header: the configuration, and the stored-quadric or plug-in code if
+    /// any.
     pub fn header(&self) -> meshfmt::CaseHeader {
         let mut h = meshfmt::lib::case_header(&self.config, self.index_type);
         match self.stored {
-            Some(tinydecimate::cost::Placement::Subset) => h.cost = CostCode::StoredSubset,
-            Some(tinydecimate::cost::Placement::Optimal) => h.cost = CostCode::StoredOptimal,
+            Some(tinydecimate::cost::Placement::Subset) => h.method = MethodCode::StoredSubset,
+            Some(tinydecimate::cost::Placement::Optimal) => h.method = MethodCode::StoredOptimal,
             None => {}
         }
+        if let Some(m) = self.method {
+            h.method = m.code();
+        }
         h
+    }
+
+    /// Whether the run borrows one `[f32; 10]` per vertex (stored quadrics, the energy's
+    /// samples): the firmware's quadric storage, `board::QUADRIC_VERTICES` of them.
+    pub fn per_vertex_storage(&self) -> bool {
+        self.header().entry().per_vertex_storage()
     }
 
     /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles).
@@ -358,8 +400,7 @@ pub fn reference(case: &Case) -> Result<Outcome> {
 fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
     let h = case.header();
     let config = meshfmt::lib::config(&h);
-    let placement = meshfmt::lib::stored_placement(&h);
-    let bounded = meshfmt::lib::bounded(&h);
+    let entry = h.entry();
     let mut positions = case.positions.clone();
     let (outcome, tris): (_, Vec<[u32; 3]>) = match case.index_type {
         IndexType::U16 => {
@@ -371,20 +412,20 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
                 })
                 .map(|[a, b, c]| Ok([a?, b?, c?]))
                 .collect::<Result<_>>()?;
-            let r = run_reference(ws, &mut positions, &mut t, &config, placement, bounded);
+            let r = run_reference(ws, &mut positions, &mut t, &config, entry);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
         }
         IndexType::U32 => {
             let mut t = case.triangles.clone();
-            let r = run_reference(ws, &mut positions, &mut t, &config, placement, bounded);
+            let r = run_reference(ws, &mut positions, &mut t, &config, entry);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             t.truncate(n);
             (r, t)
         }
     };
     let mut header = meshfmt::lib::result_header(case.index_type, &outcome, Board::Host);
-    if placement == Some(Placement::Optimal) {
+    if entry == Entry::StoredOptimal {
         header.positions_hash = meshfmt::positions_hash(&positions);
     }
     Ok(Outcome {
@@ -399,40 +440,63 @@ fn run_reference<I: tinydecimate::Index>(
     positions: &mut [[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &Config,
-    placement: Option<Placement>,
-    bounded: bool,
+    entry: Entry,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    let storage = ws.storage();
-    if bounded {
-        // The firmware lends its quadric storage to these two (`board::BOUND_BYTES`).
-        let original = triangles.to_vec();
-        let mut links =
-            vec![0u32; tinydecimate::bound::control_len(triangles.len(), positions.len())];
-        let bound = Controls::new(&original, &mut links);
-        let p = Positions::Read(positions);
-        return Ok(storage
-            .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
-            .run());
-    }
+    let mut storage = ws.storage();
+    // The firmware lends its quadric storage to the stored quadrics, the energy's samples and
+    // the bound's original triangles and links (`board::BOUND_BYTES`).
     let mut quadrics = vec![[0.0f32; 10]; positions.len()];
-    let s = match placement {
-        None => return ws.storage().simplify(positions, triangles, config),
-        Some(Placement::Subset) => storage.start(
-            Positions::Read(positions),
-            triangles,
-            config,
-            StoredQuadric::new(&mut quadrics, Placement::Subset),
-            NoBound,
-            EdgeCollapse,
-        )?,
-        Some(Placement::Optimal) => storage.start(
-            Positions::Write(positions),
-            triangles,
-            config,
-            StoredQuadric::new(&mut quadrics, Placement::Optimal),
-            NoBound,
-            EdgeCollapse,
-        )?,
-    };
-    Ok(s.run())
+    Ok(match entry {
+        Entry::Simplify => storage.simplify(positions, triangles, config)?,
+        Entry::Bounded => {
+            let original = triangles.to_vec();
+            let mut links =
+                vec![0u32; tinydecimate::bound::control_len(triangles.len(), positions.len())];
+            let bound = Controls::new(&original, &mut links);
+            let p = Positions::Read(positions);
+            storage
+                .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
+                .run()
+        }
+        Entry::StoredSubset => storage
+            .start(
+                Positions::Read(positions),
+                triangles,
+                config,
+                StoredQuadric::new(&mut quadrics, Placement::Subset),
+                NoBound,
+                EdgeCollapse,
+            )?
+            .run(),
+        Entry::StoredOptimal => storage
+            .start(
+                Positions::Write(positions),
+                triangles,
+                config,
+                StoredQuadric::new(&mut quadrics, Placement::Optimal),
+                NoBound,
+                EdgeCollapse,
+            )?
+            .run(),
+        Entry::VertexDecimation => storage
+            .start(
+                Positions::Read(positions),
+                triangles,
+                config,
+                Builtin::new(),
+                NoBound,
+                VertexDecimation::new(),
+            )?
+            .run(),
+        Entry::Energy => storage
+            .start(
+                Positions::Read(positions),
+                triangles,
+                config,
+                Energy::new(&mut quadrics),
+                NoBound,
+                EdgeCollapse,
+            )?
+            .run(),
+    })
 }

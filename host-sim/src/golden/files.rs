@@ -135,6 +135,15 @@ impl Golden {
         if let Some(p) = case.stored {
             writeln!(w, "quadric = \"stored, {p:?} placement\"")?;
         }
+        match case.method {
+            Some(super::case::MethodName::VertexDecimation) => {
+                writeln!(w, "method = \"vertex decimation, the built-in cost\"")?
+            }
+            Some(super::case::MethodName::Energy) => {
+                writeln!(w, "method = \"Hoppe's energy, edge collapse\"")?
+            }
+            None => {}
+        }
         if case.config.max_error.is_finite() {
             writeln!(
                 w,
@@ -297,8 +306,10 @@ pub fn judge(
             if case.index_type == IndexType::U16 { "u16" } else { "u32" },
             h.capacity_vertices,
             h.capacity_triangles,
-            if case.stored.is_some() {
-                " (stored quadrics: the firmware's QUADRIC_VERTICES may be lower)"
+            if case.per_vertex_storage() {
+                " (stored quadrics or energy samples: the firmware's QUADRIC_VERTICES may be lower)"
+            } else if case.method == Some(super::case::MethodName::VertexDecimation) {
+                " (vertex decimation: the firmware's VERTEX_DECIMATION, stack for a removal's buffers)"
             } else if case.config.max_error.is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {

@@ -154,7 +154,9 @@ pub fn one_instantiation(target: &str, backend: Backend) -> Result<(u64, u64)> {
 }
 
 /// Removes the variables that would leak from a cargo that runs host-sim into a nested firmware
-/// build (its own target directory, target and flags).
+/// build (its own target directory, target and flags, and its release profile: a
+/// `CARGO_PROFILE_RELEASE_LTO=false` meant for the host build would leave the firmware without
+/// LTO, deeper in stack than the micro:bit has and larger than the lm3s6965evb's flash).
 pub fn isolate(cmd: &mut std::process::Command) {
     for var in [
         "CARGO_TARGET_DIR",
@@ -164,6 +166,14 @@ pub fn isolate(cmd: &mut std::process::Command) {
         "CARGO_MANIFEST_DIR",
     ] {
         cmd.env_remove(var);
+    }
+    for (var, _) in std::env::vars_os() {
+        if var
+            .to_str()
+            .is_some_and(|v| v.starts_with("CARGO_PROFILE_"))
+        {
+            cmd.env_remove(var);
+        }
     }
 }
 

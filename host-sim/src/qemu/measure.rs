@@ -218,6 +218,7 @@ pub fn probe_case(t: usize, index_type: IndexType) -> Case {
         index_type,
         config: tinydecimate::Config::new(),
         stored: None,
+        method: None,
     }
 }
 
