@@ -12,6 +12,22 @@ pub enum Schedule {
     /// flags, sweeps vertices in index order and pairs each unprocessed non-feature vertex with
     /// the neighbour giving its cheapest legal collapse; both are then done for the pass.
     Passes,
+    /// Greedy in batches (meshoptimizer's pass structure): each pass prices every vertex's
+    /// cheapest candidate once, orders them by price and collapses them in that order, skipping
+    /// a vertex whose price a collapse earlier in the pass made stale; a pass ends at its error
+    /// limit (1.5 times the price of the candidate that would reach the target) and the next
+    /// pass prices afresh. Same rules, limits and stops as [`Schedule::Greedy`], with no
+    /// re-pricing after each collapse; the order is exact within a pass only. Needs the crate
+    /// feature `batched` (else [`Storage::start`](crate::Storage::start) refuses it).
+    Batched,
+}
+
+impl Schedule {
+    /// Whether collapses come in price order over the whole mesh ([`Schedule::Greedy`] and
+    /// [`Schedule::Batched`]): these share the defaults and options of the greedy schedule.
+    pub const fn is_ordered(self) -> bool {
+        !matches!(self, Schedule::Passes)
+    }
 }
 
 /// Which cost ranks the collapses (see [`crate::cost`]).
@@ -80,7 +96,8 @@ pub struct Config {
     /// Never perform a collapse whose cost exceeds this (in the schedule's cost units): the
     /// other stop, before the target if the remaining collapses all cost more.
     pub max_cost: f32,
-    /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue); at least 1.
+    /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue; for
+    /// [`Schedule::Batched`]: its batches); at least 1.
     pub max_passes: u32,
     /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1; the default is 2,
     /// chosen by measured error (see docs/algorithm.md). Negative or non-finite values are rejected
@@ -90,7 +107,8 @@ pub struct Config {
     pub features: bool,
     /// How D is normalised before the feature test.
     pub feature_mode: FeatureMode,
-    /// Feature vertices may be the kept endpoint of a collapse ([`Schedule::Greedy`] only; they
+    /// Feature vertices may be the kept endpoint of a collapse ([`Schedule::Greedy`] and
+    /// [`Schedule::Batched`] only; they
     /// are never removed either way). The paper says no: they take no part in any collapse, and
     /// [`Schedule::Passes`] always follows the paper here.
     pub feature_targets: bool,

@@ -52,7 +52,9 @@ pub enum ConfigField {
     /// [`VertexDecimation`](crate::VertexDecimation) with another schedule than greedy, or
     /// `VertexDecimation` with an error bound.
     Operator,
-    /// The schedule cannot run this cost ([`StoredQuadric`](crate::StoredQuadric): greedy only).
+    /// The schedule cannot run this cost ([`StoredQuadric`](crate::StoredQuadric): greedy or
+    /// batched only), or [`Schedule::Batched`](crate::Schedule::Batched) without the crate
+    /// feature `batched`.
     Schedule,
     /// Optimal placement without [`Positions::Write`](crate::Positions::Write), or with an error bound (its control
     /// points are read at the positions placement would move).
@@ -139,7 +141,8 @@ impl core::fmt::Display for Error {
                 ),
                 ConfigField::Schedule => write!(
                     f,
-                    "configuration field Schedule: stored quadrics run the greedy schedule only"
+                    "configuration field Schedule: stored quadrics run the greedy or batched \
+                     schedule only, and the batched schedule needs the crate feature `batched`"
                 ),
                 ConfigField::Placement => write!(
                     f,

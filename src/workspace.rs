@@ -172,6 +172,11 @@ impl<'a, L: Index> Storage<'a, L> {
             bound.prepare(triangles, nv, config)?;
         }
         config.validate()?;
+        if config.schedule == Schedule::Batched && !cfg!(feature = "batched") {
+            return Err(Error::InvalidConfig {
+                field: ConfigField::Schedule,
+            });
+        }
         if (!matches!(O::KIND, Kind::Edge) && config.schedule != Schedule::Greedy)
             || (matches!(O::KIND, Kind::Removal) && B::ON)
         {
@@ -180,10 +185,10 @@ impl<'a, L: Index> Storage<'a, L> {
             });
         }
         if config.error_limit.is_finite()
-            && (matches!(O::KIND, Kind::Triangle) || config.schedule != Schedule::Greedy)
+            && (matches!(O::KIND, Kind::Triangle) || !config.schedule.is_ordered())
         {
-            // Only the greedy edge collapse and vertex removal measure each operation's own
-            // error.
+            // Only the greedy and batched edge collapse and vertex removal measure each
+            // operation's own error.
             return Err(Error::InvalidConfig {
                 field: ConfigField::ErrorLimit,
             });

@@ -44,10 +44,18 @@ fn operations_are_bounded_by_the_mesh_size() {
         ("grid", grid(40, 30, 0.2)),
     ] {
         let (v, t) = (m.positions.len() as u64, m.triangles.len() as u64);
-        for config in [
+        let mut configs = vec![
             Config::new().with_ratio(0.0),
             Config::paper().with_ratio(0.0),
-        ] {
+        ];
+        if cfg!(feature = "batched") {
+            configs.push(
+                Config::new()
+                    .with_ratio(0.0)
+                    .with_schedule(Schedule::Batched),
+            );
+        }
+        for config in configs {
             let (ops, collapses, passes) = operations(&m, &config);
             // Sweeps: 3 per pass/round over V vertices, and one per halving of the mesh
             // (greedy's threshold refresh); queue: pops per collapse.
@@ -73,6 +81,11 @@ fn operations_are_bounded_by_the_mesh_size() {
                     "{name}: {ops} operations"
                 ),
                 Schedule::Passes => assert!(ops <= (v + 1) * 3 * passes as u64 + 1),
+                // Per pass: one pricing sweep, and a pop per priced vertex or re-queued one.
+                Schedule::Batched => assert!(
+                    ops <= 2 * (v + 1) * passes as u64 + v * halvings + 2 * collapses as u64,
+                    "{name}: {ops} operations"
+                ),
             }
             assert!(ops <= 3 * v * config.max_passes as u64 + v * halvings + 2 * t);
         }

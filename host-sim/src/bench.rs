@@ -111,10 +111,12 @@ pub struct Options {
     pub progress: bool,
     /// Our modes prune parts (`host-sim simplify --parts prune`, the default).
     pub prune: bool,
+    /// Only these of our modes (`None`: every one); meshoptimizer always runs.
+    pub modes: Option<Vec<Method>>,
 }
 
 /// One simplifier.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     /// tinydecimate, `Config::new()`: greedy schedule, `CostKind::Quadric` (the default).
@@ -138,11 +140,14 @@ pub enum Method {
     /// tinydecimate, Hoppe's energy (`tinydecimate::cost::Energy`, κ =
     /// `Energy::KAPPA`) with `Config::new()`.
     Energy,
+    /// tinydecimate, `Config::new().with_schedule(Schedule::Batched)`: the default's cost
+    /// and rules in meshoptimizer's passes.
+    Batched,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 9] = [
+    pub const ALL: [Method; 10] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -152,6 +157,7 @@ impl Method {
         Method::MeshoptUpdate,
         Method::VertexDecimation,
         Method::Energy,
+        Method::Batched,
     ];
 
     /// The operator of our modes.
@@ -189,6 +195,7 @@ impl Method {
             Method::MeshoptUpdate => "meshoptimizer simplifyWithUpdate",
             Method::VertexDecimation => "vertex decimation",
             Method::Energy => "Hoppe's energy",
+            Method::Batched => "batched quadric",
         }
     }
 
@@ -199,6 +206,7 @@ impl Method {
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
+            Method::Batched => Some(Config::new().with_schedule(tinydecimate::Schedule::Batched)),
             Method::Meshopt | Method::MeshoptUpdate => None,
         }
     }
@@ -215,6 +223,7 @@ impl Method {
             Method::MeshoptUpdate => "`meshopt::simplify_with_update`",
             Method::VertexDecimation => "`VertexDecimation::new()` with `Config::new()`",
             Method::Energy => "`Energy` (κ = 0.01) with `Config::new()`",
+            Method::Batched => "`Config::new().with_schedule(Schedule::Batched)`",
         }
     }
 
@@ -640,7 +649,7 @@ fn run_method(
 /// `config` with `host-sim simplify`'s default error limit where it applies (the greedy
 /// schedule).
 fn with_default_limit(config: Config, mesh: &MeshData) -> Config {
-    if config.schedule == tinydecimate::Schedule::Greedy {
+    if config.schedule.is_ordered() {
         config.with_relative_error_limit(crate::cmd::simplify::DEFAULT_ERROR_LIMIT, &mesh.positions)
     } else {
         config
@@ -716,7 +725,16 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
         bail!("--samples-per-triangle must be a positive number");
     }
     let meshes = load_meshes(opts)?;
-    let steps = (meshes.len() * opts.ratios.len() * Method::ALL.len()) as u64;
+    let methods: Vec<Method> = Method::ALL
+        .into_iter()
+        .filter(|m| match (m, &opts.modes) {
+            (_, None) | (Method::Meshopt, _) => true,
+            // The reference of the modes that move vertices.
+            (Method::MeshoptUpdate, Some(x)) => x.contains(&Method::StoredOptimal),
+            (m, Some(x)) => x.contains(m),
+        })
+        .collect();
+    let steps = (meshes.len() * opts.ratios.len() * methods.len()) as u64;
     let bar = if opts.progress && std::io::stderr().is_terminal() {
         let bar = ProgressBar::with_draw_target(Some(steps), ProgressDrawTarget::stderr());
         if let Ok(style) = ProgressStyle::with_template("bench {bar:30} {pos}/{len} {msg}") {
@@ -744,7 +762,7 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
         for &ratio in &opts.ratios {
             let target = (ratio as f64 * t as f64) as usize;
             let first = rows.len();
-            for method in Method::ALL {
+            for &method in &methods {
                 bar.set_message(format!("{name} {ratio} {}", method.label()));
                 let ours = method.is_ours();
                 let input = if ours { mesh } else { welded };
@@ -987,7 +1005,7 @@ mod tests {
         );
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 7);
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 8);
     }
 
     #[test]
@@ -1117,6 +1135,7 @@ mod tests {
             samples_per_triangle: 2.0,
             progress: false,
             prune: true,
+            modes: None,
         };
         let r = bench(&opts, "test").unwrap();
         check_rows(&r);

@@ -118,9 +118,9 @@ fn shares_positions(positions: &[[f32; 3]]) -> bool {
 }
 
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
-/// prunes in (the greedy schedule, no error bound).
+/// prunes in (the greedy or batched schedule, no error bound).
 pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
-    prune && !bounded && config.schedule == tinydecimate::Schedule::Greedy
+    prune && !bounded && config.schedule.is_ordered()
 }
 
 /// Vertex attributes for the attribute-aware stored quadric

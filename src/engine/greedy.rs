@@ -156,7 +156,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
 
     /// Whether `from -> to`, priced `c`, is over [`Config::error_limit`](crate::Config::error_limit)
     /// (then counted); else its error is taken into the largest made. Nothing without a limit.
-    fn over_error_limit(&mut self, from: usize, w: &FanSummary<C::Fan>, to: usize, c: f32) -> bool {
+    pub(super) fn over_error_limit(
+        &mut self,
+        from: usize,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        c: f32,
+    ) -> bool {
         if !self.limit2.is_finite() {
             return false;
         }
@@ -178,7 +184,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// With twins: whether the fronts' share of the target left the whole output (fronts and
     /// the backs whose fronts live) above it; then the share drops by the excess and the run
     /// goes on. One sweep of the buffer, only when the share is met.
-    fn twins_over(&mut self) -> bool {
+    pub(super) fn twins_over(&mut self) -> bool {
         if self.mesh.twins == 0 {
             return false;
         }

@@ -163,6 +163,95 @@ impl<'a, L: Index> Heap<'a, L> {
         }
     }
 
+    #[cfg(feature = "batched")]
+    /// Batched: empties the queue for a pass's order. The batched schedule never uses the
+    /// per-vertex slots (they stay unset), so [`Heap::remove`] and [`Heap::queued`] see no
+    /// vertex queued.
+    pub(crate) fn batch_clear(&mut self) {
+        self.len = 0;
+    }
+
+    #[cfg(feature = "batched")]
+    /// Batched: puts `v` in the pass's order with `key` (a binary heap on the same arrays,
+    /// without the slots: `v` must not be in it already).
+    pub(crate) fn batch_push(&mut self, v: usize, key: f32) {
+        if self.len >= self.heap.len() {
+            return;
+        }
+        if let Some(k) = self.key.get_mut(v) {
+            *k = key;
+        } else {
+            return;
+        }
+        let mut slot = self.len;
+        self.len += 1;
+        while slot > 0 {
+            let parent = (slot - 1) / 2;
+            let u = self.at(parent);
+            if !self.less(v, u) {
+                break;
+            }
+            self.put(slot, u);
+            slot = parent;
+        }
+        self.put(slot, v);
+    }
+
+    #[cfg(feature = "batched")]
+    /// Batched: `v`'s key, whether or not it is in the order.
+    pub(crate) fn batch_key(&self, v: usize) -> f32 {
+        self.key_of(v)
+    }
+
+    #[cfg(feature = "batched")]
+    /// Batched: sets `v`'s key without putting it in the order.
+    pub(crate) fn batch_set_key(&mut self, v: usize, key: f32) {
+        if let Some(k) = self.key.get_mut(v) {
+            *k = key;
+        }
+    }
+
+    #[cfg(feature = "batched")]
+    /// Batched: takes the cheapest vertex of the pass's order and its key.
+    pub(crate) fn batch_pop(&mut self) -> Option<(usize, f32)> {
+        if self.len == 0 {
+            return None;
+        }
+        let top = self.at(0);
+        self.len -= 1;
+        if self.len > 0 {
+            let v = self.at(self.len);
+            let mut slot = 0;
+            loop {
+                let l = 2 * slot + 1;
+                if l >= self.len {
+                    break;
+                }
+                let r = l + 1;
+                let mut child = l;
+                if r < self.len && self.less(self.at(r), self.at(l)) {
+                    child = r;
+                }
+                let u = self.at(child);
+                if !self.less(u, v) {
+                    break;
+                }
+                self.put(slot, u);
+                slot = child;
+            }
+            self.put(slot, v);
+        }
+        Some((top, self.key_of(top)))
+    }
+
+    #[cfg(feature = "batched")]
+    /// Writes `v` at `slot` of the order only (the batched heap keeps no slots).
+    fn put(&mut self, slot: usize, v: usize) {
+        if let Some(h) = self.heap.get_mut(slot) {
+            *h = L::narrow(v);
+        }
+    }
+
     /// The cheapest vertex and its key, without removing it.
     pub(crate) fn peek(&self) -> Option<(usize, f32)> {
         if self.len == 0 {

@@ -10,6 +10,8 @@
 //!                   ^             in cost order, collapse, re-key the vertices whose fan changed
 //!                   └── when the mesh has halved (fresh feature threshold) or the queue is empty
 //! Passes: Mean ─> Flags ─> Pairs: sweep vertices in index order, pair, collapse ─> next pass
+//! Batched: Mean ─> Price ─> Batch: pop in price order, skip stale, collapse ─> next pass
+//!                    ^                  (Mean again first when the mesh has halved)
 //! ```
 //!
 //! A vertex's key is a lower bound: the price of its cheapest candidate under the flag and
@@ -38,6 +40,7 @@ use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Schedule};
 use heap::Heap;
 
+mod batched;
 mod greedy;
 pub(crate) mod heap;
 mod log;
@@ -63,6 +66,11 @@ enum Phase {
     Queue,
     /// Passes: pairing vertices in index order.
     Pairs,
+    /// Batched: pricing every vertex's cheapest candidate into the pass's order.
+    Price,
+    /// Batched: collapsing in the pass's order.
+    #[cfg_attr(not(feature = "batched"), allow(dead_code))]
+    Batch,
     /// Finished.
     Done(Stop),
 }
@@ -120,6 +128,9 @@ pub struct Simplifier<
     refresh_at: usize,
     /// Greedy: the Mean sweep under way only refreshes the threshold (no new round).
     refresh_only: bool,
+    /// Batched: the pass under way (nothing without the `batched` feature).
+    #[cfg_attr(not(feature = "batched"), allow(dead_code))]
+    batch: batched::Pass,
     pass_triangles: heapless::Vec<u32, { crate::PASS_LOG }>,
     rejected: Rejections,
     /// Collapse log (`[removed, kept]`), written only once `record_into` gave one.
@@ -210,6 +221,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             reached2: 0.0,
             refresh_at: 0,
             refresh_only: false,
+            batch: batched::Pass::new(),
             pass_triangles: heapless::Vec::new(),
             rejected: Rejections::default(),
             log: &mut [],
@@ -330,10 +342,16 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                         0.0
                     });
                     self.v = 0;
+                    if self.config.schedule == Schedule::Batched {
+                        self.threshold_taken();
+                    }
                     if self.refresh_only {
                         // Vertices meet the new threshold as they are re-keyed.
                         self.refresh_only = false;
                         self.refresh_at = self.mesh.live / 2;
+                        if self.config.schedule == Schedule::Batched {
+                            return self.start_pass();
+                        }
                         self.phase = Phase::Queue;
                         return;
                     }
@@ -384,15 +402,17 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             }
             Phase::Queue => self.pop(),
             Phase::Pairs => self.pair(),
+            Phase::Price => self.price_next(),
+            Phase::Batch => self.batch(),
         }
     }
 
     /// The phase that starts a round's work.
     fn after_init(&self) -> Phase {
-        if self.config.schedule == Schedule::Passes {
-            Phase::Flags
-        } else {
-            Phase::Keys
+        match self.config.schedule {
+            Schedule::Passes => Phase::Flags,
+            Schedule::Greedy => Phase::Keys,
+            Schedule::Batched => Phase::Price,
         }
     }
 

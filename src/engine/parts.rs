@@ -32,7 +32,7 @@ use crate::policy::cost::Cost;
 use {
     crate::math,
     crate::mesh::{flag, next3, Mesh},
-    crate::{ConfigField, Error, Schedule},
+    crate::{ConfigField, Error},
 };
 
 /// The parts of a pruning run.
@@ -99,7 +99,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let nv = self.mesh.vertex_count();
         if B::ON
             || self.logging
-            || self.config.schedule != Schedule::Greedy
+            || !self.config.schedule.is_ordered()
             || self.phase != Phase::Mean
             || self.v != 0
             || self.passes != 0

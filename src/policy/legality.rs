@@ -82,7 +82,7 @@
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::mesh::{corner, flag, next3, prev3, Mesh, NIL};
-use crate::{Config, Schedule};
+use crate::Config;
 
 /// Why a candidate collapse was refused: one variant per rule, in the order of [`RULES`],
 /// whose row says what the rule protects. The engine counts each in
@@ -348,7 +348,7 @@ impl Rules {
             cos_turn2: c * c,
             min_ratio: q * q / 12.0,
             // The paper's schedule keeps the paper's rule.
-            feature_targets: config.feature_targets && config.schedule == Schedule::Greedy,
+            feature_targets: config.feature_targets && config.schedule.is_ordered(),
         }
     }
 }

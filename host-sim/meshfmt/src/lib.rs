@@ -132,6 +132,8 @@ pub enum ScheduleCode {
     Greedy = 0,
     /// `Schedule::Passes`.
     Passes = 1,
+    /// `Schedule::Batched`.
+    Batched = 2,
 }
 
 /// Method code: the cost and operator a case runs (header byte 30). Codes 0-3 name a cost of
@@ -336,6 +338,7 @@ impl CaseHeader {
         let schedule = match r.u8() {
             0 => ScheduleCode::Greedy,
             1 => ScheduleCode::Passes,
+            2 => ScheduleCode::Batched,
             _ => return Err(FormatError::Code),
         };
         let vertices = r.u32();
@@ -695,6 +698,7 @@ pub mod lib {
             .with_schedule(match h.schedule {
                 ScheduleCode::Greedy => Schedule::Greedy,
                 ScheduleCode::Passes => Schedule::Passes,
+                ScheduleCode::Batched => Schedule::Batched,
             })
             .with_target(target(h.target_ratio, h.target_triangles))
             .with_lambda(h.lambda)
@@ -765,6 +769,7 @@ pub mod lib {
             schedule: match config.schedule {
                 Schedule::Greedy => ScheduleCode::Greedy,
                 Schedule::Passes => ScheduleCode::Passes,
+                Schedule::Batched => ScheduleCode::Batched,
             },
             method: match config.cost {
                 CostKind::Quadric => MethodCode::Quadric,

@@ -46,6 +46,10 @@ pub struct Args {
     /// cheaper than the next collapse vanish whole, `keep` keeps every part.
     #[arg(long, value_enum, default_value_t = super::simplify::PartsArg::Prune)]
     pub parts: super::simplify::PartsArg,
+    /// Only these of our modes, comma separated (default: every one); meshoptimizer always
+    /// runs, as the reference (simplifyWithUpdate too with stored-optimal).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub modes: Option<Vec<crate::bench::Method>>,
 }
 
 impl Args {
@@ -76,6 +80,7 @@ impl Args {
             samples_per_triangle: self.samples_per_triangle,
             progress: true,
             prune: self.parts == super::simplify::PartsArg::Prune,
+            modes: self.modes.clone(),
         };
         let partial = self.quick || self.only.is_some();
         let default = |p: &str| (!partial).then(|| PathBuf::from(p));

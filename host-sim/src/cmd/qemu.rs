@@ -62,8 +62,11 @@ pub struct Args {
     #[arg(long, default_value_t = 0.25)]
     pub ratio: f32,
     /// With --mesh: the paper's passes instead of the greedy schedule.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "batched")]
     pub passes: bool,
+    /// With --mesh: the batched schedule (`Schedule::Batched`) instead of the greedy one.
+    #[arg(long)]
+    pub batched: bool,
     /// With --mesh: u32 triangles (default u16).
     #[arg(long)]
     pub u32: bool,
@@ -167,7 +170,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     } else {
         let (cases, expected) = match &a.mesh {
             Some(path) => (
-                vec![mesh_case(path, a.ratio, a.passes, a.u32)?],
+                vec![mesh_case(path, a.ratio, a.schedule(), a.u32)?],
                 Expected::Host,
             ),
             None => (
@@ -196,16 +199,29 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     })
 }
 
+impl Args {
+    /// The schedule of a --mesh run.
+    fn schedule(&self) -> tinydecimate::Schedule {
+        use tinydecimate::Schedule;
+        match (self.passes, self.batched) {
+            (true, _) => Schedule::Passes,
+            (_, true) => Schedule::Batched,
+            _ => Schedule::Greedy,
+        }
+    }
+}
+
 /// A case of a mesh file with `Config::new()` and the given ratio and schedule.
-pub fn mesh_case(path: &Path, ratio: f32, passes: bool, u32: bool) -> Result<Case> {
+pub fn mesh_case(
+    path: &Path,
+    ratio: f32,
+    schedule: tinydecimate::Schedule,
+    u32: bool,
+) -> Result<Case> {
     let m = crate::io::load(path)?;
     let config = tinydecimate::Config::new()
         .with_ratio(ratio)
-        .with_schedule(if passes {
-            tinydecimate::Schedule::Passes
-        } else {
-            tinydecimate::Schedule::Greedy
-        });
+        .with_schedule(schedule);
     Ok(Case {
         name: path
             .file_stem()

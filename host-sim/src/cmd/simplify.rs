@@ -34,6 +34,10 @@ pub enum ScheduleArg {
     /// collapses in sweeps over the mesh, each vertex at most once per pass. For comparison
     /// with the paper; its error is higher than greedy's at the same triangle count.
     Passes,
+    /// Greedy in batches (meshoptimizer's passes): every vertex priced once per pass, the
+    /// pass collapsed in price order, skipping vertices an earlier collapse of the pass
+    /// touched; `Config::new()` otherwise.
+    Batched,
 }
 
 /// Which cost, on the command line (`Config::with_cost`).
@@ -361,8 +365,9 @@ pub struct Args {
     /// the kept vertex to the planes it replaces, plus any boundary retreat) is above it is not
     /// made, so the run stops short of the target (`stop: ErrorLimit`) rather than cut a corner
     /// to reach a count. `P%` of the bounding-box diagonal or a distance in the input's units;
-    /// `none` for no limit. Default: 2% with the greedy schedule and edge collapse (the only
-    /// ones that measure it), none otherwise. Not a guarantee (see --max-error for one).
+    /// `none` for no limit. Default: 2% with the greedy or batched schedule, except with the
+    /// triangle collapse (the runs that measure it), none otherwise. Not a guarantee (see
+    /// --max-error for one).
     #[arg(long, value_parser = parse_error_limit)]
     pub error_limit: Option<ErrorLimit>,
     /// Collapse schedule.
@@ -437,7 +442,7 @@ impl Args {
     pub fn error_limit(&self) -> ErrorLimit {
         match self.error_limit {
             Some(e) => e,
-            None if self.schedule == ScheduleArg::Greedy
+            None if self.schedule != ScheduleArg::Passes
                 && self.operator != OperatorArg::Triangle =>
             {
                 ErrorLimit::At(MaxError::Fraction(DEFAULT_ERROR_LIMIT))
@@ -452,6 +457,7 @@ impl Args {
         let base = match self.schedule {
             ScheduleArg::Greedy => Config::new().with_schedule(Schedule::Greedy),
             ScheduleArg::Passes => Config::paper(),
+            ScheduleArg::Batched => Config::new().with_schedule(Schedule::Batched),
         };
         let base = match self.cost {
             Some(cost) => base.with_cost(cost.into()),

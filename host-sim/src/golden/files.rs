@@ -75,6 +75,7 @@ fn config_line(c: &Config) -> String {
         match c.schedule {
             Schedule::Greedy => "greedy",
             Schedule::Passes => "passes",
+            Schedule::Batched => "batched",
         },
         match c.cost {
             tinydecimate::CostKind::Quadric => "quadric",

@@ -179,7 +179,7 @@ impl Cost for Energy<'_> {
                 available: self.samples.len(),
             });
         }
-        if config.schedule != crate::Schedule::Greedy {
+        if !config.schedule.is_ordered() {
             return super::bad(crate::ConfigField::Schedule);
         }
         for s in self.samples.iter_mut() {

@@ -28,7 +28,7 @@ pub enum Placement {
 /// The matrices live in a caller-provided slice, one [`VertexQuadric`] (40 bytes) per vertex, at
 /// least as long as the positions (else [`Error::Capacity`] for
 /// [`Capacity::Quadrics`](crate::Capacity::Quadrics) when the run starts). Needs the greedy
-/// schedule (else [`Error::InvalidConfig`] for [`ConfigField::Schedule`]) and [`Config::cost`]
+/// or batched schedule (else [`Error::InvalidConfig`] for [`ConfigField::Schedule`]) and [`Config::cost`]
 /// = [`CostKind::Quadric`]; the boundary weight is [`Config::boundary_weight`].
 /// [`Config::stored`] is the recommended configuration (no feature rule: lower mean error,
 /// and the faster re-keying). All in the engine's normalised units, and each vertex's
@@ -126,7 +126,7 @@ impl Cost for StoredQuadric<'_> {
                 available: self.q.len(),
             });
         }
-        if config.schedule != crate::Schedule::Greedy {
+        if !config.schedule.is_ordered() {
             return bad(ConfigField::Schedule);
         }
         if config.cost != CostKind::Quadric {

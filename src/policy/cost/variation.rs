@@ -36,7 +36,7 @@ impl NormalVariation {
 
     pub(super) const fn from_config(config: &Config) -> Self {
         NormalVariation {
-            length_weighted: matches!(config.schedule, crate::Schedule::Greedy),
+            length_weighted: config.schedule.is_ordered(),
             boundary_weight: config.boundary_weight,
         }
     }
