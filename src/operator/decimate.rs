@@ -599,6 +599,18 @@ fn fit2(pv: V3, pos: &[V3; MAX_RING], tris: &[[u8; 3]]) -> (f32, f32, f32) {
     (e, area2, far2)
 }
 
+/// `x` modulo `n` for `x < 2n`: a ring position past the end wraps once. No division (the
+/// Cortex-M0 has none, and a remainder by a length the compiler cannot prove nonzero keeps a
+/// panic path).
+#[inline]
+fn wrap(x: usize, n: usize) -> usize {
+    if x >= n {
+        x - n
+    } else {
+        x
+    }
+}
+
 /// The fan of ring position `i` over `fan`'s loop: triangles `(i, j, j + 1)` around the loop
 /// (the half-edge collapse of the removed vertex onto `ring[i]`), each rotated to loop order,
 /// into `out`; how many. A boundary loop is open: only its ends have a fan.
@@ -606,7 +618,7 @@ fn ring_fan(fan: &Fan, i: usize, out: &mut [[u8; 3]; MAX_RING]) -> usize {
     let n = fan.n;
     let mut made = 0;
     for j in 1..n.saturating_sub(1) {
-        let (b, c) = ((i + j) % n, (i + j + 1) % n);
+        let (b, c) = (wrap(i + j, n), wrap(i + j + 1, n));
         // Three ring positions in cyclic order from `i`, rotated so the smallest leads.
         let t = [i as u8, b as u8, c as u8];
         let r = if t[1] < t[0] && t[1] < t[2] {
@@ -665,7 +677,7 @@ pub(crate) fn plan(
     for k in 0..closed {
         let (a, b) = (
             pos.get(k).copied().unwrap_or(pv),
-            pos.get((k + 1) % n).copied().unwrap_or(pv),
+            pos.get(wrap(k + 1, n)).copied().unwrap_or(pv),
         );
         let c = math::cross(math::sub(a, pv), math::sub(b, pv));
         old2 += sqrt(math::dot(c, c));
@@ -752,10 +764,10 @@ pub(crate) fn plan(
         // Each new triangle (i, b, b + 1) takes the place of the old (v, b, b + 1): its
         // normal is the reference, as for the collapse's own normal rules.
         for (j, p) in planes.iter_mut().enumerate().take(k) {
-            let b = (i + j + 1) % n;
+            let b = wrap(i + j + 1, n);
             let (pb, pc) = (
                 pos.get(b).copied().unwrap_or(pv),
-                pos.get((b + 1) % n).copied().unwrap_or(pv),
+                pos.get(wrap(b + 1, n)).copied().unwrap_or(pv),
             );
             let c = math::cross(math::sub(pb, pv), math::sub(pc, pv));
             let l2 = math::dot(c, c);

@@ -20,15 +20,15 @@ use tinydecimate::cluster::{
     Quadrics, Scratch, SliceSource, Source, ThenCollapseError, KEY_LANES,
 };
 use tinydecimate::cost::{
-    error, AttributeQuadric, AttributeState, Builtin, Cost, Move, NormalVariation, Placement,
-    Quadric, StoredQuadric, VertexQuadric,
+    error, AttributeQuadric, AttributeState, Builtin, Cost, Energy, Move, NormalVariation,
+    Placement, Quadric, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::operator::Operator;
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, EdgeCollapse, FeatureMode, Index, NoBound, Positions, Progressive, Report,
-    Schedule, Simplifier, Target, TriangleCollapse, VertexDecimation, Workspace,
+    Config, CostKind, EdgeCollapse, FeatureMode, Fill, Index, NoBound, Positions, Progressive,
+    Report, Schedule, Simplifier, Target, TriangleCollapse, VertexDecimation, Workspace,
 };
 
 #[panic_handler]
@@ -213,7 +213,12 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     let decimation = VertexDecimation::new()
         .with_feature_angle(opaque_f32(6))
         .with_feature_growth(opaque_f32(7), opaque_f32(8))
-        .with_min_aspect(opaque_f32(9));
+        .with_min_aspect(opaque_f32(9))
+        .with_fill(if input(13) & 1 == 0 {
+            Fill::Fit
+        } else {
+            Fill::Shape
+        });
     match ws.start(
         Positions::Read(p),
         t,
@@ -232,6 +237,18 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     }
     let pd = Quadric::new();
     match ws.start(Positions::Read(p), t, &config, pd, NoBound, EdgeCollapse) {
+        Ok(s) => drive(s),
+        Err(e) => display(&e),
+    }
+    // The batched schedule (crate feature `batched`).
+    match ws.start(
+        Positions::Read(p),
+        t,
+        &config.with_schedule(Schedule::Batched),
+        Builtin::new(),
+        NoBound,
+        EdgeCollapse,
+    ) {
         Ok(s) => drive(s),
         Err(e) => display(&e),
     }
@@ -260,6 +277,21 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
                 t,
                 &config,
                 StoredQuadric::new(q, Placement::Optimal),
+                NoBound,
+                EdgeCollapse,
+            )
+            .map(|s| s.run())
+        {
+            Ok(r) => use_report(&r),
+            Err(e) => display(&e),
+        }
+        // Hoppe's energy: its samples in the quadrics' storage.
+        match ws
+            .start(
+                Positions::Read(p),
+                t,
+                &config,
+                Energy::new(q).with_weights(opaque_f32(14), opaque_f32(15)),
                 NoBound,
                 EdgeCollapse,
             )
