@@ -58,31 +58,39 @@ impl<'a, L: Index> Heap<'a, L> {
         }
     }
 
-    fn place(&mut self, slot: usize, v: usize) {
+    /// Writes `v` at `slot` of the order, and with `SLOTS` its slot (the batched order keeps
+    /// none).
+    fn place_with<const SLOTS: bool>(&mut self, slot: usize, v: usize) {
         if let Some(h) = self.heap.get_mut(slot) {
             *h = L::narrow(v);
         }
-        if let Some(p) = self.pos.get_mut(v) {
-            *p = L::narrow(slot);
+        if SLOTS {
+            if let Some(p) = self.pos.get_mut(v) {
+                *p = L::narrow(slot);
+            }
         }
     }
 
-    fn up(&mut self, mut slot: usize) {
-        let v = self.at(slot);
+    fn place(&mut self, slot: usize, v: usize) {
+        self.place_with::<true>(slot, v);
+    }
+
+    /// Moves `v` up from `slot` to its place in the order.
+    fn sift_up<const SLOTS: bool>(&mut self, mut slot: usize, v: usize) {
         while slot > 0 {
             let parent = (slot - 1) / 2;
             let u = self.at(parent);
             if !self.less(v, u) {
                 break;
             }
-            self.place(slot, u);
+            self.place_with::<SLOTS>(slot, u);
             slot = parent;
         }
-        self.place(slot, v);
+        self.place_with::<SLOTS>(slot, v);
     }
 
-    fn down(&mut self, mut slot: usize) {
-        let v = self.at(slot);
+    /// Moves `v` down from `slot` to its place in the order.
+    fn sift_down<const SLOTS: bool>(&mut self, mut slot: usize, v: usize) {
         loop {
             let l = 2 * slot + 1;
             if l >= self.len {
@@ -97,10 +105,20 @@ impl<'a, L: Index> Heap<'a, L> {
             if !self.less(u, v) {
                 break;
             }
-            self.place(slot, u);
+            self.place_with::<SLOTS>(slot, u);
             slot = child;
         }
-        self.place(slot, v);
+        self.place_with::<SLOTS>(slot, v);
+    }
+
+    fn up(&mut self, slot: usize) {
+        let v = self.at(slot);
+        self.sift_up::<true>(slot, v);
+    }
+
+    fn down(&mut self, slot: usize) {
+        let v = self.at(slot);
+        self.sift_down::<true>(slot, v);
     }
 
     /// Inserts `v` with `key`, or moves it if already queued.
@@ -183,18 +201,9 @@ impl<'a, L: Index> Heap<'a, L> {
         } else {
             return;
         }
-        let mut slot = self.len;
+        let slot = self.len;
         self.len += 1;
-        while slot > 0 {
-            let parent = (slot - 1) / 2;
-            let u = self.at(parent);
-            if !self.less(v, u) {
-                break;
-            }
-            self.put(slot, u);
-            slot = parent;
-        }
-        self.put(slot, v);
+        self.sift_up::<false>(slot, v);
     }
 
     #[cfg(feature = "batched")]
@@ -221,35 +230,9 @@ impl<'a, L: Index> Heap<'a, L> {
         self.len -= 1;
         if self.len > 0 {
             let v = self.at(self.len);
-            let mut slot = 0;
-            loop {
-                let l = 2 * slot + 1;
-                if l >= self.len {
-                    break;
-                }
-                let r = l + 1;
-                let mut child = l;
-                if r < self.len && self.less(self.at(r), self.at(l)) {
-                    child = r;
-                }
-                let u = self.at(child);
-                if !self.less(u, v) {
-                    break;
-                }
-                self.put(slot, u);
-                slot = child;
-            }
-            self.put(slot, v);
+            self.sift_down::<false>(0, v);
         }
         Some((top, self.key_of(top)))
-    }
-
-    #[cfg(feature = "batched")]
-    /// Writes `v` at `slot` of the order only (the batched heap keeps no slots).
-    fn put(&mut self, slot: usize, v: usize) {
-        if let Some(h) = self.heap.get_mut(slot) {
-            *h = L::narrow(v);
-        }
     }
 
     /// The cheapest vertex and its key, without removing it.
