@@ -40,13 +40,8 @@ use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 #[cfg(feature = "batched")]
 use {
-    super::price::take_cheapest,
-    super::walk::MAX_CANDIDATES,
-    super::Phase,
-    crate::math::V3,
-    crate::mesh::{flag, NIL},
-    crate::policy::legality::on,
-    crate::report::Stop,
+    super::price::take_cheapest_of, super::walk::MAX_CANDIDATES, super::Phase, crate::math::V3,
+    crate::mesh::flag, crate::policy::legality::on, crate::report::Stop,
 };
 
 /// The state of the pass under way.
@@ -160,15 +155,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if is && on!(Feature) {
             return self.heap.batch_set_key(v, f32::INFINITY);
         }
-        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, w, &mut cand);
-        let mut key = f32::INFINITY;
-        for &(c, _) in cand.iter().take(n) {
-            if c < key {
-                key = c;
-            }
-        }
-        if n > 0 {
+        let key = self.least(v, w);
+        if key.is_finite() {
             self.heap.batch_push(v, key);
         } else {
             self.heap.batch_set_key(v, f32::INFINITY);
@@ -216,19 +204,29 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             self.over_cost = true;
             return self.end_pass();
         }
+        if let Some((to, at)) = self.choose_batched(v, key) {
+            self.count_pop(key);
+            self.collapse_batched(v, to, at);
+        }
+    }
+
+    /// Batched: the cheapest legal candidate of `v` (keyed `key`) if its price is still
+    /// `key`; else `v` goes back into the order at its new price, or is dropped.
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    fn choose_batched(&mut self, v: usize, key: f32) -> Option<(usize, Option<([f32; 3], V3)>)> {
         let mut w = self.unwalked();
         let w = self.walk(v, &mut w);
-        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, w, &mut cand);
-        let cand = cand.get_mut(..n).unwrap_or(&mut []);
-        while let Some((c, to)) = take_cheapest(cand) {
+        let mut prices = [f32::INFINITY; MAX_CANDIDATES];
+        self.prices(v, w, &mut prices);
+        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb) {
             if c > key {
                 // Its cheapest candidate was refused, or its price rose (a stored cost's
                 // kept vertex grew): back into the order at this price, and priced in full
                 // in the next pass (the key is no longer its cheapest price).
                 self.heap.batch_push(v, c);
                 self.mesh.set_flag(v, flag::RAISED, true);
-                return;
+                return None;
             }
             match self.legal(v, w, to, c) {
                 Ok((c, at)) => {
@@ -236,18 +234,17 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                         // Placement refused: at the kept vertex's own, higher price.
                         self.heap.batch_push(v, c);
                         self.mesh.set_flag(v, flag::RAISED, true);
-                    } else if !self.over_error_limit(v, w, to, c) {
-                        self.count_pop(key);
-                        self.collapse_batched(v, to, at);
-                    } else {
-                        // Not cut to reach a count: the next candidate, if any.
-                        continue;
+                        return None;
                     }
-                    return;
+                    if !self.over_error_limit(v, w, to, c) {
+                        return Some((to, at));
+                    }
+                    // Not cut to reach a count: the next candidate, if any.
                 }
                 Err(r) => self.rejected.count(r),
             }
         }
+        None
     }
 
     /// Batched: counts a vertex of the order that was collapsed or skipped as stale; the one

@@ -1,7 +1,7 @@
 //! The greedy schedule: a queue keyed by each vertex's cheapest candidate, popped in cost
 //! order, re-keying the vertices whose fans a collapse changed.
 
-use super::price::take_cheapest;
+use super::price::take_cheapest_of;
 use super::walk::{FanSummary, MAX_CANDIDATES};
 use super::{Phase, Simplifier};
 use crate::index::Index;
@@ -38,15 +38,8 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if is && on!(Feature) {
             return self.heap.remove(v);
         }
-        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, w, &mut cand);
-        let mut key = f32::INFINITY;
-        for &(c, _) in cand.iter().take(n) {
-            if c < key {
-                key = c;
-            }
-        }
-        if n > 0 {
+        let key = self.least(v, w);
+        if key.is_finite() {
             self.heap.set(v, key)
         } else {
             self.heap.remove(v)
@@ -111,22 +104,29 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             Kind::Removal => return self.pop_removal(),
             Kind::Edge => {}
         }
-        let Some((v, key)) = self.top() else {
-            return;
-        };
+        if let Some((v, to, at)) = self.choose() {
+            self.collapse_greedy(v, to, at);
+        }
+    }
+
+    /// Greedy: the collapse the top of the queue makes, if any (a vertex whose cheapest
+    /// candidate is refused or dearer than its key goes back in at its true price, or out).
+    #[allow(clippy::type_complexity)]
+    #[inline(always)]
+    fn choose(&mut self) -> Option<(usize, usize, Option<([f32; 3], V3)>)> {
+        let (v, key) = self.top()?;
         let mut w = self.unwalked();
         let w = self.walk(v, &mut w);
-        let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-        let n = self.candidates(v, w, &mut cand);
-        let cand = cand.get_mut(..n).unwrap_or(&mut []);
+        let mut prices = [f32::INFINITY; MAX_CANDIDATES];
+        self.prices(v, w, &mut prices);
         let mut refused = false;
-        while let Some((c, to)) = take_cheapest(cand) {
+        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb) {
             if c > key && self.keys_only_fall() {
                 // A stale key (see `keys_only_fall`): back in at this price before the rules
                 // are spent on it; above a refused candidate, no longer a lower bound.
                 self.heap.set(v, c);
                 self.mesh.set_flag(v, flag::RAISED, refused);
-                return;
+                return None;
             }
             refused = true;
             match self.legal(v, w, to, c) {
@@ -138,20 +138,20 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                             // Past a refused candidate or placement.
                             self.mesh.set_flag(v, flag::RAISED, true);
                         }
-                    } else {
-                        if self.over_error_limit(v, w, to, c) {
-                            // Not cut to reach a count: the next candidate, if any.
-                            continue;
-                        }
-                        self.heap.remove(v);
-                        self.collapse_greedy(v, to, at);
+                        return None;
                     }
-                    return;
+                    if self.over_error_limit(v, w, to, c) {
+                        // Not cut to reach a count: the next candidate, if any.
+                        continue;
+                    }
+                    self.heap.remove(v);
+                    return Some((v, to, at));
                 }
                 Err(r) => self.rejected.count(r),
             }
         }
         self.heap.remove(v);
+        None
     }
 
     /// Whether `from -> to`, priced `c`, is over [`Config::error_limit`](crate::Config::error_limit)
@@ -320,20 +320,18 @@ mod tests {
                 };
                 let mut w = self.unwalked();
                 let w = self.walk(v, &mut w);
-                let mut cand = [(f32::INFINITY, NIL); MAX_CANDIDATES];
-                let n = self.candidates(v, w, &mut cand);
-                let least = cand
-                    .iter()
-                    .take(n)
-                    .fold(f32::INFINITY, |m, c| if c.0 < m { c.0 } else { m });
+                let mut prices = [f32::INFINITY; MAX_CANDIDATES];
+                self.prices(v, w, &mut prices);
+                let least = self.least(v, w);
                 if key > least && !self.mesh.has(v, flag::RAISED) {
                     return Some((v, key, least));
                 }
                 // Raised: at most its cheapest candidate the rules allow now.
-                let legal = cand
+                let legal = prices
                     .iter()
-                    .take(n)
-                    .filter_map(|c| self.legal(v, w, c.1, c.0).ok())
+                    .zip(w.neighbours())
+                    .filter(|c| c.0.is_finite())
+                    .filter_map(|c| self.legal(v, w, c.1, *c.0).ok())
                     .fold(f32::INFINITY, |m, c| if c.0 < m { c.0 } else { m });
                 if key > legal {
                     return Some((v, key, legal));

@@ -173,24 +173,56 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         }
     }
 
-    /// `v`'s candidates with their prices, in fan order; returns how many.
-    pub(super) fn candidates(
+    /// The prices of `v`'s candidates (`w`'s neighbours, in fan order) into `out`,
+    /// `INFINITY` where the flag and boundary rules refuse one; returns how many were priced.
+    /// One price per neighbour, no vertex numbers: those are `w.nb` (the micro:bit's stack).
+    pub(super) fn prices(
         &self,
         v: usize,
         w: &FanSummary<C::Fan>,
-        out: &mut [(f32, usize); MAX_CANDIDATES],
+        out: &mut [f32; MAX_CANDIDATES],
     ) -> usize {
         let mut n = 0;
-        for x in w.neighbours() {
-            if let Some(p) = self.price(v, w, x) {
-                if let Some(slot) = out.get_mut(n) {
-                    *slot = (p, x);
+        for (x, slot) in w.neighbours().zip(out.iter_mut()) {
+            *slot = match self.price(v, w, x) {
+                Some(p) => {
                     n += 1;
+                    p
                 }
-            }
+                None => f32::INFINITY,
+            };
         }
         n
     }
+
+    /// The least price among `v`'s candidates (`INFINITY`: none), without an array.
+    pub(super) fn least(&self, v: usize, w: &FanSummary<C::Fan>) -> f32 {
+        let mut key = f32::INFINITY;
+        for x in w.neighbours() {
+            if let Some(p) = self.price(v, w, x) {
+                if p < key {
+                    key = p;
+                }
+            }
+        }
+        key
+    }
+}
+
+/// Removes and returns the cheapest `(price, vertex)` of `prices` (finite prices only; `nb`
+/// the vertices in the same order; ties: lower vertex), if any is left.
+pub(super) fn take_cheapest_of(prices: &mut [f32], nb: &[u32]) -> Option<(f32, usize)> {
+    let mut min: Option<(f32, u32, usize)> = None;
+    for (i, (&c, &x)) in prices.iter().zip(nb).enumerate() {
+        if c.is_finite() && min.is_none_or(|(m, y, _)| less((c, x as usize), (m, y as usize))) {
+            min = Some((c, x, i));
+        }
+    }
+    let (c, x, i) = min?;
+    if let Some(slot) = prices.get_mut(i) {
+        *slot = f32::INFINITY;
+    }
+    Some((c, x as usize))
 }
 
 /// Removes and returns the cheapest `(price, vertex)` (ties: lower vertex), if any is left.

@@ -387,8 +387,25 @@ fn simplify(
     };
     let ticks = measure::stop(syst);
     let low = measure::lowest_touched();
+    write_header(h, &outcome, pos, ticks, sp, low, r);
+}
 
-    *r = meshfmt::lib::result_header(h.index_type, &outcome, board::BOARD);
+/// The result header of a library call and its log lines. Never inlined: its temporaries
+/// (the header, the report's formatting) stay out of the frame that lies above the library's
+/// during the call, so the board's stack holds larger meshes.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn write_header(
+    h: &CaseHeader,
+    outcome: &Result<tinydecimate::Report, tinydecimate::Error>,
+    pos: &[[f32; 3]],
+    ticks: u64,
+    sp: usize,
+    low: usize,
+    r: &mut ResultHeader,
+) {
+    let entry = h.entry();
+    *r = meshfmt::lib::result_header(h.index_type, outcome, board::BOARD);
     if entry == meshfmt::Entry::StoredOptimal {
         r.positions_hash = meshfmt::positions_hash(pos);
     }
@@ -396,7 +413,7 @@ fn simplify(
     r.stack_bytes = sp.saturating_sub(low) as u32;
     r.stack_high_water = measure::depth(low) as u32;
     r.workspace_bytes = board::Workspace::BYTES as u32;
-    match &outcome {
+    match outcome {
         Ok(report) => defmt::info!("{}", report),
         Err(e) => defmt::warn!("simplify failed: {}", e),
     }
