@@ -125,7 +125,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
             next_r2: f32::INFINITY,
             removed: 0,
         };
-        if count > 0 {
+        if count > 1 {
             (parts.next, parts.next_r2) = measure(&self.mesh, &parts, &self.cost, parts.order(0));
         }
         self.parts = parts;
@@ -242,6 +242,10 @@ fn label<L: Index, I: Index, C: Cost>(
             }
             count += 1;
         }
+    }
+    if count < 2 {
+        // One part never goes (the last part stays): no sizes to take.
+        return count;
     }
     for i in 0..count {
         let r = links.get(i).map_or(0, |l| l[1].to_usize());
