@@ -219,7 +219,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let w = self.walk(v, &mut w);
         let mut prices = [f32::INFINITY; MAX_CANDIDATES];
         self.prices(v, w, &mut prices);
-        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb) {
+        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb, w.n) {
             if c > key {
                 // Its cheapest candidate was refused, or its price rose (a stored cost's
                 // kept vertex grew): back into the order at this price, and priced in full

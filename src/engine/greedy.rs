@@ -120,7 +120,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let mut prices = [f32::INFINITY; MAX_CANDIDATES];
         self.prices(v, w, &mut prices);
         let mut refused = false;
-        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb) {
+        while let Some((c, to)) = take_cheapest_of(&mut prices, &w.nb, w.n) {
             if c > key && self.keys_only_fall() {
                 // A stale key (see `keys_only_fall`): back in at this price before the rules
                 // are spent on it; above a refused candidate, no longer a lower bound.

@@ -209,11 +209,11 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     }
 }
 
-/// Removes and returns the cheapest `(price, vertex)` of `prices` (finite prices only; `nb`
-/// the vertices in the same order; ties: lower vertex), if any is left.
-pub(super) fn take_cheapest_of(prices: &mut [f32], nb: &[u32]) -> Option<(f32, usize)> {
+/// Removes and returns the cheapest `(price, vertex)` among the first `n` of `prices` (finite
+/// prices only; `nb` the vertices in the same order; ties: lower vertex), if any is left.
+pub(super) fn take_cheapest_of(prices: &mut [f32], nb: &[u32], n: usize) -> Option<(f32, usize)> {
     let mut min: Option<(f32, u32, usize)> = None;
-    for (i, (&c, &x)) in prices.iter().zip(nb).enumerate() {
+    for (i, (&c, &x)) in prices.iter().zip(nb).take(n).enumerate() {
         if c.is_finite() && min.is_none_or(|(m, y, _)| less((c, x as usize), (m, y as usize))) {
             min = Some((c, x, i));
         }
