@@ -7,6 +7,8 @@
 //! * `keeping_parts_loses_none`: the same mesh without `with_parts` keeps every part, leaves
 //!   the sheet fewer triangles, and stops short of a target that pruning reaches.
 //! * `the_last_part_stays`: small parts only and a target of one triangle: never empty.
+//! * `one_part_runs_as_without_parts`: the cow (one part) gives the same triangles with and
+//!   without `with_parts`.
 //! * `stepping_prunes_as_one_run`: a run in steps of one operation gives the same bytes.
 //! * `refusals`: passes schedule, an error bound, short links, after the first step.
 //! * `shared_meshes_reach_their_target`: pr2_sensor_mount and pins at 10 %.
@@ -182,6 +184,19 @@ fn the_last_part_stays() {
     let left: BTreeSet<u32> = out.triangles.iter().flatten().copied().collect();
     assert!(left.iter().all(|&v| v >= 24), "{left:?}");
     parts_verdict(&m, &out).assert_valid("octahedra");
+}
+
+/// One part is the last part and never goes: the cow runs as without `with_parts`.
+#[test]
+fn one_part_runs_as_without_parts() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/cow.obj");
+    let m = parse_obj(&std::fs::read_to_string(path).expect("cow"));
+    let (with, r_with) = run(&m, 0.1, true);
+    let (without, r_without) = run(&m, 0.1, false);
+    assert_eq!(r_with.parts_removed, 0, "{r_with:?}");
+    assert_eq!(r_with.collapses, r_without.collapses);
+    assert_eq!(with.triangles, without.triangles);
+    parts_verdict(&m, &with).assert_valid("cow");
 }
 
 #[test]

@@ -249,3 +249,26 @@ pub(super) fn take_cheapest(cand: &mut [(f32, usize)]) -> Option<(f32, usize)> {
 fn less(a: (f32, usize), b: (f32, usize)) -> bool {
     a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::take_cheapest_of;
+
+    /// Cheapest first, ties on the lower vertex, refused (infinite) prices and the slots past
+    /// the fan's own candidates never taken.
+    #[test]
+    fn cheapest_then_lower_vertex() {
+        let inf = f32::INFINITY;
+        let mut prices = [2.0, inf, 1.0, 1.0, 0.5, 0.0];
+        let nb = [7, 3, 9, 4, 8, 1];
+        let mut order = [(0.0, 0); 6];
+        let mut n = 0;
+        while let Some(c) = take_cheapest_of(&mut prices, &nb, 5) {
+            order[n] = c;
+            n += 1;
+        }
+        // Slot 5 (price 0, vertex 1) is past the fan's 5 candidates; slot 1 was refused.
+        assert_eq!(n, 4);
+        assert_eq!(order[..4], [(0.5, 8), (1.0, 4), (1.0, 9), (2.0, 7)]);
+    }
+}
