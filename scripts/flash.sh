@@ -5,10 +5,12 @@
 # opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
 # of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
 #
-# Usage: scripts/flash.sh [--all] [--micromath] [--symbols N] [--target T]...
+# Usage: scripts/flash.sh [--all] [--micromath] [--opt-level L] [--symbols N] [--target T]...
 #   --all         also Config::paper(), a second triangle index type (u32 triangles on the same
 #                 Workspace<u16, ..>) and a second link type (Workspace<u32, ..> over u32)
 #   --micromath   the library's micromath backend instead of libm
+#   --opt-level L another opt-level than the "s" of tests/flash's Cargo.toml (e.g. z: smaller,
+#                 and slower: docs/devices.md has the instructions at each level)
 #   --symbols N   how many of the largest symbols the call adds to list per target (default 15)
 #   --target T    a Rust target (repeatable; default thumbv7em-none-eabihf thumbv6m-none-eabi
 #                 riscv32imc-unknown-none-elf)
@@ -20,12 +22,14 @@ root=$PWD
 
 all=0
 extra=()
+opt=s
 nsym=15
 targets=()
 while [ $# -gt 0 ]; do
     case $1 in
         --all | --paper) all=1 ;;
         --micromath) extra=(micromath) ;;
+        --opt-level) opt=$2; shift ;;
         --symbols) nsym=$2; shift ;;
         --target) targets+=("$2"); shift ;;
         -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
@@ -48,6 +52,8 @@ for t in "${targets[@]}"; do
 done
 
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/tests/flash/target}"
+# Cargo reads a profile setting from the environment over the manifest's.
+export CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt
 images="$CARGO_TARGET_DIR/images"
 mkdir -p "$images"
 # Variants: name, cargo features (comma-separated, may be empty), what the row shows.
@@ -68,7 +74,7 @@ build() { # target name features
     [ -z "$features" ] || args+=(--features "$features")
     echo "  cargo ${args[*]}" >&2
     cargo "${args[@]}" >&2
-    local elf="$images/$1-$2${extra[0]:+-${extra[0]}}.elf"
+    local elf="$images/$1-$2${extra[0]:+-${extra[0]}}-o$opt.elf"
     cp "$CARGO_TARGET_DIR/$1/release/tinydecimate-flash" "$elf"
     echo "$elf"
 }
@@ -102,7 +108,7 @@ added_symbols() { # without with n
     rm -f "$tmp"
 }
 
-echo "building tests/flash (opt-level \"s\", fat LTO, codegen-units 1, panic = abort)${extra[0]:+, ${extra[0]}}:" >&2
+echo "building tests/flash (opt-level \"$opt\", fat LTO, codegen-units 1, panic = abort)${extra[0]:+, ${extra[0]}}:" >&2
 declare -A size elf
 for t in "${targets[@]}"; do
     for v in "${variants[@]}"; do
@@ -113,7 +119,7 @@ for t in "${targets[@]}"; do
 done
 
 echo
-echo "flash of the library (.text + .rodata; image with the call - image without)${extra[0]:+, ${extra[0]} backend}"
+echo "flash of the library (.text + .rodata; image with the call - image without; opt-level \"$opt\")${extra[0]:+, ${extra[0]} backend}"
 echo
 echo "| target | instantiation | without | with | library (difference) |"
 echo "|---|---|---:|---:|---:|"
