@@ -174,25 +174,12 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     }
 
     /// The prices of `v`'s candidates (`w`'s neighbours, in fan order) into `out`,
-    /// `INFINITY` where the flag and boundary rules refuse one; returns how many were priced.
-    /// One price per neighbour, no vertex numbers: those are `w.nb` (the micro:bit's stack).
-    pub(super) fn prices(
-        &self,
-        v: usize,
-        w: &FanSummary<C::Fan>,
-        out: &mut [f32; MAX_CANDIDATES],
-    ) -> usize {
-        let mut n = 0;
+    /// `INFINITY` where the flag and boundary rules refuse one. One price per neighbour, no
+    /// vertex numbers: those are `w.nb` (the micro:bit's stack).
+    pub(super) fn prices(&self, v: usize, w: &FanSummary<C::Fan>, out: &mut [f32; MAX_CANDIDATES]) {
         for (x, slot) in w.neighbours().zip(out.iter_mut()) {
-            *slot = match self.price(v, w, x) {
-                Some(p) => {
-                    n += 1;
-                    p
-                }
-                None => f32::INFINITY,
-            };
+            *slot = self.price(v, w, x).unwrap_or(f32::INFINITY);
         }
-        n
     }
 
     /// The least price among `v`'s candidates (`INFINITY`: none), without an array.
