@@ -27,6 +27,18 @@ pub(crate) const fn prev3(k: usize) -> usize {
     }
 }
 
+/// The two vertices after slot `k` of `t` in winding order: `(t[next3(k)], t[prev3(k)])`, by
+/// a match on `k` (indexing with a computed slot spilled the triangle to the stack).
+#[inline(always)]
+pub(crate) fn others<T: Copy>(t: [T; 3], k: usize) -> (T, T) {
+    let [a, b, c] = t;
+    match k {
+        0 => (b, c),
+        1 => (c, a),
+        _ => (a, b),
+    }
+}
+
 /// Same three vertices (any order or winding): a later copy of a kept triangle is dropped.
 /// Both directions, so a removed `[x, x, x]` never matches.
 pub(crate) fn same_set(a: [usize; 3], b: [usize; 3]) -> bool {

@@ -70,6 +70,9 @@ fn seed_citations() {
             "Garland-Heckbert",
             "Garland and Heckbert",
             "§3.1-3.3",
+            // The passes and the normal variation W are the mobile paper's (Lin 2007).
+            "Cheng, Pan and Shi's passes",
+            "normal variation W (Cheng",
         ] {
             assert!(!text.contains(bad), "{name} still says {bad:?}");
         }

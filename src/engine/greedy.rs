@@ -6,7 +6,7 @@ use super::walk::{FanSummary, MAX_CANDIDATES};
 use super::{Phase, Simplifier};
 use crate::index::Index;
 use crate::math::V3;
-use crate::mesh::{flag, next3, prev3, NIL};
+use crate::mesh::{flag, NIL};
 use crate::operator::{Kind, Operator};
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
@@ -234,10 +234,10 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         // Both neighbours of every corner: a locked b's list has no order.
         let mut c = self.mesh.first(b);
         while c != NIL {
-            let tri = self.mesh.tri(c >> 2);
-            self.refresh(tri[next3(c & 3)], b);
-            self.refresh(tri[prev3(c & 3)], b);
-            c = self.mesh.after(c);
+            let (x, y) = crate::tri::others(self.mesh.tri(c >> 2), c & 3);
+            self.refresh(x, b);
+            self.refresh(y, b);
+            c = self.mesh.after_in(c, b);
         }
     }
 

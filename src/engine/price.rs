@@ -50,7 +50,21 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         to: usize,
         keep: bool,
     ) -> Option<f32> {
-        let m = self.make_move(from, w, to, keep)?;
+        self.price_with(from, self.mesh.flags(from), w, to, keep)
+    }
+
+    /// [`Self::price_kept`] with `from`'s flags `ff` already read: the move built in place,
+    /// not returned through memory by a call (one copy, for flash).
+    #[inline(never)]
+    fn price_with(
+        &self,
+        from: usize,
+        ff: u8,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        keep: bool,
+    ) -> Option<f32> {
+        let m = self.move_of(from, ff, w, to, keep)?;
         let c = self.cost.price(&w.fan, &m);
         if c.is_finite() {
             Some(if c > 0.0 { c } else { 0.0 })
@@ -74,8 +88,20 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         to: usize,
         keep: bool,
     ) -> Option<Move> {
+        self.move_of(from, self.mesh.flags(from), w, to, keep)
+    }
+
+    /// [`Self::make_move`] with `from`'s flags `ff` already read, inlined into its caller.
+    #[inline(always)]
+    fn move_of(
+        &self,
+        from: usize,
+        ff: u8,
+        w: &FanSummary<C::Fan>,
+        to: usize,
+        keep: bool,
+    ) -> Option<Move> {
         let mesh = &self.mesh;
-        let ff = mesh.flags(from);
         legality::flags_allow(&self.rules, ff, mesh.flags(to)).ok()?;
         let mut retreat2 = 0.0;
         if ff & flag::BOUNDARY != 0 && on!(Boundary) {
@@ -177,22 +203,37 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
     /// `INFINITY` where the flag and boundary rules refuse one. One price per neighbour, no
     /// vertex numbers: those are `w.nb` (the micro:bit's stack).
     pub(super) fn prices(&self, v: usize, w: &FanSummary<C::Fan>, out: &mut [f32; MAX_CANDIDATES]) {
+        let ff = self.movable_flags(v);
         for (x, slot) in w.neighbours().zip(out.iter_mut()) {
-            *slot = self.price(v, w, x).unwrap_or(f32::INFINITY);
+            *slot = ff
+                .and_then(|ff| self.price_with(v, ff, w, x, false))
+                .unwrap_or(f32::INFINITY);
         }
     }
 
     /// The least price among `v`'s candidates (`INFINITY`: none), without an array.
     pub(super) fn least(&self, v: usize, w: &FanSummary<C::Fan>) -> f32 {
         let mut key = f32::INFINITY;
+        let Some(ff) = self.movable_flags(v) else {
+            return key;
+        };
         for x in w.neighbours() {
-            if let Some(p) = self.price(v, w, x) {
+            if let Some(p) = self.price_with(v, ff, w, x, false) {
                 if p < key {
                     key = p;
                 }
             }
         }
         key
+    }
+
+    /// `v`'s flags, or `None` if the flag rules refuse every move of `v` whatever the kept
+    /// vertex (unused, locked, a feature): then no candidate of its walk is priced.
+    #[inline(always)]
+    fn movable_flags(&self, v: usize) -> Option<u8> {
+        let ff = self.mesh.flags(v);
+        legality::flags_allow(&self.rules, ff, flag::USED).ok()?;
+        Some(ff)
     }
 }
 

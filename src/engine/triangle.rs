@@ -197,7 +197,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                 continue;
             }
             let keep = tri[prev3(next3(k))];
-            let (x, y) = (tri[next3(k)], tri[prev3(k)]);
+            let (x, y) = crate::tri::others(tri, k);
             match self.check(x, keep, None) {
                 Ok(()) => {
                     self.heap.remove(x);

@@ -5,12 +5,13 @@
 use super::Simplifier;
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::mesh::{flag, next3, prev3, NIL};
+use crate::mesh::{flag, NIL};
 use crate::operator::Operator;
 use crate::policy::bound::Bound;
 use crate::policy::cost::Cost;
 use crate::policy::feature::Variation;
 use crate::policy::legality::Shape;
+use crate::tri;
 
 /// Candidates priced per vertex: its first `MAX_CANDIDATES` neighbours in fan order (a vertex
 /// of higher valence never moves onto the others).
@@ -88,14 +89,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         let normals = self.normals();
         let mut c = mesh.first(v);
         while c != NIL {
-            let tri = mesh.tri(c >> 2);
-            let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+            let (x, y) = tri::others(mesh.tri(c >> 2), c & 3);
             if w.n == 0 {
                 w.ends.0 = x;
             }
             w.ends.1 = y;
             w.push(x);
-            c = mesh.after(c);
+            c = mesh.after_in(c, v);
             if !normals {
                 continue;
             }
@@ -137,7 +137,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         while c != NIL && guard > 0 {
             guard -= 1;
             let tri = self.mesh.tri(c >> 2);
-            let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+            let (x, y) = tri::others(tri, c & 3);
             let (px, py) = (self.mesh.p(x), self.mesh.p(y));
             let (ex, ey) = (math::sub(px, pv), math::sub(py, pv));
             self.cost
@@ -167,7 +167,7 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     }
                 }
             }
-            c = self.mesh.after(c);
+            c = self.mesh.after_in(c, v);
         }
     }
 

@@ -194,11 +194,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut total = 0;
         let mut twice = false;
         for (t, k) in self.corners(v) {
-            let tri = self.tri(t);
-            for (x, f, map) in [
-                (tri[next3(k)], flag::SEEN_A, &mut *by_a),
-                (tri[prev3(k)], flag::SEEN_B, &mut *by_b),
-            ] {
+            let (a, b) = tri::others(self.tri(t), k);
+            for (x, f, map) in [(a, flag::SEEN_A, &mut *by_a), (b, flag::SEEN_B, &mut *by_b)] {
                 twice |= self.has(x, f);
                 self.set_flag(x, f, true);
                 if let Some(m) = map.get_mut(x) {
@@ -229,9 +226,9 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
             }
         }
         for (t, k) in self.corners(v) {
-            let tri = self.tri(t);
-            self.set_flag(tri[next3(k)], flag::SEEN_A, false);
-            self.set_flag(tri[prev3(k)], flag::SEEN_B, false);
+            let (a, b) = tri::others(self.tri(t), k);
+            self.set_flag(a, flag::SEEN_A, false);
+            self.set_flag(b, flag::SEEN_B, false);
         }
         fan
     }

@@ -13,7 +13,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len() + 1;
         while c != NIL && guard > 0 {
             guard -= 1;
-            let n = self.after(c);
+            let n = self.after_in(c, v);
             if (c >> 2) == t {
                 if prev == NIL {
                     self.set_first(v, n);
@@ -51,12 +51,12 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
                 c1 = c;
             }
             last = c;
-            c = self.after(c);
+            c = self.after_in(c, a);
         }
         let mut c = first;
         if c1 != NIL && c1 != last {
             self.set_after(last, first);
-            c = self.after(c1);
+            c = self.after_in(c1, a);
             self.set_after(c1, NIL);
         }
         // Walk the rotated list: survivors are re-pointed at b and chained into the run;
@@ -67,7 +67,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            let n = self.after(c);
+            // Before `c`'s triangle is re-pointed at b.
+            let n = self.after_in(c, a);
             let t = c >> 2;
             if self.tri(t).contains(&b) {
                 if let Some(d) = dead.get_mut(n_dead) {
@@ -185,7 +186,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            let n = self.after(c);
+            let n = self.after_in(c, b);
             if dead.contains(&(c >> 2)) {
                 if w_first == NIL {
                     w_first = c;

@@ -248,6 +248,16 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         }
     }
 
+    /// [`Mesh::after`] for a corner of `v`'s own list (a fan walk knows its vertex, so the
+    /// corner's index is not read again).
+    #[inline]
+    pub(crate) fn after_in(&self, c: usize, v: usize) -> usize {
+        match self.next.get(c >> 2).and_then(|n| n.get(c & 3)) {
+            Some(&t) if t != L::NIL => self.corner_of(t.to_usize(), v),
+            _ => NIL,
+        }
+    }
+
     #[inline]
     fn set_after(&mut self, c: usize, n: usize) {
         if let Some(x) = self.next.get_mut(c >> 2).and_then(|t| t.get_mut(c & 3)) {
@@ -357,6 +367,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         Corners {
             mesh: self,
             c: self.first(v),
+            v,
         }
     }
 
@@ -368,7 +379,7 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         while c != NIL && guard > 0 {
             guard -= 1;
             last = c;
-            c = self.after(c);
+            c = self.after_in(c, v);
         }
         last
     }
@@ -397,10 +408,10 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut guard = self.tris.len();
         while c != NIL && guard > 0 {
             guard -= 1;
-            let tri = self.tri(c >> 2);
-            f(tri[next3(c & 3)]);
-            f(tri[prev3(c & 3)]);
-            c = self.after(c);
+            let (x, y) = crate::tri::others(self.tri(c >> 2), c & 3);
+            f(x);
+            f(y);
+            c = self.after_in(c, v);
         }
     }
 
@@ -427,6 +438,7 @@ pub(crate) fn is_dead(t: [usize; 3]) -> bool {
 pub(crate) struct Corners<'m, 'a, L: Index, I: Index> {
     mesh: &'m Mesh<'a, L, I>,
     c: usize,
+    v: usize,
 }
 
 impl<L: Index, I: Index> Iterator for Corners<'_, '_, L, I> {
@@ -437,7 +449,7 @@ impl<L: Index, I: Index> Iterator for Corners<'_, '_, L, I> {
             return None;
         }
         let c = self.c;
-        self.c = self.mesh.after(c);
+        self.c = self.mesh.after_in(c, self.v);
         Some(((c >> 2), (c & 3)))
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::mesh::{flag, next3, prev3, Mesh, NIL};
+use crate::mesh::{flag, Mesh, NIL};
 
 /// The largest ring a vertex may have to be removed (its valence, plus one on a boundary):
 /// the hole's loop, and so every buffer of one removal, is at most this long.
@@ -285,7 +285,7 @@ pub(crate) fn classify<L: Index, I: Index>(
     let mut k = 0;
     for (t, c) in mesh.corners(v) {
         let tri = mesh.tri(t);
-        let (x, y) = (tri[next3(c)], tri[prev3(c)]);
+        let (x, y) = crate::tri::others(tri, c);
         if k > 0 && last_y != x {
             return None;
         }

@@ -546,7 +546,7 @@ fn survivor<L: Index, I: Index>(
     prev: Option<(usize, Shape)>,
     after: &impl Fn(usize) -> Shape,
 ) -> Result<Shape, Reject> {
-    let (x, y) = (old[next3(k)], old[prev3(k)]);
+    let (x, y) = crate::tri::others(old, k);
     let q = old.map(|v| mesh.p(v));
     let mut r = q;
     if let Some(v) = r.get_mut(k) {
@@ -604,7 +604,7 @@ pub(crate) fn check<L: Index, I: Index>(
     let (mut o1, mut o2, mut n_ab) = (NIL, NIL, 0);
     for (t, k) in mesh.corners(a) {
         let tri = mesh.tri(t);
-        let (x, y) = (tri[next3(k)], tri[prev3(k)]);
+        let (x, y) = crate::tri::others(tri, k);
         if x == b {
             o1 = y;
             n_ab += 1;
@@ -659,7 +659,7 @@ pub(crate) fn check<L: Index, I: Index>(
         if old.contains(&b) {
             continue;
         }
-        let (x, y) = (old[next3(k)], old[prev3(k)]);
+        let (x, y) = crate::tri::others(old, k);
         if on!(Duplicate)
             && ((x == o1 && y == o2) || (x == o2 && y == o1))
             && mesh.corners(b).any(|(u, _)| {
@@ -693,7 +693,7 @@ pub(crate) fn check<L: Index, I: Index>(
     while c != NIL && guard > 0 {
         guard -= 1;
         let tri = mesh.tri(c >> 2);
-        let (x, y) = (tri[next3(c & 3)], tri[prev3(c & 3)]);
+        let (x, y) = crate::tri::others(tri, c & 3);
         mesh.mark(x, true);
         mesh.mark(y, true);
         if x != a && y != a {
@@ -706,7 +706,7 @@ pub(crate) fn check<L: Index, I: Index>(
                 across_o2 = c >> 2;
             }
         }
-        c = mesh.after(c);
+        c = mesh.after_in(c, b);
     }
     let mut common = false;
     mesh.for_each_neighbour(a, |x| {
@@ -836,7 +836,7 @@ fn check_moved_b<L: Index, I: Index>(
         if old.contains(&a) {
             continue;
         }
-        let (x, y) = (old[next3(k)], old[prev3(k)]);
+        let (x, y) = crate::tri::others(old, k);
         let now = survivor(mesh, rules, (t, k, old), p, prev, &after)?;
         if first.is_none() {
             first = Some((x, now));

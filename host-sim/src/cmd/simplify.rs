@@ -30,7 +30,7 @@ pub enum ScheduleArg {
     /// The default and the one to use: the cheapest legal collapse of the whole mesh first,
     /// so the error grows as slowly as it can.
     Greedy,
-    /// Cheng, Pan and Shi's passes as the paper writes them (λ = 1, normal-variation cost):
+    /// Lin 2007's passes as the paper writes them (Algorithms 3-4; λ = 1, normal-variation cost):
     /// collapses in sweeps over the mesh, each vertex at most once per pass. For comparison
     /// with the paper; its error is higher than greedy's at the same triangle count.
     Passes,
@@ -47,7 +47,7 @@ pub enum CostArg {
     /// the squared distance to the removed vertex's current planes plus a boundary term
     /// (`Config::new()`). Nothing stored per vertex.
     Quadric,
-    /// The paper's normal variation W (Cheng, Pan and Shi), scaled by ℓ² for the greedy
+    /// The paper's normal variation W (Lin 2007 eq. 1-2), scaled by ℓ² for the greedy
     /// schedule (`Config::paper()`): keeps flat regions flat rather than minimising distance;
     /// for comparison with the paper, higher Metro error than `quadric`.
     Normal,
