@@ -27,8 +27,9 @@ pub(crate) const fn prev3(k: usize) -> usize {
     }
 }
 
-/// The two vertices after slot `k` of `t` in winding order: `(t[next3(k)], t[prev3(k)])`, by
-/// a match on `k` (indexing with a computed slot spilled the triangle to the stack).
+/// The two vertices after slot `k` (0, 1 or 2) of `t` in winding order: `(t[next3(k)],
+/// t[prev3(k)])`, by a match on `k` (indexing with a computed slot spilled the triangle to the
+/// stack). A corner's slot is never 3; it would read as 2.
 #[inline(always)]
 pub(crate) fn others<T: Copy>(t: [T; 3], k: usize) -> (T, T) {
     let [a, b, c] = t;
