@@ -31,7 +31,7 @@ use crate::policy::cost::Cost;
 #[cfg(feature = "parts")]
 use {
     crate::math,
-    crate::mesh::{flag, next3, Mesh},
+    crate::mesh::{flag, is_dead, Mesh},
     crate::{ConfigField, Error},
 };
 
@@ -198,10 +198,15 @@ fn label<L: Index, I: Index, C: Cost>(
     for (v, l) in links.iter_mut().enumerate() {
         l[0] = L::narrow(v);
     }
-    for v in 0..nv {
-        for (t, k) in mesh.corners(v) {
-            let w = mesh.tri(t)[next3(k)];
-            let (a, b) = (find(links, v), find(links, w));
+    // Two unions per live triangle join its three vertices; the roots do not depend on the
+    // order of the unions.
+    for t in 0..mesh.triangle_count() {
+        let tri = mesh.tri(t);
+        if is_dead(tri) {
+            continue;
+        }
+        for w in [tri[1], tri[2]] {
+            let (a, b) = (find(links, tri[0]), find(links, w));
             if let Some(l) = links.get_mut(a.max(b)) {
                 l[0] = L::narrow(a.min(b));
             }

@@ -106,22 +106,25 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     /// turned over from whatever its front became, as meshoptimizer keeps both sides.
     #[inline(always)]
     fn drop_duplicates(&mut self) {
+        // Twins need a pair with the same vertex set; without one in the first sweep (every
+        // clean mesh) the second finds nothing.
+        let mut pairs = false;
         for twins in [false, true] {
             for t in 0..self.tris.len() {
                 let tri = self.tri(t);
-                if is_dead(tri) {
+                if is_dead(tri) || (twins && !pairs) {
                     continue;
                 }
                 let mut c = self.first(tri[0]);
                 let mut first = NIL;
                 while c != NIL {
                     let u = c >> 2;
-                    if u < t
-                        && tri::same_set(self.tri(u), tri)
-                        && (twins || tri::same_winding(self.tri(u), tri))
-                    {
-                        first = u;
-                        break;
+                    if u < t && tri::same_set(self.tri(u), tri) {
+                        pairs = true;
+                        if twins || tri::same_winding(self.tri(u), tri) {
+                            first = u;
+                            break;
+                        }
                     }
                     c = self.after(c);
                 }
@@ -193,10 +196,17 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     fn order(&mut self, v: usize, by_a: &mut [L], by_b: &mut [L]) -> Fan {
         let mut total = 0;
         let mut twice = false;
+        // Vertices that are both some triangle's `a` and some triangle's `b`, each counted
+        // when its second flag is set.
+        let mut both = 0;
         for (t, k) in self.corners(v) {
             let (a, b) = tri::others(self.tri(t), k);
-            for (x, f, map) in [(a, flag::SEEN_A, &mut *by_a), (b, flag::SEEN_B, &mut *by_b)] {
+            for (x, f, g, map) in [
+                (a, flag::SEEN_A, flag::SEEN_B, &mut *by_a),
+                (b, flag::SEEN_B, flag::SEEN_A, &mut *by_b),
+            ] {
                 twice |= self.has(x, f);
+                both += usize::from(self.has(x, g));
                 self.set_flag(x, f, true);
                 if let Some(m) = map.get_mut(x) {
                     *m = L::narrow(t);
@@ -207,13 +217,14 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
         let mut fan = Fan::Irregular;
         if !twice {
             // The start: a triangle whose `a` is no triangle's `b` (none: a disc, start
-            // anywhere).
-            let mut starts = 0;
+            // anywhere). With no `a` twice, there are `total - both` of them.
+            let starts = total - both.min(total);
             let mut start = self.first(v);
-            for (t, k) in self.corners(v) {
-                if !self.has(self.tri(t)[next3(k)], flag::SEEN_B) {
-                    starts += 1;
-                    start = corner(t, k);
+            if starts == 1 {
+                for (t, k) in self.corners(v) {
+                    if !self.has(self.tri(t)[next3(k)], flag::SEEN_B) {
+                        start = corner(t, k);
+                    }
                 }
             }
             if starts <= 1 && self.fan_walk(v, start, by_a, false) == total {
