@@ -15,7 +15,7 @@ echo "|---|---|---|---:|---:|---:|---:|---|---|"
 for m in $meshes; do
   for s in greedy passes; do
     log="$out/$m-$s.txt"
-    "$bin" simplify "../shared/meshes/$m.obj" "$out/$m-$s.obj" --ratio "$ratio" --schedule "$s" >"$log" 2>&1 || true
+    "$bin" simplify "tests/fixtures/$m.obj" "$out/$m-$s.obj" --ratio "$ratio" --schedule "$s" >"$log" 2>&1 || true
     tin=$(awk '/triangles in/{print $3}' "$log")
     tout=$(awk '/triangles out/{print $3}' "$log")
     ms=$(awk '/library call/{print $3}' "$log")

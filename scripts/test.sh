@@ -46,6 +46,8 @@ example_log=$(cd examples/cortex-m4f && cargo run -q --release --example simplif
 echo "$example_log"
 grep -q "in flash at 0x" <<<"$example_log"
 grep -q "target_reached: true" <<<"$example_log"
+# The report's refusals by rule name, as defmt prints them (not a bare array of counts).
+grep -q "rejected: locked [0-9]*, feature [0-9]*" <<<"$example_log"
 
 echo "== the firmware example as a project template: copied out of the repository, built and run under QEMU"
 bash examples/cortex-m4f/check-template.sh

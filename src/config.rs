@@ -294,8 +294,14 @@ impl Config {
         self.with_max_error(fraction * crate::bound::bounding_diagonal(positions))
     }
 
+    /// The error limit `host-sim simplify` uses by default, as a fraction of the bounding-box
+    /// diagonal ([`Config::with_relative_error_limit`]): on clean meshes no collapse down to
+    /// 10 % is over it; on raw CAD exports and multi-part assets it refuses the few collapses
+    /// that cut a part or a corner.
+    pub const MODEL_ERROR_LIMIT: f32 = 0.02;
+
     /// Sets the error limit to `fraction` of the bounding-box diagonal of `positions` (0.02:
-    /// 2 % of the diagonal, what `host-sim simplify` uses by default).
+    /// 2 % of the diagonal, [`Config::MODEL_ERROR_LIMIT`]).
     pub fn with_relative_error_limit(self, fraction: f32, positions: &[[f32; 3]]) -> Self {
         self.with_error_limit(fraction * crate::bound::bounding_diagonal(positions))
     }

@@ -99,6 +99,8 @@ mod error;
 mod index;
 mod math;
 mod mesh;
+#[cfg(feature = "seams")]
+pub mod model;
 pub mod operator;
 mod policy;
 pub mod progressive;
@@ -120,6 +122,8 @@ pub use engine::Simplifier;
 pub use error::{Capacity, ConfigField, Error};
 pub use index::Index;
 pub use legality::{Reject, RULES};
+#[cfg(feature = "seams")]
+pub use model::ModelStorage;
 pub use operator::{EdgeCollapse, Fill, TriangleCollapse, VertexDecimation};
 pub use progressive::Progressive;
 pub use report::{Rejections, Report, Stop, PASS_LOG};

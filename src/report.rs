@@ -9,7 +9,6 @@ pub const PASS_LOG: usize = 32;
 /// per evaluation, under the first rule that refuses it, so the figures say which rule binds
 /// most, not how many distinct edges were refused.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rejections {
     counts: [u32; Reject::COUNT],
 }
@@ -45,6 +44,18 @@ impl core::fmt::Display for Rejections {
             write!(f, "{sep}{} {n}", rule.name)?;
         }
         Ok(())
+    }
+}
+
+/// As [`Display`](core::fmt::Display): each rule's name with its count, so a device's log
+/// says which rule refused what without the table at hand.
+#[cfg(feature = "defmt")]
+impl defmt::Format for Rejections {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        for (i, (rule, n)) in self.iter().enumerate() {
+            let sep = if i == 0 { "" } else { ", " };
+            defmt::write!(f, "{=str}{=str} {=u32}", sep, rule.name, n);
+        }
     }
 }
 

@@ -78,7 +78,7 @@ fn sort<L: Index>(positions: &[[f32; 3]], order: &mut [L]) {
         if k(order, root) >= k(order, child) {
             break;
         }
-        order.swap(root, child);
+        swap(order, root, child);
         root = child;
     };
     let n = order.len();
@@ -86,8 +86,17 @@ fn sort<L: Index>(positions: &[[f32; 3]], order: &mut [L]) {
         sift(order, root, n);
     }
     for end in (1..n).rev() {
-        order.swap(0, end);
+        swap(order, 0, end);
         sift(order, 0, end);
+    }
+}
+
+/// `order.swap(i, j)` where both are in range; the check keeps the heapsort panic-free where
+/// the optimiser cannot see the bounds through the sift's closure.
+#[inline]
+fn swap<L: Index>(order: &mut [L], i: usize, j: usize) {
+    if i < order.len() && j < order.len() {
+        order.swap(i, j);
     }
 }
 

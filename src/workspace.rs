@@ -98,6 +98,12 @@ impl<'a, L: Index> Storage<'a, L> {
         (self.keys.len().min(L::COUNT), self.next.len().min(L::COUNT))
     }
 
+    /// The queue's slots, one link per vertex: scratch before a run (the build writes them).
+    #[cfg(feature = "seams")]
+    pub(crate) fn queue_links(&mut self) -> &mut [L] {
+        self.heap
+    }
+
     /// A shorter-lived copy of the same storage (to run again after a [`Storage::start`]).
     pub fn reborrow(&mut self) -> Storage<'_, L> {
         Storage {
@@ -327,6 +333,20 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         config: &Config,
     ) -> Result<Report, Error> {
         self.as_storage().simplify(positions, triangles, config)
+    }
+
+    /// [`Storage::simplify_model`] on this workspace: a model's seams welded, its small parts
+    /// pruned, as `host-sim simplify` does by default (crate feature `seams`).
+    #[cfg(feature = "seams")]
+    pub fn simplify_model<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        model: &mut crate::model::ModelStorage<'_, I, L>,
+        config: &Config,
+    ) -> Result<Report, Error> {
+        self.as_storage()
+            .simplify_model(positions, triangles, model, config)
     }
 
     /// [`Storage::start`] on this workspace.

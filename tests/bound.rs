@@ -341,11 +341,6 @@ fn shared_meshes_stay_within_the_bound() {
         "fandisk.obj",
         "pr2_sensor_mount.obj",
     ] {
-        let path = common::shared_meshes().join(name);
-        if !path.exists() {
-            eprintln!("{name}: not found, skipped");
-            continue;
-        }
         let m = common::load_obj(name);
         check(name, &m, &[0.005], unlimited());
     }

@@ -1,4 +1,4 @@
-//! The real meshes of `../shared/meshes`: each simplifies to 25 % and 10 % with every
+//! The real meshes of `tests/fixtures`: each simplifies to 25 % and 10 % with every
 //! invariant holding, in both schedules.
 
 mod common;

@@ -58,7 +58,7 @@ pub const MESHOPT_CRATE_VERSION: &str = "0.7.0";
 pub const QUICK_MESHES: [&str; 2] = ["cow.obj", "plate_holes.obj"];
 /// The ratios `--quick` runs.
 pub const QUICK_RATIOS: [f32; 2] = [0.5, 0.1];
-/// The messy multi-part meshes of `../shared/meshes` (see its SOURCES.md: many open parts,
+/// The messy multi-part meshes of `tests/fixtures` (see its SOURCES.md: many open parts,
 /// non-manifold edges, pinched vertices). The summary reports their worst error ratios apart
 /// from the other meshes': the targets are ≤ 1.5x meshoptimizer at the same triangle count there,
 /// ≤ 0.8x mean and ≤ 1.0x max elsewhere.
@@ -69,7 +69,7 @@ pub fn is_messy(mesh: &str) -> bool {
     MESSY_MESHES.contains(&mesh)
 }
 
-/// The real-world meshes of `../shared/meshes` (see its SOURCES.md, "Added for real-world
+/// The real-world meshes of `tests/fixtures` (see its SOURCES.md, "Added for real-world
 /// content"): raw CAD exports (flat faces tessellated into long slivers) and a renderer's
 /// seam-split index buffer. Their worst error ratios are reported apart, held to ≤ 1.0x
 /// meshoptimizer (at the same triangle count where ours stops short).
@@ -83,18 +83,13 @@ pub fn is_real_world(mesh: &str) -> bool {
 /// The ratios the summary's time figure is the geometric mean over (50 % and 10 %).
 pub const TIME_RATIOS: [f32; 2] = [0.5, 0.1];
 
-/// `../shared/meshes` beside the checkout (the default mesh directory).
+/// The repository's public test meshes (`tests/fixtures`, sources and licences in its
+/// SOURCES.md): the default mesh directory.
 pub fn default_meshes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes")
-}
-
-/// The repository's own copies of the quick meshes (`tests/fixtures`), so `--quick` runs
-/// without the shared meshes (in CI).
-pub fn fixture_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures")
 }
 
-/// What one benchmark run does (the resolved [`Args`]).
+/// What one benchmark run does (the resolved [`Args`](crate::cmd::bench::Args)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Mesh directory.
@@ -858,10 +853,15 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
         machine: machine(),
         meshoptimizer_version: MESHOPTIMIZER_VERSION.into(),
         meshopt_crate_version: MESHOPT_CRATE_VERSION.into(),
-        meshes: std::fs::canonicalize(&opts.meshes)
-            .unwrap_or_else(|_| opts.meshes.clone())
-            .display()
-            .to_string(),
+        meshes: {
+            // Relative to the repository where it is inside it: the report names no machine's path.
+            let abs = std::fs::canonicalize(&opts.meshes).unwrap_or_else(|_| opts.meshes.clone());
+            let root = std::fs::canonicalize(crate::repo_root()).unwrap_or_default();
+            abs.strip_prefix(&root)
+                .unwrap_or(&abs)
+                .display()
+                .to_string()
+        },
         ratios: opts.ratios.clone(),
         reps: opts.reps,
         samples_per_triangle: opts.samples_per_triangle,
@@ -982,7 +982,7 @@ mod tests {
         let c = Cli::try_parse_from(["x", "--quick", "--ratios", "0.3,0.2"]).unwrap();
         let (o, md, js) = c.args.options();
         assert_eq!((o.ratios, o.reps), (vec![0.3, 0.2], 1));
-        assert_eq!(o.meshes, fixture_meshes());
+        assert_eq!(o.meshes, default_meshes());
         assert_eq!((md, js), (None, None));
         let c =
             Cli::try_parse_from(["x", "--only", "wuson.obj,cow.obj", "--ratios", "0.1"]).unwrap();
@@ -1128,7 +1128,7 @@ mod tests {
     #[test]
     fn stopped_short_is_compared_at_the_same_count() {
         let opts = Options {
-            meshes: fixture_meshes(),
+            meshes: default_meshes(),
             only: Some(vec!["plate_holes.obj".into()]),
             ratios: vec![0.01],
             reps: 1,

@@ -3,7 +3,7 @@
 //!
 //! The checker itself is the `meshcheck` crate (`host-sim/meshcheck`), shared with the
 //! library's tests and the fuzz targets; its documentation has the definitions, which match
-//! `/work/shared/meshes/SOURCES.md`. This module only adapts it to host-sim's mesh type.
+//! `tests/fixtures/SOURCES.md`. This module only adapts it to host-sim's mesh type.
 
 use crate::io::MeshData;
 
@@ -307,10 +307,7 @@ mod tests {
             ("plate_holes.obj", 618, 1878, 0, 0, 0, -8, 1),
         ];
         for (name, v, e, be, bl, nmv, eu, c) in expect {
-            let p = std::path::Path::new("/work/shared/meshes").join(name);
-            if !p.exists() {
-                continue;
-            }
+            let p = crate::bench::default_meshes().join(name);
             let m = crate::io::load(&p).unwrap();
             let t = analyse(&m);
             assert_eq!(

@@ -16,12 +16,12 @@ pub struct MeshData {
     pub triangles: Vec<Tri>,
 }
 
-/// `../shared/meshes` beside the checkout.
+/// The repository's public test meshes (`tests/fixtures`, sources and licences in its
+/// SOURCES.md).
 pub fn shared_meshes() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("shared")
-        .join("meshes")
+        .join("tests")
+        .join("fixtures")
 }
 
 /// Minimal reader for the shared meshes (only `v x y z` and `f a b c`, 1-based).

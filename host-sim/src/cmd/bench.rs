@@ -7,13 +7,13 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 
 use crate::bench::markdown::markdown;
-use crate::bench::{bench, default_meshes, fixture_meshes, Options, QUICK_MESHES, QUICK_RATIOS};
+use crate::bench::{bench, default_meshes, Options, QUICK_MESHES, QUICK_RATIOS};
 
 /// `host-sim bench ...`
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
     /// Directory of meshes (.obj, .ply, .stl); every mesh in it runs, smallest first. Default:
-    /// `../shared/meshes` beside the checkout (with --quick: the repository's tests/fixtures).
+    /// the repository's `tests/fixtures`.
     #[arg(long)]
     pub meshes: Option<PathBuf>,
     /// Only these files of the mesh directory, comma separated (e.g. `--only cow.obj`).
@@ -59,7 +59,7 @@ impl Args {
     pub fn options(&self) -> (Options, Option<PathBuf>, Option<PathBuf>) {
         let (meshes, only, ratios, reps) = if self.quick {
             (
-                self.meshes.clone().unwrap_or_else(fixture_meshes),
+                self.meshes.clone().unwrap_or_else(default_meshes),
                 Some(QUICK_MESHES.iter().map(|s| s.to_string()).collect()),
                 QUICK_RATIOS.to_vec(),
                 1,

@@ -20,7 +20,7 @@ use crate::metro::{metro, MetroOptions};
 /// `host-sim bound-table [MESH...]`
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
-    /// Meshes (default: every .obj in ../shared/meshes, smallest first).
+    /// Meshes (default: every .obj in tests/fixtures, smallest first).
     pub meshes: Vec<PathBuf>,
     /// The bound and meshoptimizer's target_error, as a fraction (0.005 = 0.5 %; ours of the
     /// bounding-box diagonal, meshoptimizer's of its own scale, the largest bbox side).
@@ -35,7 +35,7 @@ pub struct Args {
 }
 
 fn default_meshes() -> Vec<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
+    let dir = crate::bench::default_meshes();
     let mut v: Vec<(u64, PathBuf)> = std::fs::read_dir(&dir)
         .map(|d| {
             d.filter_map(|e| e.ok())

@@ -236,7 +236,7 @@ fn parse_samples(v: &str) -> std::result::Result<f64, String> {
 /// The default `--error-limit` as a fraction of the bounding-box diagonal (the bench uses it
 /// too): on the shared clean meshes no collapse down to 10 % is over it; on the real-world ones
 /// it refuses the few collapses that cut a part or a corner (docs/realworld.md).
-pub const DEFAULT_ERROR_LIMIT: f32 = 0.02;
+pub const DEFAULT_ERROR_LIMIT: f32 = tinydecimate::Config::MODEL_ERROR_LIMIT;
 
 /// `--error-limit`: a distance, a percentage of the diagonal, or none.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -25,10 +25,12 @@ use tinydecimate::cost::{
 };
 use tinydecimate::operator::Operator;
 use tinydecimate::progressive::{Split, Storage};
+use tinydecimate::seam::SeamCorners;
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{
-    Config, CostKind, EdgeCollapse, FeatureMode, Fill, Index, NoBound, Positions, Progressive,
-    Report, Schedule, Simplifier, Target, TriangleCollapse, VertexDecimation, Workspace,
+    Config, CostKind, EdgeCollapse, FeatureMode, Fill, Index, ModelStorage, NoBound, Positions,
+    Progressive, Report, Schedule, Simplifier, Target, TriangleCollapse, VertexDecimation,
+    Workspace,
 };
 
 #[panic_handler]
@@ -187,6 +189,25 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
     match ws.simplify(p, t, &config) {
         Ok(r) => use_report(&r),
         Err(e) => display(&e),
+    }
+    // A model's one call: seams welded, parts pruned, either kind of seam corner.
+    let mut wedges: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let mut parts: [[L; 2]; V] = black_box([[L::ZERO; 2]; V]);
+    let (nw, nl) = (input(9) as usize, input(10) as usize);
+    if let (Some(w), Some(l)) = (wedges.get_mut(..nw), parts.get_mut(..nl)) {
+        let corners = if input(11) & 1 == 0 {
+            SeamCorners::Lock
+        } else {
+            SeamCorners::Move
+        };
+        let mut model = ModelStorage::new(w).with_corners(corners);
+        if input(11) & 2 == 0 {
+            model = model.with_parts(l);
+        }
+        match ws.simplify_model(p, t, &mut model, &config) {
+            Ok(r) => use_report(&r),
+            Err(e) => display(&e),
+        }
     }
     match ws_default.start(
         Positions::Read(p),
