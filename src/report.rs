@@ -54,7 +54,7 @@ impl defmt::Format for Rejections {
     fn format(&self, f: defmt::Formatter<'_>) {
         for (i, (rule, n)) in self.iter().enumerate() {
             let sep = if i == 0 { "" } else { ", " };
-            defmt::write!(f, "{=str}{=str} {=u32}", sep, rule.name, n);
+            defmt::write!(f, "{=str:a}{=str:a} {=u32}", sep, rule.name, n);
         }
     }
 }

@@ -64,17 +64,46 @@ pub fn compare_parts(
     )
 }
 
+/// What a simplification promises, as `simplify`'s options say: the rules its own verdict
+/// and `check`'s both apply.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Promise {
+    /// Optimal placement: kept vertices may have moved (`--placement optimal`).
+    pub moved: bool,
+    /// Seams welded (`--seams weld`, simplify's default): both meshes compared welded by
+    /// position, so a seam pulled apart is a crack and twins are one vertex.
+    pub welded: bool,
+    /// Parts may vanish whole (`--parts prune`, simplify's default).
+    pub parts: bool,
+}
+
+impl Default for Promise {
+    /// `simplify`'s defaults: subset placement, seams welded, parts pruned.
+    fn default() -> Self {
+        Promise {
+            moved: false,
+            welded: true,
+            parts: true,
+        }
+    }
+}
+
 /// The one verdict on a simplified mesh as read from its file, shared by `check` and
 /// `simplify` (which checks what it wrote, read back): `output` in `input`'s numbering
-/// (matched by position unless `moved`, see [`renumbered`]), the note on how, and the
-/// validity. With `moved` (optimal placement) kept vertices may have moved and vertices are
-/// matched by index: an output with another vertex count is refused, as nothing else says
-/// which input vertex an output vertex was.
+/// (matched by position unless `promise.moved`, see [`renumbered`]), the note on how, and
+/// the validity under `promise`. With `moved` (optimal placement) kept vertices may have
+/// moved and vertices are matched by index: an output with another vertex count is refused,
+/// as nothing else says which input vertex an output vertex was.
 pub fn verdict(
     input: &MeshData,
     output: &MeshData,
-    moved: bool,
+    promise: Promise,
 ) -> anyhow::Result<(MeshData, Option<String>, Validity)> {
+    let Promise {
+        moved,
+        welded,
+        parts,
+    } = promise;
     if moved {
         if output.positions.len() != input.positions.len() {
             anyhow::bail!(
@@ -85,11 +114,11 @@ pub fn verdict(
                 input.positions.len()
             );
         }
-        let v = compare_with(input, output, true);
+        let v = compare_parts(input, output, true, welded, parts);
         return Ok((output.clone(), None, v));
     }
-    let (b, mut note) = renumbered(input, output);
-    let v = compare(input, &b);
+    let (b, mut note) = renumbered(input, output, welded);
+    let v = compare_parts(input, &b, false, welded, parts);
     if v.new_vertices > 0 && note.is_none() {
         note = Some(format!(
             "{} vertices are not at their input position: a result of optimal placement \
@@ -111,8 +140,9 @@ pub fn same_numbering(input: &MeshData, output: &MeshData) -> bool {
 
 /// `output` in `input`'s numbering: itself if it already is, else matched back by position
 /// ([`crate::io::renumber_onto`]) when it is an order-keeping subset of the input's vertices.
-/// The note says what was done, if anything.
-pub fn renumbered(input: &MeshData, output: &MeshData) -> (MeshData, Option<String>) {
+/// The note says what was done, if anything, and (`welded`: the check welds by position) what
+/// a match among vertices at one position can change.
+pub fn renumbered(input: &MeshData, output: &MeshData, welded: bool) -> (MeshData, Option<String>) {
     if same_numbering(input, output) {
         return (output.clone(), None);
     }
@@ -123,7 +153,13 @@ pub fn renumbered(input: &MeshData, output: &MeshData) -> (MeshData, Option<Stri
                  onto the original's by position",
                 output.positions.len()
             );
-            if twins > 0 {
+            if twins > 0 && welded {
+                note += &format!(
+                    "; {twins} of them share their position with another original vertex and \
+                     were matched in order: the check welds by position, so only the count of \
+                     wedges gone with faces depends on it (--keep-numbering writes an exact one)"
+                );
+            } else if twins > 0 {
                 note += &format!(
                     "; {twins} of them share their position with another original vertex and \
                      were matched in order (write with --keep-numbering for an exact check)"
@@ -133,6 +169,84 @@ pub fn renumbered(input: &MeshData, output: &MeshData) -> (MeshData, Option<Stri
         }
         None => (output.clone(), None),
     }
+}
+
+/// The parts `simplify` simplifies and judges one at a time, each in its own numbering: a glTF
+/// file's triangle primitives, or an OBJ file's material groups when its faces carry texture
+/// coordinates or normals. `None` for anything `simplify` takes as one mesh (and for standard
+/// input).
+pub fn parts_of(path: &std::path::Path) -> anyhow::Result<Option<Vec<(String, MeshData)>>> {
+    if crate::io::is_std(path) {
+        return Ok(None);
+    }
+    if crate::io::gltf::is_gltf_path(path) {
+        let file = crate::io::gltf::load(path)?;
+        return Ok(Some(
+            file.primitives
+                .iter()
+                .map(|p| {
+                    let mesh = MeshData {
+                        positions: p.positions.clone(),
+                        triangles: p.triangles.clone(),
+                    };
+                    (crate::io::gltf::label(p), mesh)
+                })
+                .collect(),
+        ));
+    }
+    if crate::io::format_of(path).ok() != Some(crate::io::Format::Obj) {
+        return Ok(None);
+    }
+    let bytes =
+        std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+    if !crate::io::objattr::has_attributes(&bytes) {
+        return Ok(None);
+    }
+    let file = crate::io::objattr::parse(&bytes)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(Some(
+        (0..file.groups.len())
+            .map(|g| {
+                let name = file.groups[g].material.as_deref().unwrap_or("(none)");
+                (format!("material {name}"), file.mesh(g))
+            })
+            .collect(),
+    ))
+}
+
+/// One part's verdict, as [`verdict`] gives it.
+pub struct PartVerdict {
+    /// The part's label (`material NAME`, or a glTF primitive's).
+    pub label: String,
+    /// How the output part was matched back onto the input part, if it was.
+    pub note: Option<String>,
+    /// The part's validity.
+    pub validity: Validity,
+}
+
+/// [`verdict`] per part, as `simplify` judges a file with several parts ([`parts_of`]):
+/// `None` unless both files have the same number (more than one) of parts.
+pub fn part_verdicts(
+    input: &std::path::Path,
+    output: &std::path::Path,
+    promise: Promise,
+) -> anyhow::Result<Option<Vec<PartVerdict>>> {
+    let (Some(a), Some(b)) = (parts_of(input)?, parts_of(output)?) else {
+        return Ok(None);
+    };
+    if a.len() < 2 || a.len() != b.len() {
+        return Ok(None);
+    }
+    let mut out = Vec::new();
+    for ((label, pa), (_, pb)) in a.iter().zip(&b) {
+        let (_, note, validity) = verdict(pa, pb, promise)?;
+        out.push(PartVerdict {
+            label: label.clone(),
+            note,
+            validity,
+        });
+    }
+    Ok(Some(out))
 }
 
 #[cfg(test)]

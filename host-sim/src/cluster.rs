@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
 use tinydecimate::cluster::{
-    cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, Quadrics, Scratch, SliceSource,
-    KEY_LANES,
+    cluster_then_collapse, ClusterConfig, ClusterReport, Clusterer, GridChoice, Quadrics, Scratch,
+    SliceSource, KEY_LANES,
 };
 use tinydecimate::{Config, Report, Target};
 
@@ -140,6 +140,64 @@ pub fn then_collapse(
         r,
         dt,
     ))
+}
+
+/// One clustering of [`then_collapse_to`]: its target, the triangles it gave, and the
+/// collapses' result from there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Attempt {
+    /// The clustering's target (`None`: the grid given as a cell size).
+    pub cluster_target: Option<usize>,
+    /// Triangles after clustering.
+    pub clustered: usize,
+    /// Triangles after the collapses.
+    pub collapsed: usize,
+    /// Why the collapses stopped.
+    pub stop: tinydecimate::Stop,
+}
+
+/// [`then_collapse`] that reaches `target`: when the collapses stop short, it clusters again,
+/// to halfway between the last clustering's count and `target`, and collapses again, until
+/// the count is reached. Each clustering gives fewer triangles than the one before (at most
+/// its target), and a clustering to `target` itself needs no collapse, so it ends, at most
+/// `target` triangles (unless a clustering fails to give fewer triangles than the one before,
+/// which ends it short). Returns the last attempt's output and reports, the total time and
+/// every attempt, first to last.
+#[allow(clippy::type_complexity)]
+pub fn then_collapse_to(
+    mesh: &MeshData,
+    config: &ClusterConfig,
+    quadric: bool,
+    target: usize,
+) -> Result<(MeshData, ClusterReport, Report, Duration, Vec<Attempt>)> {
+    let mut cc = *config;
+    let mut attempts = Vec::new();
+    let mut total = Duration::ZERO;
+    loop {
+        let (out, cr, r, dt) = then_collapse(mesh, &cc, quadric, target)?;
+        total += dt;
+        attempts.push(Attempt {
+            cluster_target: match cc.grid {
+                GridChoice::TargetTriangles(t) => Some(t),
+                GridChoice::CellSize(_) | GridChoice::Resolution(_) => None,
+            },
+            clustered: cr.triangles_out,
+            collapsed: r.triangles_out,
+            stop: r.stop,
+        });
+        // Also ends when a clustering gave no fewer triangles than the one before (a grid
+        // search that cannot meet its target): the caller reports the shortfall.
+        let stalled = attempts
+            .iter()
+            .rev()
+            .nth(1)
+            .is_some_and(|a| a.clustered <= cr.triangles_out);
+        if r.triangles_out <= target || cr.triangles_out <= target || stalled {
+            return Ok((out, cr, r, total, attempts));
+        }
+        let next = target + (cr.triangles_out - target) / 2;
+        cc.grid = GridChoice::TargetTriangles(next);
+    }
 }
 
 /// Bytes a right-sized table needs for `cells` occupied cells (no slack), and per output

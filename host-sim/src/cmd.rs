@@ -6,6 +6,7 @@ pub mod bound_table;
 pub mod check;
 pub mod cluster;
 pub mod demo;
+pub mod embed;
 pub mod golden;
 pub mod metro;
 pub mod pm;

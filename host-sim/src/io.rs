@@ -1,11 +1,12 @@
-//! Mesh files: OBJ, PLY (ascii and binary) and STL (ascii and binary) in; OBJ, binary PLY and
-//! binary STL out. `-` is standard input (format found from the bytes) or standard output (the
-//! format given by the caller, OBJ by default).
+//! Mesh files: OBJ, PLY (ascii and binary), STL (ascii and binary) and glTF 2.0 (`.gltf`,
+//! `.glb`) in; OBJ, binary PLY and binary STL out. `-` is standard input (format found from
+//! the bytes) or standard output (the format given by the caller, OBJ by default).
 //!
 //! Only positions and faces are read: attributes (texture coordinates, normals, colours, any
-//! other PLY property) are not carried, and [`LoadNotes`] says which were dropped. Faces with
-//! more than three corners (quads, n-gons, concave ones too) are split into triangles by ear
-//! clipping ([`triangulate`]), and [`LoadNotes`] counts them.
+//! other PLY property, every glTF attribute but POSITION) are not carried, and [`LoadNotes`]
+//! says which were dropped. Faces with more than three corners (quads, n-gons, concave ones
+//! too) are split into triangles by ear clipping ([`triangulate`]), and [`LoadNotes`] counts
+//! them.
 //!
 //! * **OBJ**: only `v` and `f` lines matter (`vt`, `vn`, `o`, `g`, `s`, `usemtl`, `l`, `p`, ...
 //!   are ignored). Vertices keep the file's numbering exactly, unreferenced ones included; face
@@ -20,6 +21,14 @@
 //!   by first appearance. A file is binary when its size is exactly `84 + 50 n` bytes with `n`
 //!   the triangle count at offset 80, even if its header starts with `solid` (`stl_io` 0.11
 //!   alone would take such a file for ascii and fail).
+//! * **glTF**: read by [`gltf`] (every length and count checked), then seen as `simplify` sees
+//!   it ([`gltf::geometry`]): every TRIANGLES primitive once, in file order, in its mesh's own
+//!   coordinates, its vertices numbered after the previous primitive's. Node transforms are
+//!   not applied and a mesh that several nodes place (instancing) counts once, so every
+//!   command that reads a mesh counts the triangles `simplify` counts; [`LoadNotes`] says when
+//!   the scene draws the meshes otherwise (`render` draws the scene as placed). A `.gltf`'s
+//!   external buffers are read beside it; on standard input a GLB is known by its `glTF`
+//!   magic, a `.gltf` by its `{`, and then only embedded (`data:`) buffers are read.
 //!
 //! Every error names the file and, where it can, the line (text) or byte offset (binary).
 //! A file without any triangle is an error, and so is a non-finite coordinate of a vertex a
@@ -104,6 +113,8 @@ pub struct LoadNotes {
     /// Attributes that were in the file and are not carried, e.g. "1204 texture coordinates
     /// (vt)" or "vertex properties nx, ny, nz".
     pub dropped: Vec<String>,
+    /// Anything else worth a line, e.g. how a glTF scene places its meshes.
+    pub other: Vec<String>,
 }
 
 impl LoadNotes {
@@ -122,6 +133,7 @@ impl LoadNotes {
                 self.dropped.join("; ")
             ));
         }
+        out.extend(self.other.iter().map(|o| format!("note: {name}: {o}")));
         out
     }
 }
@@ -164,8 +176,9 @@ pub fn sniff(bytes: &[u8]) -> Format {
     Format::Obj
 }
 
-/// Loads a triangle mesh, choosing the format by extension (`.obj`, `.ply`, `.stl`, any case);
-/// `-` reads standard input and finds the format from the bytes ([`sniff`]).
+/// Loads a triangle mesh, choosing the format by extension (`.obj`, `.ply`, `.stl`, `.gltf`,
+/// `.glb`, any case); `-` reads standard input and finds the format from the bytes ([`sniff`],
+/// and glTF by [`is_gltf_bytes`]).
 pub fn load(path: impl AsRef<Path>) -> Result<MeshData> {
     load_with_notes(path).map(|(m, _)| m)
 }
@@ -173,14 +186,29 @@ pub fn load(path: impl AsRef<Path>) -> Result<MeshData> {
 /// [`load`], and what the reader split or dropped.
 pub fn load_with_notes(path: impl AsRef<Path>) -> Result<(MeshData, LoadNotes)> {
     let path = path.as_ref();
+    if gltf::is_gltf_path(path) {
+        let file = gltf::load(path)?;
+        let (mesh, notes) = gltf::geometry(&file);
+        validate(&mesh).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        return Ok((mesh, notes));
+    }
     let (bytes, format, name) = if is_std(path) {
         let mut bytes = Vec::new();
         std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes)
             .context("standard input: cannot read")?;
+        if is_gltf_bytes(&bytes) {
+            let (mesh, notes) = parse_gltf(&bytes).map_err(|e| anyhow!("standard input: {e}"))?;
+            return Ok((mesh, notes));
+        }
         let f = sniff(&bytes);
         (bytes, f, "standard input".to_string())
     } else {
-        let format = format_of(path)?;
+        let format = format_of(path).map_err(|_| {
+            anyhow!(
+                "{}: unknown mesh format (expected extension .obj, .ply, .stl, .gltf or .glb)",
+                path.display()
+            )
+        })?;
         let bytes =
             std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
         (bytes, format, path.display().to_string())
@@ -207,6 +235,21 @@ pub fn load_noting(path: impl AsRef<Path>) -> Result<MeshData> {
 
 type Parsed = std::result::Result<(MeshData, LoadNotes), String>;
 
+/// Whether mesh bytes are glTF: a GLB (`glTF` magic) or a JSON document (first non-blank
+/// byte `{`, which no OBJ, PLY or STL starts with).
+pub fn is_gltf_bytes(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"glTF") || bytes.trim_ascii_start().starts_with(b"{")
+}
+
+/// glTF bytes as [`gltf::geometry`] sees them, checked as [`load`] checks; only embedded
+/// buffers are read.
+fn parse_gltf(bytes: &[u8]) -> Parsed {
+    let file = gltf::parse(bytes, None)?;
+    let (mesh, notes) = gltf::geometry(&file);
+    validate(&mesh)?;
+    Ok((mesh, notes))
+}
+
 fn parse_format(bytes: &[u8], format: Format) -> Parsed {
     match format {
         Format::Obj => parse_obj(bytes),
@@ -215,14 +258,16 @@ fn parse_format(bytes: &[u8], format: Format) -> Parsed {
     }
 }
 
-/// Parses a mesh from memory, the format given by `ext` (`obj`, `ply` or `stl`, any case, no
-/// dot), with the checks of [`load`]. Errors carry no file name. Used by the fuzz targets.
+/// Parses a mesh from memory, the format given by `ext` (`obj`, `ply`, `stl`, `gltf` or `glb`,
+/// any case, no dot), with the checks of [`load`]; a glTF's buffers must be embedded. Errors
+/// carry no file name. Used by the fuzz targets.
 pub fn parse_bytes(bytes: &[u8], ext: &str) -> Result<MeshData> {
     let format = match ext.to_ascii_lowercase().as_str() {
         "obj" => Format::Obj,
         "ply" => Format::Ply,
         "stl" => Format::Stl,
-        _ => bail!("unknown mesh format {ext:?} (expected obj, ply or stl)"),
+        "gltf" | "glb" => return parse_gltf(bytes).map(|(m, _)| m).map_err(|e| anyhow!(e)),
+        _ => bail!("unknown mesh format {ext:?} (expected obj, ply, stl, gltf or glb)"),
     };
     let (mesh, _) = parse_format(bytes, format).map_err(|e| anyhow!(e))?;
     validate(&mesh).map_err(|e| anyhow!(e))?;

@@ -8,7 +8,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cmd::{
-    bench, bound_table, check, cluster, demo, golden, metro, pm, qemu, render, run_elf, simplify,
+    bench, bound_table, check, cluster, demo, embed, golden, metro, pm, qemu, render, run_elf,
+    simplify,
 };
 
 #[derive(Parser)]
@@ -51,6 +52,9 @@ enum Command {
     /// Runs a firmware image under QEMU and prints its decoded defmt log: the Cargo runner of
     /// examples/cortex-m4f (`cargo run --example … --target thumbv7em-none-eabihf`).
     RunElf(run_elf::Args),
+    /// A mesh file as Rust source for firmware (`static` POSITIONS and TRIANGLES, in flash),
+    /// or with --blob as a little-endian binary for `include_bytes!`.
+    Embed(embed::Args),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +72,7 @@ fn main() -> ExitCode {
         Command::Pm(a) => pm::run(a),
         Command::RunElf(a) => run_elf::run(a),
         Command::BoundTable(a) => bound_table::run(a),
+        Command::Embed(a) => embed::run(a),
     };
     result.unwrap_or_else(|e| {
         // A reader that closed the pipe early wants no more: end quietly, as `out!` does.

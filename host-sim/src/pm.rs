@@ -44,6 +44,14 @@ impl Store {
 
 /// Simplifies `mesh` with `config` and a collapse log; returns the log.
 pub fn collapse_log(mesh: &MeshData, config: &Config) -> Result<Vec<[u32; 2]>> {
+    collapse_log_reporting(mesh, config).map(|(log, _)| log)
+}
+
+/// [`collapse_log`] and the run's report (whether the base reached its target, and why not).
+pub fn collapse_log_reporting(
+    mesh: &MeshData,
+    config: &Config,
+) -> Result<(Vec<[u32; 2]>, tinydecimate::Report)> {
     let mut ws = HostWorkspace::for_mesh(mesh);
     let mut tris = mesh.triangles.clone();
     let mut log = vec![[0u32; 2]; mesh.positions.len()];
@@ -62,9 +70,9 @@ pub fn collapse_log(mesh: &MeshData, config: &Config) -> Result<Vec<[u32; 2]>> {
         .record_into(&mut log);
     while !s.step(u32::MAX) {}
     let n = s.records().len();
-    s.finish();
+    let report = s.finish();
     log.truncate(n);
-    Ok(log)
+    Ok((log, report))
 }
 
 /// The stream of `mesh` simplified with `config`, and its sizes.
@@ -74,7 +82,17 @@ pub fn encode_mesh(
     quantised: bool,
     chunk: u16,
 ) -> Result<(Vec<u8>, stream::Encoded, Vec<u32>)> {
-    let log = collapse_log(mesh, config)?;
+    encode_mesh_reporting(mesh, config, quantised, chunk).map(|(b, e, o, _)| (b, e, o))
+}
+
+/// [`encode_mesh`] and the report of the simplification that made the base mesh.
+pub fn encode_mesh_reporting(
+    mesh: &MeshData,
+    config: &Config,
+    quantised: bool,
+    chunk: u16,
+) -> Result<(Vec<u8>, stream::Encoded, Vec<u32>, tinydecimate::Report)> {
+    let (log, report) = collapse_log_reporting(mesh, config)?;
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let mut store = Store::new(v, t);
     let (mut order, mut scratch) = (vec![0u32; v], vec![0u32; t]);
@@ -91,7 +109,7 @@ pub fn encode_mesh(
     let e = stream::encode(&mut pm, &mesh.positions, &order, quantised, chunk, &mut out)
         .map_err(|e| anyhow!("tinydecimate: {e}"))?;
     out.truncate(e.bytes);
-    Ok((out, e, order))
+    Ok((out, e, order, report))
 }
 
 /// A decoded stream, at a level.

@@ -7,7 +7,7 @@
 //! (the minimal firmware of `tests/flash`, as `scripts/flash.sh` builds it:
 //! [`build::one_instantiation`]), and the largest mesh it simplifies.
 //!
-//! This file holds the boards; [`build`] the images, [`mod@run`] the QEMU runs, [`defmt`] the
+//! This file holds the boards; [`mod@build`] the images, [`mod@run`] the QEMU runs, [`defmt`] the
 //! log, [`check`] the comparison, [`measure`] the measurements and [`cluster`] the streaming
 //! clustering. The command is `host-sim qemu` ([`crate::cmd::qemu`]); `host-sim qemu --help`
 //! lists the modes. By hand (what [`build()`] and [`run_in()`] do):
@@ -75,7 +75,7 @@ pub struct Board {
     /// The rate of the counter the firmware reads, in Hz: the core clock QEMU's SysTick counts
     /// on Cortex-M. Under `-icount shift=0` one instruction is 1 ns, so one tick is
     /// 1e9 / clock_hz instructions. On RISC-V the firmware reads `mcycle`, which QEMU's icount
-    /// advances by one per instruction: 1 GHz. Checked by [`calibrate`].
+    /// advances by one per instruction: 1 GHz. Checked by [`calibrate`](measure::calibrate).
     pub clock_hz: u32,
 }
 

@@ -363,6 +363,12 @@ pub fn simplify_with_attributes(
 
 /// The report, every field, one per line.
 pub fn format_report(r: &Report) -> String {
+    format_report_for(r, None)
+}
+
+/// [`format_report`] with `target` in the target line instead of the triangle count (a run
+/// to an error bound alone, whose count of 0 is no target).
+pub fn format_report_for(r: &Report, target: Option<&str>) -> String {
     let j = &r.rejected;
     let passes: Vec<String> = r.pass_triangles.iter().map(|t| t.to_string()).collect();
     format!(
@@ -371,7 +377,7 @@ pub fn format_report(r: &Report) -> String {
          \x20 duplicates dropped     {}\n\
          \x20 double-sided twins     {}\n\
          \x20 triangles out          {} ({:.2} % of the input)\n\
-         \x20 target                 {} (reached: {})\n\
+         \x20 target                 {}\n\
          \x20 stop                   {:?}\n\
          \x20 collapses              {}\n\
          \x20 vertices removed       {}\n\
@@ -387,8 +393,14 @@ pub fn format_report(r: &Report) -> String {
         r.twins,
         r.triangles_out,
         100.0 * r.triangles_out as f64 / r.triangles_in.max(1) as f64,
-        r.target_triangles,
-        if r.target_reached { "yes" } else { "no" },
+        match target {
+            Some(t) => t.to_string(),
+            None => format!(
+                "{} (reached: {})",
+                r.target_triangles,
+                if r.target_reached { "yes" } else { "no" }
+            ),
+        },
         r.stop,
         r.collapses,
         r.vertices_removed,

@@ -2,9 +2,13 @@
 //! the original | the simplified model | the simplified model with its triangle edges, each
 //! with its base colour texture, so a person sees at once whether seams and texture held.
 //!
-//! The scene is drawn as a viewer would place it: every node of the default scene (or of the
-//! first, or every root node when there is no scene) with its world transform (`matrix` or
-//! translation/rotation/scale, composed down the node tree). Each triangle primitive is drawn
+//! The scene is drawn as a viewer would place it ([`crate::io::gltf::placements`]): every node
+//! of the default scene (or of the first, or every root node when there is no scene) with its
+//! world transform (`matrix` or translation/rotation/scale, composed down the node tree), so a
+//! mesh that several nodes place is drawn once per node. The triangle counts printed are the
+//! file's, each primitive once, as `simplify` and every other command count them; when the
+//! scene draws another number (instancing, or a mesh no node places) the output says so:
+//! "2856 triangles, 3624 drawn: mesh 1 drawn 2 times". Each triangle primitive is drawn
 //! with its material's `baseColorTexture` (sampled bilinearly at the interpolated
 //! `TEXCOORD_n` it names, wrapped as its sampler says) times `baseColorFactor`; a primitive with
 //! no texture is drawn in its factor's colour, one with no material in light grey. Shading is
@@ -18,18 +22,10 @@ use anyhow::{anyhow, Context, Result};
 use image::{ImageFormat, Rgb, RgbImage, RgbaImage};
 use serde_json::Value;
 
-use crate::io::gltf::{GltfFile, Stream};
+use crate::io::gltf::{GltfFile, Instancing, Stream, Transform};
 use crate::io::MeshData;
 use crate::render::{View, BACKGROUND, SIZE};
 
-type M4 = [[f64; 4]; 4];
-
-const IDENTITY: M4 = [
-    [1.0, 0.0, 0.0, 0.0],
-    [0.0, 1.0, 0.0, 0.0],
-    [0.0, 0.0, 1.0, 0.0],
-    [0.0, 0.0, 0.0, 1.0],
-];
 /// Colour of a primitive without a material (glTF's default material is white; light grey
 /// keeps shading visible).
 const NO_MATERIAL: [f64; 4] = [0.85, 0.85, 0.85, 1.0];
@@ -59,68 +55,12 @@ pub struct Scene {
     /// Material of each triangle (index into `materials`).
     material: Vec<usize>,
     materials: Vec<Material>,
-}
-
-fn mul(a: &M4, b: &M4) -> M4 {
-    let mut m = [[0.0; 4]; 4];
-    for (r, row) in m.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v = (0..4).map(|k| a[r][k] * b[k][c]).sum();
-        }
-    }
-    m
+    /// The file's triangles as stored (as `simplify` counts them) and as drawn.
+    instancing: Instancing,
 }
 
 fn floats(v: Option<&Value>) -> Option<Vec<f64>> {
     v?.as_array()?.iter().map(Value::as_f64).collect()
-}
-
-/// A node's local transform (row-major, column vectors).
-fn local(node: &Value) -> M4 {
-    if let Some(m) = floats(node.get("matrix")).filter(|m| m.len() == 16) {
-        // glTF stores column-major.
-        let mut out = [[0.0; 4]; 4];
-        for c in 0..4 {
-            for r in 0..4 {
-                out[r][c] = m[c * 4 + r];
-            }
-        }
-        return out;
-    }
-    let t = floats(node.get("translation")).filter(|v| v.len() == 3);
-    let q = floats(node.get("rotation")).filter(|v| v.len() == 4);
-    let s = floats(node.get("scale")).filter(|v| v.len() == 3);
-    let t = t.unwrap_or(vec![0.0; 3]);
-    let [x, y, z, w] = match q {
-        Some(q) => [q[0], q[1], q[2], q[3]],
-        None => [0.0, 0.0, 0.0, 1.0],
-    };
-    let s = s.unwrap_or(vec![1.0; 3]);
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - z * w),
-            2.0 * (x * z + y * w),
-        ],
-        [
-            2.0 * (x * y + z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - x * w),
-        ],
-        [
-            2.0 * (x * z - y * w),
-            2.0 * (y * z + x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    let mut m = IDENTITY;
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = r[i][j] * s[j];
-        }
-        m[i][3] = t[i];
-    }
-    m
 }
 
 /// The element `i` of a TEXCOORD stream as floats (`FLOAT`, or normalized `UNSIGNED_BYTE` /
@@ -235,68 +175,22 @@ impl Scene {
             uvs: Vec::new(),
             material: Vec::new(),
             materials,
+            instancing: Instancing::default(),
         };
-        let nodes = file.json.get("nodes").and_then(Value::as_array);
-        let roots: Vec<usize> = {
-            let scenes = file.json.get("scenes").and_then(Value::as_array);
-            let pick = file.json.get("scene").and_then(Value::as_u64).unwrap_or(0) as usize;
-            match scenes
-                .and_then(|s| s.get(pick))
-                .and_then(|s| s.get("nodes"))
-            {
-                Some(list) => floats(Some(list))
-                    .unwrap_or_default()
-                    .into_iter()
-                    .map(|n| n as usize)
-                    .collect(),
-                None => {
-                    // No scene: every node that is no other node's child.
-                    let n = nodes.map_or(0, Vec::len);
-                    let mut child = vec![false; n];
-                    for node in nodes.into_iter().flatten() {
-                        for c in floats(node.get("children")).unwrap_or_default() {
-                            if let Some(x) = child.get_mut(c as usize) {
-                                *x = true;
-                            }
-                        }
-                    }
-                    (0..n).filter(|&i| !child[i]).collect()
-                }
-            }
-        };
-        // Depth-first down the node tree; a node seen twice (a cycle, invalid glTF) is not
-        // entered again.
-        let mut seen = vec![false; nodes.map_or(0, Vec::len)];
-        let mut stack: Vec<(usize, M4)> = roots.into_iter().rev().map(|r| (r, IDENTITY)).collect();
-        while let Some((n, parent)) = stack.pop() {
-            let Some(node) = nodes.and_then(|l| l.get(n)) else {
-                continue;
-            };
-            if std::mem::replace(&mut seen[n], true) {
-                continue;
-            }
-            let world = mul(&parent, &local(node));
-            if let Some(m) = node.get("mesh").and_then(Value::as_u64) {
-                for p in file.primitives.iter().filter(|p| p.mesh == m as usize) {
-                    let material = file.json["meshes"][p.mesh]["primitives"][p.index]
-                        .get("material")
-                        .and_then(Value::as_u64)
-                        .map_or(plain, |m| (m as usize).min(plain));
-                    scene.add(p, &world, material);
-                }
-            }
-            for c in floats(node.get("children"))
-                .unwrap_or_default()
-                .into_iter()
-                .rev()
-            {
-                stack.push((c as usize, world));
+        for pl in crate::io::gltf::placements(&file.json) {
+            for p in file.primitives.iter().filter(|p| p.mesh == pl.mesh) {
+                let material = file.json["meshes"][p.mesh]["primitives"][p.index]
+                    .get("material")
+                    .and_then(Value::as_u64)
+                    .map_or(plain, |m| (m as usize).min(plain));
+                scene.add(p, &pl.world, material);
             }
         }
+        scene.instancing = crate::io::gltf::Instancing::of(file);
         scene
     }
 
-    fn add(&mut self, p: &crate::io::gltf::Primitive, world: &M4, material: usize) {
+    fn add(&mut self, p: &crate::io::gltf::Primitive, world: &Transform, material: usize) {
         let name = format!("TEXCOORD_{}", self.materials[material].tex_coord);
         let uv = p.attributes.iter().find(|s| s.semantic == name);
         let place = |v: [f32; 3]| -> [f32; 3] {
@@ -327,6 +221,22 @@ impl Scene {
     /// The flattened geometry (world space).
     pub fn mesh(&self) -> &MeshData {
         &self.mesh
+    }
+
+    /// "2856 triangles", or "2856 triangles, 3624 drawn: mesh 1 drawn 2 times" when the
+    /// scene draws another number than the file stores.
+    pub fn triangles_text(&self) -> String {
+        let i = &self.instancing;
+        if i.drawn == i.stored && i.meshes.is_empty() {
+            format!("{} triangles", i.stored)
+        } else {
+            format!(
+                "{} triangles, {} drawn: {}",
+                i.stored,
+                i.drawn,
+                i.meshes_text()
+            )
+        }
     }
 }
 
@@ -498,7 +408,10 @@ fn load(path: &Path) -> Result<Scene> {
 pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
     let m = load(mesh)?;
     let img = match compare {
-        None => render_textured(&m, &View::fit(&m.mesh), false),
+        None => {
+            crate::outln!("{}: {}", mesh.display(), m.triangles_text());
+            render_textured(&m, &View::fit(&m.mesh), false)
+        }
         Some(orig) => {
             if !crate::io::gltf::is_gltf_path(orig) {
                 anyhow::bail!(
@@ -509,9 +422,9 @@ pub fn draw(mesh: &Path, out: &Path, compare: Option<&Path>) -> Result<()> {
             }
             let o = load(orig)?;
             crate::outln!(
-                "panels: original ({} triangles) | simplified ({} triangles) | simplified with its edges",
-                o.mesh.triangles.len(),
-                m.mesh.triangles.len()
+                "panels: original ({}) | simplified ({}) | simplified with its edges",
+                o.triangles_text(),
+                m.triangles_text()
             );
             render_textured_compare(&o, &m)
         }

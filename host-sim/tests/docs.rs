@@ -151,7 +151,12 @@ fn firmware_advice_and_example() {
     let cmd = "cargo run --release --example simplify_in_flash --target thumbv7em-none-eabihf";
     assert!(readme.contains(cmd));
     let example = read("examples/cortex-m4f/examples/simplify_in_flash.rs");
-    assert!(example.contains("static POSITIONS") && example.contains("static WORKSPACE"));
+    assert!(example.contains("cow::POSITIONS") && example.contains("static WORKSPACE"));
+    let mesh = read("examples/cortex-m4f/src/cow.rs");
+    assert!(
+        mesh.contains("pub static POSITIONS"),
+        "the mesh as a static, in flash"
+    );
     assert!(example.contains("defmt::info!"));
     let config = read("examples/cortex-m4f/.cargo/config.toml");
     assert!(config.contains("runner = \"./qemu-runner.sh\""));
@@ -329,4 +334,190 @@ fn the_package_holds_the_library_only() {
     }
     // The manifest's metadata is complete enough for crates.io.
     assert!(!stderr.contains("manifest has no"), "{stderr}");
+}
+
+/// `host-sim ARGS --help` (long help), as text.
+fn help_of(args: &[&str]) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .arg("--help")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{args:?} --help failed");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// What a command's `--help` lists: its subcommands, and its flags (long names, `--help` and
+/// `--version` left out) each with its possible values.
+#[derive(Debug, Default)]
+struct Help {
+    commands: Vec<String>,
+    flags: Vec<(String, Vec<String>)>,
+}
+
+/// Reads clap's long help: `Commands:` lines (`  name  about`), option lines (`  -x, --flag
+/// <V>` or `      --flag`), and under an option its values, as `[possible values: a, b]` or
+/// a `Possible values:` list of `- a: ...` lines.
+fn parse_help(text: &str) -> Help {
+    let mut h = Help::default();
+    let mut section = "";
+    let mut in_values = false;
+    for line in text.lines() {
+        if !line.starts_with(' ') && line.ends_with(':') {
+            section = line;
+            in_values = false;
+            continue;
+        }
+        let t = line.trim_start();
+        let indent = line.len() - t.len();
+        match section {
+            "Commands:" if indent == 2 => {
+                let name = t.split_whitespace().next().unwrap_or("");
+                if name != "help" {
+                    h.commands.push(name.to_string());
+                }
+            }
+            "Options:" if indent <= 6 && t.starts_with('-') => {
+                in_values = false;
+                let long = t
+                    .split([',', ' ', '='])
+                    .find(|w| w.starts_with("--"))
+                    .unwrap_or("");
+                if !long.is_empty() && long != "--help" && long != "--version" {
+                    // Short help puts the values on the option's line.
+                    let values = t
+                        .split_once("[possible values: ")
+                        .map(|(_, l)| l.trim_end_matches(']').split(", ").map(str::to_string))
+                        .map_or_else(Vec::new, Iterator::collect);
+                    h.flags.push((long.to_string(), values));
+                }
+            }
+            "Options:" => {
+                let Some((_, values)) = h.flags.last_mut() else {
+                    continue;
+                };
+                if let Some(list) = t.strip_prefix("[possible values: ") {
+                    let list = list.trim_end_matches(']');
+                    values.extend(list.split(", ").map(str::to_string));
+                } else if t == "Possible values:" {
+                    in_values = true;
+                } else if in_values && t.starts_with("- ") {
+                    let v = t[2..].split(':').next().unwrap_or("").trim();
+                    values.push(v.to_string());
+                } else if in_values && !t.is_empty() && indent <= 10 {
+                    in_values = false;
+                }
+            }
+            _ => {}
+        }
+    }
+    h
+}
+
+/// Every leaf command (`simplify`, `pm encode`, ...) and its help.
+fn commands() -> Vec<(String, Help)> {
+    let top = parse_help(&help_of(&[]));
+    assert!(top.commands.len() >= 12, "{:?}", top.commands);
+    let mut out = Vec::new();
+    for c in top.commands {
+        let h = parse_help(&help_of(&[&c]));
+        if h.commands.is_empty() {
+            out.push((c, h));
+        } else {
+            for sub in &h.commands {
+                out.push((format!("{c} {sub}"), parse_help(&help_of(&[&c, sub]))));
+            }
+        }
+    }
+    out
+}
+
+/// The `--flags` a text names (`--flag`, `--flag=x`, `--flag <V>`).
+fn flags_named(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let b = text.as_bytes();
+    for (i, _) in text.match_indices("--") {
+        let before = i.checked_sub(1).map(|j| b[j]);
+        if before.is_some_and(|c| c.is_ascii_alphanumeric() || c == b'-') {
+            continue;
+        }
+        let name: String = text[i + 2..]
+            .chars()
+            .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '-')
+            .collect();
+        if name.len() > 1 && name.starts_with(|c: char| c.is_ascii_lowercase()) {
+            out.push(format!("--{name}"));
+        }
+    }
+    out
+}
+
+/// Whether `word` occurs in `text` bounded by characters that cannot be part of a name.
+fn has_word(text: &str, word: &str) -> bool {
+    let part = |c: char| c.is_ascii_alphanumeric() || c == '-' || c == '_';
+    text.match_indices(word).any(|(i, _)| {
+        !text[..i].chars().next_back().is_some_and(part)
+            && !text[i + word.len()..].chars().next().is_some_and(part)
+    })
+}
+
+/// docs/harness.md's reference section of each command: `### `cmd`` up to the next heading.
+fn reference(doc: &str, command: &str) -> Option<String> {
+    let heading = format!("### `{command}`");
+    let start = doc.lines().position(|l| l.trim_end() == heading)?;
+    let body: Vec<&str> = doc
+        .lines()
+        .skip(start + 1)
+        .take_while(|l| !l.starts_with('#'))
+        .collect();
+    Some(body.join("\n"))
+}
+
+/// docs/harness.md and `--help` agree: every command has a reference section; every flag of
+/// a command's help is named there on a line that also names each of its possible values;
+/// every flag the section names is in that command's help, and every flag the page names is
+/// some command's.
+#[test]
+fn harness_reference_matches_help() {
+    let doc = read("docs/harness.md");
+    let commands = commands();
+    let mut problems = Vec::new();
+    for (name, help) in &commands {
+        let Some(section) = reference(&doc, name) else {
+            problems.push(format!("no section \"### `{name}`\""));
+            continue;
+        };
+        for (flag, values) in &help.flags {
+            let lines: Vec<&str> = section.lines().filter(|l| has_word(l, flag)).collect();
+            if lines.is_empty() {
+                problems.push(format!("{name}: {flag} is in --help, not in the docs"));
+            }
+            for v in values {
+                if !lines.iter().any(|l| has_word(l, v)) {
+                    problems.push(format!("{name}: {flag} {v} is in --help, not in the docs"));
+                }
+            }
+        }
+        let known: Vec<&str> = help.flags.iter().map(|(f, _)| f.as_str()).collect();
+        for flag in flags_named(&section) {
+            if !known.contains(&flag.as_str()) {
+                problems.push(format!(
+                    "{name}: the docs name {flag}, --help has no such flag"
+                ));
+            }
+        }
+    }
+    // Elsewhere on the page (the command table, cross-references): a flag some command has.
+    let all: Vec<&str> = commands
+        .iter()
+        .flat_map(|(_, h)| h.flags.iter().map(|(f, _)| f.as_str()))
+        .collect();
+    // Cargo's and clap's own flags are no command's.
+    let own = ["--release", "--help", "--version"];
+    for flag in flags_named(&doc) {
+        if !all.contains(&flag.as_str()) && !own.contains(&flag.as_str()) {
+            problems.push(format!("docs/harness.md names {flag}, no command has it"));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

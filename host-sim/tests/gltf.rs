@@ -596,16 +596,19 @@ fn simplify_command_writes_glb_and_refuses_optimal_placement() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("optimal placement moves vertices"));
-    // glTF in, OBJ out: refused with the reason.
+    // OBJ in, glTF out: refused with the reason (glTF in, OBJ out is written:
+    // `simplify_glb_to_obj_ply_stl_writes_the_geometry`).
+    let obj = dir.path().join("x.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .args(["simplify"])
-        .arg(&input)
-        .arg(dir.path().join("x.obj"))
+        .arg(&obj)
+        .arg(dir.path().join("x.glb"))
         .args(["--ratio", "0.5"])
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("only as glTF"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("glTF is written only from glTF"));
 }
 
 /// `--attribute-weights`: the attribute-aware stored quadric runs on a glTF and prints
@@ -635,6 +638,7 @@ fn simplify_command_takes_attribute_weights() {
             "stored",
             "--attribute-weights",
             "uv=10,normal=1",
+            "--measure",
         ],
     );
     let text = String::from_utf8_lossy(&o.stdout);
@@ -1018,6 +1022,7 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
                 hard_edges,
                 "--seams",
                 seams,
+                "--measure",
             ])
             .output()
             .unwrap();
@@ -1053,4 +1058,409 @@ fn flat_shaded_texture_simplifies_with_hard_edges_welded() {
     // is a valid simplification of the file's vertices.
     let split = run("weld", "split");
     assert!(split > 200, "seams split: {split} of 288 triangles");
+}
+
+/// Runs the real binary with `args`.
+fn host(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// The same geometry as a GLB, written as OBJ from the `gltf` crate's reading (not ours): every
+/// primitive's vertices, then its triangles, numbered after the previous primitive's.
+fn obj_from_gltf_crate(bytes: &[u8]) -> (String, usize) {
+    let mut v = String::new();
+    let mut f = String::new();
+    let mut base = 0;
+    let mut triangles = 0;
+    for (verts, idx) in read_with_gltf_crate(bytes) {
+        for (_, p, _, _, _) in &verts {
+            let p = p.map(f32::from_bits);
+            v += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        for t in idx.chunks(3) {
+            f += &format!(
+                "f {} {} {}\n",
+                base + t[0] as usize + 1,
+                base + t[1] as usize + 1,
+                base + t[2] as usize + 1
+            );
+            triangles += 1;
+        }
+        base += verts.len();
+    }
+    (v + &f, triangles)
+}
+
+/// `check`, `metro`, `cluster` and `pm encode` read a GLB as `simplify` does (every triangle
+/// primitive once, in its own coordinates): each prints the same as for the same geometry
+/// written as OBJ, file names aside, and the triangle count `simplify` reports. Bad glTF gets
+/// one line and exit code 2 from each.
+#[test]
+fn every_command_reads_glb_as_simplify_counts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n);
+    let (json, bin) = document();
+    let bytes = glb(&json, &bin);
+    std::fs::write(d("m.glb"), &bytes).unwrap();
+    let (obj, triangles) = obj_from_gltf_crate(&bytes);
+    std::fs::write(d("m.obj"), obj).unwrap();
+    assert_eq!(triangles, 288 + 2 + 72);
+    // simplify's count of the same file.
+    let o = host(&[
+        "simplify".as_ref(),
+        d("m.glb").as_os_str(),
+        d("s.glb").as_os_str(),
+        "--ratio".as_ref(),
+        "0.5".as_ref(),
+        "--no-measure".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains(&format!("{triangles} -> ")),
+        "{}",
+        text(&o)
+    );
+    let s = d("s.obj");
+    let runs: Vec<(&str, Vec<&std::ffi::OsStr>)> = vec![
+        ("check", vec!["check".as_ref(), "M".as_ref(), s.as_os_str()]),
+        ("metro", vec!["metro".as_ref(), "M".as_ref(), s.as_os_str()]),
+        (
+            "cluster",
+            vec![
+                "cluster".as_ref(),
+                "M".as_ref(),
+                "OUT".as_ref(),
+                "--target-triangles".as_ref(),
+                "100".as_ref(),
+            ],
+        ),
+        (
+            "pm encode",
+            vec![
+                "pm".as_ref(),
+                "encode".as_ref(),
+                "M".as_ref(),
+                "OUT".as_ref(),
+            ],
+        ),
+    ];
+    // A simplified mesh to compare with, from the OBJ.
+    let o = host(&[
+        "simplify".as_ref(),
+        d("m.obj").as_os_str(),
+        s.as_os_str(),
+        "--ratio".as_ref(),
+        "0.5".as_ref(),
+        "--no-measure".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let bad = {
+        let mut j = json.clone();
+        let pa = j["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+            .as_u64()
+            .unwrap() as usize;
+        j["accessors"][pa]["count"] = json!(1_000_000_000u64);
+        [
+            ("truncated.glb", bytes[..bytes.len() / 2].to_vec()),
+            ("junk.glb", b"glTF\x02\0\0\0junk".to_vec()),
+            ("junk.gltf", b"{ not json".to_vec()),
+            ("count.glb", glb(&j, &bin)),
+        ]
+    };
+    for (name, b) in &bad {
+        std::fs::write(d(name), b).unwrap();
+    }
+    for (cmd, args) in &runs {
+        let with = |input: &str, out: &str| -> std::process::Output {
+            let a: Vec<std::ffi::OsString> = args
+                .iter()
+                .map(|a| match a.to_str() {
+                    Some("M") => d(input).into_os_string(),
+                    Some("OUT") => d(out).into_os_string(),
+                    _ => a.to_os_string(),
+                })
+                .collect();
+            let a: Vec<&std::ffi::OsStr> = a.iter().map(|x| x.as_os_str()).collect();
+            host(&a)
+        };
+        let from_glb = with("m.glb", "c1.obj");
+        let from_obj = with("m.obj", "c2.obj");
+        assert!(from_glb.status.success(), "{cmd}: {}", text(&from_glb));
+        assert!(from_obj.status.success(), "{cmd}: {}", text(&from_obj));
+        // Times differ from run to run; everything else is the same.
+        let same = |o: &std::process::Output| -> Vec<String> {
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .filter(|l| !l.contains("time"))
+                .map(|l| {
+                    l.replace(&d("m.glb").display().to_string(), "M")
+                        .replace(&d("m.obj").display().to_string(), "M")
+                        .replace(&d("c1.obj").display().to_string(), "OUT")
+                        .replace(&d("c2.obj").display().to_string(), "OUT")
+                })
+                .collect()
+        };
+        assert_eq!(same(&from_glb), same(&from_obj), "{cmd}");
+        let out = String::from_utf8_lossy(&from_glb.stdout).to_string();
+        assert!(
+            out.contains(&triangles.to_string()),
+            "{cmd} does not print {triangles}:\n{out}"
+        );
+        if cmd.starts_with("cluster") {
+            assert_eq!(
+                std::fs::read(d("c1.obj")).unwrap(),
+                std::fs::read(d("c2.obj")).unwrap()
+            );
+        }
+        for (name, _) in &bad {
+            let o = with(name, "c3.obj");
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{cmd} {name}: {}", text(&o));
+            assert_eq!(err.trim_end().lines().count(), 1, "{cmd} {name}: {err}");
+            assert!(err.contains(name) && !err.contains("panick"), "{err}");
+        }
+    }
+}
+
+/// glTF in, OBJ, PLY or STL out: the primitives simplified as for glTF out, the geometry
+/// written; the OBJ with each kept vertex's texture coordinates (v flipped: OBJ's v runs up
+/// the image) and normals, and one line naming what OBJ cannot hold. `check` finds the OBJ a
+/// valid simplification of the GLB.
+#[test]
+fn simplify_glb_to_obj_ply_stl_writes_the_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n);
+    let (json, bin) = document();
+    let bytes = glb(&json, &bin);
+    std::fs::write(d("m.glb"), &bytes).unwrap();
+    let simplify = |out: &str| {
+        let o = host(&[
+            "simplify".as_ref(),
+            d("m.glb").as_os_str(),
+            d(out).as_os_str(),
+            "--ratio".as_ref(),
+            "0.4".as_ref(),
+        ]);
+        assert!(o.status.success(), "{out}: {}", text(&o));
+        let t = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(!t.contains("NOT valid"), "{t}");
+        // "... 362 -> N triangles" on the first line.
+        let first = t.lines().next().unwrap().to_string();
+        let n: usize = first
+            .rsplit("-> ")
+            .next()
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|x| x.parse().ok())
+            .unwrap_or_else(|| panic!("{first}"));
+        (n, first, String::from_utf8_lossy(&o.stderr).to_string())
+    };
+    let (n_glb, _, _) = simplify("s.glb");
+    let (n_obj, head, err) = simplify("s.obj");
+    assert_eq!(n_obj, n_glb);
+    assert!(n_obj < 362 && head.contains("362 -> "), "{head}");
+    assert!(head.contains("glTF to OBJ"), "{head}");
+    // One line on what is not written: the colours, the material's texture, the node transforms.
+    let notes: Vec<&str> = err.lines().filter(|l| l.contains("not written")).collect();
+    assert_eq!(notes.len(), 1, "{err}");
+    assert!(
+        notes[0].contains("COLOR_0") && notes[0].contains("node"),
+        "{err}"
+    );
+
+    // The OBJ, read here line by line: every corner a position, texture coordinate and normal
+    // of one input vertex (texture coordinates as (u, 1 - v)).
+    let obj = std::fs::read_to_string(d("s.obj")).unwrap();
+    let floats = |l: &str| -> Vec<f32> {
+        l.split_whitespace()
+            .skip(1)
+            .map(|x| x.parse().unwrap())
+            .collect()
+    };
+    let lines = |key: &str| -> Vec<Vec<f32>> {
+        obj.lines()
+            .filter(|l| l.split_whitespace().next() == Some(key))
+            .map(floats)
+            .collect()
+    };
+    let (vs, vts, vns) = (lines("v"), lines("vt"), lines("vn"));
+    let input = read_with_gltf_crate(&bytes);
+    let mut corners_with_uv = 0;
+    let mut corners_with_normal = 0;
+    let mut tris = 0;
+    for l in obj.lines().filter(|l| l.starts_with("f ")) {
+        tris += 1;
+        for c in l.split_whitespace().skip(1) {
+            let ix: Vec<Option<usize>> = c
+                .split('/')
+                .map(|x| x.parse::<usize>().ok().map(|i| i - 1))
+                .collect();
+            let p = vs[ix[0].unwrap()]
+                .iter()
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>();
+            let uv = ix.get(1).copied().flatten().map(|t| &vts[t]);
+            let n = ix.get(2).copied().flatten().map(|t| &vns[t]);
+            let found = input.iter().flat_map(|(v, _)| v).any(|v| {
+                v.1[..] == p[..]
+                    && n.is_none_or(|n| v.2.is_some_and(|vn| vn.map(f32::from_bits)[..] == n[..]))
+                    && uv.is_none_or(|uv| {
+                        v.3.is_some_and(|t| {
+                            f32::from_bits(t[0]) == uv[0]
+                                && (1.0 - f32::from_bits(t[1]) - uv[1]).abs() < 1e-6
+                        })
+                    })
+            });
+            assert!(found, "corner {c} of {l}: {p:?} {n:?} {uv:?}");
+            corners_with_uv += usize::from(uv.is_some());
+            corners_with_normal += usize::from(n.is_some());
+        }
+    }
+    assert!(corners_with_normal > corners_with_uv);
+    assert_eq!(tris, n_obj);
+    assert!(corners_with_uv > 0);
+    // `check` reads both, with simplify's counts. (Its verdict is on the primitives side by
+    // side in their own coordinates, where this file's overlap; simplify's per-part verdict
+    // above is the one that holds.)
+    let o = host(&[
+        "check".as_ref(),
+        d("m.glb").as_os_str(),
+        d("s.obj").as_os_str(),
+    ]);
+    assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+    let counts: Vec<String> = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .filter(|l| l.trim_start().starts_with("triangles "))
+        .map(|l| l.split_whitespace().last().unwrap().to_string())
+        .collect();
+    assert_eq!(
+        counts,
+        ["362".to_string(), n_obj.to_string()],
+        "{}",
+        text(&o)
+    );
+
+    // PLY and STL: the same triangles, positions only, and the line says so.
+    for out in ["s.ply", "s.stl"] {
+        let (n, head, err) = simplify(out);
+        assert_eq!(n, n_glb, "{head}");
+        let m = host_sim::io::load(d(out)).unwrap();
+        assert_eq!(m.triangles.len(), n);
+        let notes: Vec<&str> = err.lines().filter(|l| l.contains("not written")).collect();
+        assert_eq!(notes.len(), 1, "{err}");
+        assert!(
+            notes[0].contains("TEXCOORD_0") && notes[0].contains("NORMAL"),
+            "{err}"
+        );
+    }
+}
+
+/// A mesh two nodes place (instancing): `simplify` counts its triangles once; `render` prints
+/// that count and says how many the scene draws; `check` notes it.
+#[test]
+fn instanced_mesh_counts_agree_between_simplify_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = |n: &str| dir.path().join(n);
+    let (mut json, bin) = document();
+    json["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"mesh": 1, "translation": [20.0, 0.0, 0.0]}));
+    json["scenes"][0]["nodes"] = json!([0, 1, 2]);
+    std::fs::write(d("m.glb"), glb(&json, &bin)).unwrap();
+    let o = host(&[
+        "simplify".as_ref(),
+        d("m.glb").as_os_str(),
+        d("s.glb").as_os_str(),
+        "--ratio".as_ref(),
+        "0.5".as_ref(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let t = String::from_utf8_lossy(&o.stdout).to_string();
+    let head = t.lines().next().unwrap();
+    let (tin, tout) = {
+        let (a, b) = head
+            .rsplit_once(": ")
+            .unwrap()
+            .1
+            .split_once(" -> ")
+            .unwrap();
+        (
+            a.parse::<usize>().unwrap(),
+            b.split_whitespace()
+                .next()
+                .unwrap()
+                .parse::<usize>()
+                .unwrap(),
+        )
+    };
+    assert_eq!(tin, 362, "{head}");
+    // mesh 1 (primitive B) in the result.
+    let out = std::fs::read(d("s.glb")).unwrap();
+    let b_out = read_with_gltf_crate(&out)[2].1.len() / 3;
+    let o = host(&[
+        "render".as_ref(),
+        d("s.glb").as_os_str(),
+        d("c.png").as_os_str(),
+        "--compare".as_ref(),
+        d("m.glb").as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r = String::from_utf8_lossy(&o.stdout);
+    let want = format!(
+        "panels: original ({tin} triangles, {} drawn: mesh 1 drawn 2 times) | simplified ({tout} \
+         triangles, {} drawn: mesh 1 drawn 2 times)",
+        tin + 72,
+        tout + b_out
+    );
+    assert!(r.contains(&want), "{r}\nwanted {want}");
+    let o = host(&[
+        "render".as_ref(),
+        d("m.glb").as_os_str(),
+        d("m.png").as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        r.contains(&format!("{tin} triangles, {} drawn", tin + 72)),
+        "{r}"
+    );
+    // Without instancing the counts are one number.
+    let (plain, bin) = document();
+    std::fs::write(d("p.glb"), glb(&plain, &bin)).unwrap();
+    let o = host(&[
+        "render".as_ref(),
+        d("p.glb").as_os_str(),
+        d("p.png").as_os_str(),
+    ]);
+    let r = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        r.contains(": 362 triangles\n") && !r.contains("drawn"),
+        "{r}"
+    );
+    // `check` reads the scene as `simplify` does and says how the scene differs.
+    let o = host(&[
+        "check".as_ref(),
+        d("m.glb").as_os_str(),
+        d("s.glb").as_os_str(),
+    ]);
+    assert_ne!(o.status.code(), Some(2), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(&format!(
+            "the scene draws {} triangles: mesh 1 drawn 2 times",
+            tin + 72
+        )),
+        "{err}"
+    );
 }

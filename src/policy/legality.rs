@@ -24,11 +24,11 @@
 //!   check is a soft penalty.
 //! - **quality** (`feature`, `normal_turn`, `seam`): the output stays valid without them; they
 //!   keep the feature vertices of Lin Mouguang 2007, bound how far a triangle may turn in one
-//!   collapse ([`Config::max_normal_turn_deg`]), and with welded seams ([`crate::seam`], crate
+//!   collapse ([`Config::max_normal_turn_deg`]), and with welded seams (module `seam`, crate
 //!   feature `seams`) keep a seam where it is, so that no triangle takes attributes from both
 //!   of its sides (meshoptimizer's vertex kinds: a seam vertex moves along its seam; a vertex
 //!   where more than two wedges meet stays, like its complex kind, or with
-//!   [`SeamCorners::Move`](crate::seam::SeamCorners::Move) moves all of them).
+//!   `seam::SeamCorners::Move` moves all of them).
 //! - **guarantee** (`bound`): the error bound of Zhu, Wang and Meng 2007, a promise the caller
 //!   asks for ([`Config::max_error`]); checked after the others, in `collapse`, and only on the
 //!   bounded entry points (see [`crate::bound`]).

@@ -1,5 +1,6 @@
-//! A complete firmware for a Cortex-M4F board: simplifies a mesh kept in flash with a `static`
-//! workspace and logs the report through defmt.
+//! A complete firmware for a Cortex-M4F board: simplifies a mesh kept in flash (`src/cow.rs`,
+//! written from an OBJ file by `host-sim embed`) with a `static` workspace and logs the report
+//! through defmt.
 //!
 //! In QEMU (mps2-an386), from this folder, with `qemu-system-arm` installed:
 //!
@@ -24,18 +25,15 @@ use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use static_cell::ConstStaticCell;
 use tinydecimate::{Config, Workspace};
-use tinydecimate_examples::saddle;
+use tinydecimate_examples::cow;
 
-/// The mesh's positions: a `static`, so in flash. The library only ever reads them.
-static POSITIONS: [[f32; 3]; saddle::VERTICES] = saddle::positions();
-
-/// The triangles, which the library rewrites in place: initialised from flash into RAM at
-/// boot (`.data`).
-static TRIANGLES: ConstStaticCell<[[u16; 3]; saddle::TRIANGLES]> =
-    ConstStaticCell::new(saddle::triangles());
+/// The triangle buffer the library rewrites in place: a `static` in RAM (`.bss`), filled from
+/// the copy in flash ([`cow::TRIANGLES`]) at boot, so the original stays there to start over.
+static TRIANGLES: ConstStaticCell<[[u16; 3]; cow::TRIANGLES_COUNT]> =
+    ConstStaticCell::new([[0; 3]; cow::TRIANGLES_COUNT]);
 
 /// The workspace type: u16 links, sized for this mesh at compile time.
-type Ws = Workspace<u16, { saddle::VERTICES }, { saddle::TRIANGLES }>;
+type Ws = Workspace<u16, { cow::VERTICES }, { cow::TRIANGLES_COUNT }>;
 
 /// The workspace: a `static` in `.bss` (`Workspace::new` is a `const fn`), never on the stack.
 static WORKSPACE: ConstStaticCell<Ws> = ConstStaticCell::new(Workspace::new());
@@ -44,13 +42,14 @@ static WORKSPACE: ConstStaticCell<Ws> = ConstStaticCell::new(Workspace::new());
 fn main() -> ! {
     let ws = WORKSPACE.take();
     let triangles = TRIANGLES.take();
+    triangles.copy_from_slice(&cow::TRIANGLES);
     // The positions are read where they are: in flash, below RAM at 0x2000_0000 (mps2-an386's
     // code memory, a real board's flash).
-    let at = POSITIONS.as_ptr() as usize;
+    let at = cow::POSITIONS.as_ptr() as usize;
     defmt::info!(
         "simplifying {} triangles over {} vertices in flash at {=usize:#x}; static workspace {} bytes",
-        saddle::TRIANGLES,
-        saddle::VERTICES,
+        cow::TRIANGLES_COUNT,
+        cow::VERTICES,
         at,
         Ws::BYTES
     );
@@ -58,7 +57,7 @@ fn main() -> ! {
         defmt::error!("the positions are not in flash");
         exit(3);
     }
-    match ws.simplify(&POSITIONS, triangles, &Config::new().with_ratio(0.25)) {
+    match ws.simplify(&cow::POSITIONS, triangles, &Config::new().with_ratio(0.25)) {
         Ok(report) => {
             defmt::info!("{}", report);
             defmt::info!(

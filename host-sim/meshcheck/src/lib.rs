@@ -43,11 +43,14 @@
 //! * when the cleaned input has no non-manifold edge (the library's promise: "keeps a closed
 //!   manifold closed, keeps the Euler characteristic and the number of boundary loops"): a
 //!   changed Euler characteristic, a changed number of boundary loops, a closed input that is
-//!   no longer closed, and an output boundary vertex that was not a boundary vertex of the
-//!   input (boundaries only shrink along themselves).
+//!   no longer closed, and a **crack**: an output boundary edge with an end that was not a
+//!   boundary vertex of the input (boundaries only shrink along themselves; with
+//!   [`Options::welded`] both meshes are compared welded by position, so a seam pulled apart
+//!   is a crack).
 
-use std::collections::{BTreeSet, HashSet};
+use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// Two triangles sharing an edge are folded when their unit normals' dot product is below this
 /// (as `legality::FOLD_DOT` in the library).
@@ -89,7 +92,7 @@ pub struct Options<'a> {
     pub allow_moved: bool,
     /// Seams welded (`tinydecimate::seam`): vertices at identical positions are one vertex
     /// with several wedges. Both meshes are welded by position ([`weld`]) before every test,
-    /// so a crack (a seam opened by the simplification) shows as new boundary vertices and
+    /// so a crack (a seam opened by the simplification) shows as [`Defect::Crack`] and
     /// changed boundary loops; and the input wedges of positions the output still uses but
     /// the output does not are counted ([`Verdict::lost_wedges`]).
     pub welded: bool,
@@ -146,6 +149,8 @@ pub struct Analysis {
     pub vertices: BTreeSet<u32>,
     /// Vertices of boundary edges.
     pub boundary_vertices: BTreeSet<u32>,
+    /// Boundary edges, sorted.
+    pub boundary_edges: Vec<Edge>,
     pub non_manifold_edges: BTreeSet<Edge>,
     pub pinched_vertices: BTreeSet<u32>,
     pub inconsistent_edges: BTreeSet<Edge>,
@@ -220,9 +225,12 @@ pub enum Defect {
     NewTwins {
         count: usize,
     },
-    /// An output boundary vertex that was not on the input's boundary.
-    NewBoundaryVertex {
-        vertex: u32,
+    /// An output boundary edge with an end that was not on the input's boundary: the
+    /// surface opened there (with welded seams, compared by position: a seam pulled apart).
+    Crack {
+        edge: Edge,
+        /// The end that was inside the input's surface (the smaller if both were).
+        inner: u32,
     },
     /// A closed input whose output has boundary edges.
     Opened {
@@ -259,9 +267,12 @@ impl fmt::Display for Defect {
             Defect::NewTwins { count } => {
                 write!(f, "{count} double-sided twins more than the input had")
             }
-            Defect::NewBoundaryVertex { vertex } => {
-                write!(f, "vertex {vertex}: new on the boundary")
-            }
+            Defect::Crack { edge, inner } => write!(
+                f,
+                "crack at edge {}-{}: a boundary edge where the input had surface (vertex \
+                 {inner} was not on the input's boundary)",
+                edge.0, edge.1
+            ),
             Defect::Opened { boundary_edges } => {
                 write!(f, "closed input opened: {boundary_edges} boundary edges")
             }
@@ -300,6 +311,9 @@ pub struct Verdict {
     pub new_vertices: usize,
     /// Output boundary vertices that were interior (compared only with a clean input).
     pub new_boundary_vertices: usize,
+    /// Output boundary edges with an end among those vertices: cracks, each a
+    /// [`Defect::Crack`].
+    pub cracks: usize,
     /// With welded seams: input wedges of kept positions that the output does not use
     /// (information, not a defect: a face of a flat-shaded model collapsed away takes its own
     /// wedges with it).
@@ -348,6 +362,32 @@ impl Verdict {
         }
     }
 
+    /// The defects, one a line, at most `per_kind` of each kind (in the order each kind first
+    /// occurs), so that a few of one kind do not hide another.
+    pub fn describe_by_kind(&self, per_kind: usize) -> String {
+        let mut kinds: Vec<(std::mem::Discriminant<Defect>, Vec<&Defect>)> = Vec::new();
+        for d in &self.defects {
+            let k = std::mem::discriminant(d);
+            match kinds.iter_mut().find(|(x, _)| *x == k) {
+                Some((_, v)) => v.push(d),
+                None => kinds.push((k, vec![d])),
+            }
+        }
+        let mut s = String::new();
+        for (_, ds) in kinds {
+            for d in ds.iter().take(per_kind) {
+                s.push_str(&format!("  {d}\n"));
+            }
+            if ds.len() > per_kind {
+                s.push_str(&format!(
+                    "  ... {} more of that kind\n",
+                    ds.len() - per_kind
+                ));
+            }
+        }
+        s
+    }
+
     /// The defects, one a line, at most `max` of them.
     pub fn describe(&self, max: usize) -> String {
         let mut s = String::new();
@@ -375,6 +415,7 @@ impl fmt::Display for Verdict {
             ("out-of-range triangles", v.out_of_range_triangles),
             ("new or moved vertices", v.new_vertices),
             ("new boundary vertices", v.new_boundary_vertices),
+            ("cracks (boundary edges)", v.cracks),
         ];
         for (name, n) in counts {
             writeln!(f, "  {name:<24} {n:<6} {}", mark(n == 0))?;
@@ -427,7 +468,7 @@ impl fmt::Display for Verdict {
             mark(v.components.0 == v.components.1)
         )?;
         if !v.is_valid() {
-            write!(f, "{}", v.describe(10))?;
+            write!(f, "{}", v.describe_by_kind(3))?;
         }
         write!(f, "  => {}", if v.is_valid() { "VALID" } else { "INVALID" })
     }
@@ -455,6 +496,60 @@ impl fmt::Display for Topology {
         writeln!(f, "  euler (V-E+F)          {}", t.euler)?;
         write!(f, "  components             {}", t.components)
     }
+}
+
+/// The hash of the checker's maps and sets (FxHash's multiply-rotate, with the high half
+/// folded into the low on finishing): its keys are vertex indices and position bits, not
+/// attacker-chosen, and the default SipHash took a sixth of `host-sim simplify`'s time on a
+/// 70 k-triangle scan.
+#[derive(Clone, Copy, Default)]
+struct Fx(u64);
+
+impl Hasher for Fx {
+    fn write(&mut self, bytes: &[u8]) {
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let mut w = [0u8; 8];
+            w.copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+        let rest = chunks.remainder();
+        if !rest.is_empty() {
+            let mut w = [0u8; 8];
+            w[..rest.len()].copy_from_slice(rest);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(u64::from(i));
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+    fn finish(&self) -> u64 {
+        self.0 ^ (self.0 >> 32)
+    }
+}
+
+type FxBuild = BuildHasherDefault<Fx>;
+
+/// Marks of the indices `of` yields, for `n` indices (indices past `n` are not marked).
+fn marks(n: usize, of: impl IntoIterator<Item = u32>) -> Vec<bool> {
+    let mut m = vec![false; n];
+    for i in of {
+        if let Some(x) = m.get_mut(i as usize) {
+            *x = true;
+        }
+    }
+    m
+}
+
+/// The marked indices, as a set.
+fn marked(m: &[bool]) -> BTreeSet<u32> {
+    (0..m.len() as u32).filter(|&i| m[i as usize]).collect()
 }
 
 /// Sorted vertex triple of a triangle.
@@ -550,11 +645,14 @@ pub fn clean(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
         })
         .collect();
     let (_, _, fronts) = split_twins(&good);
-    let fronts: HashSet<usize> = fronts.into_iter().collect();
-    let mut seen = HashSet::with_capacity(good.len());
+    let mut front = vec![false; good.len()];
+    for i in fronts {
+        front[i] = true;
+    }
+    let mut seen = HashSet::with_capacity_and_hasher(good.len(), FxBuild::default());
     good.iter()
         .enumerate()
-        .filter(|(i, t)| !fronts.contains(i) || seen.insert(sorted(**t)))
+        .filter(|(i, t)| !front[*i] || seen.insert(sorted(**t)))
         .map(|(_, t)| *t)
         .collect()
 }
@@ -573,7 +671,8 @@ pub fn analyse_with(positions: &[[f32; 3]], triangles: &[Tri], opts: &Options) -
     // Triangles taking part in edge counts: in range and not degenerate.
     let mut good: Vec<Tri> = Vec::with_capacity(triangles.len());
     let mut referenced = vec![false; nv];
-    let mut vertex_sets = HashSet::with_capacity(triangles.len());
+    let mut vertex_sets = HashSet::with_capacity_and_hasher(triangles.len(), FxBuild::default());
+    let mut in_good = vec![false; nv];
     let mut comp = Dsu::new(nv);
     for (i, &t) in triangles.iter().enumerate() {
         if t.iter().any(|&v| v as usize >= nv) {
@@ -592,9 +691,12 @@ pub fn analyse_with(positions: &[[f32; 3]], triangles: &[Tri], opts: &Options) -
         if !vertex_sets.insert(sorted(t)) {
             an.duplicates.push(i);
         }
-        an.vertices.extend(t);
+        for &v in &t {
+            in_good[v as usize] = true;
+        }
         good.push(t);
     }
+    an.vertices = marked(&in_good);
     topo.out_of_range_triangles = an.out_of_range.len();
     topo.degenerate_triangles = an.degenerate.len();
     topo.duplicate_triangles = an.duplicates.len();
@@ -647,8 +749,7 @@ pub fn analyse_with(positions: &[[f32; 3]], triangles: &[Tri], opts: &Options) -
             1 => {
                 topo.boundary_edges += 1;
                 boundary_graph.push(edge);
-                an.boundary_vertices.insert(edge.0);
-                an.boundary_vertices.insert(edge.1);
+                an.boundary_edges.push(edge);
             }
             2 => {
                 if group[0].3 == group[1].3 {
@@ -689,6 +790,10 @@ pub fn analyse_with(positions: &[[f32; 3]], triangles: &[Tri], opts: &Options) -
             }
         }
     }
+    an.boundary_vertices = marked(&marks(
+        nv,
+        an.boundary_edges.iter().flat_map(|&(a, b)| [a, b]),
+    ));
     topo.non_manifold_edges = an.non_manifold_edges.len();
     topo.inconsistent_edges = an.inconsistent_edges.len();
     topo.folded_pairs = an.folded.len();
@@ -779,7 +884,7 @@ pub fn check(positions: &[[f32; 3]], input: &[Tri], output: &[Tri]) -> Verdict {
 /// numbers them. Out-of-range indices stay.
 pub fn weld(positions: &[[f32; 3]], triangles: &[Tri]) -> Vec<Tri> {
     let key = |p: &[f32; 3]| p.map(|x| if x == 0.0 { 0 } else { x.to_bits() });
-    let mut first = std::collections::HashMap::new();
+    let mut first = HashMap::with_capacity_and_hasher(positions.len(), FxBuild::default());
     for (i, p) in positions.iter().enumerate() {
         first.entry(key(p)).or_insert(i as u32);
     }
@@ -842,9 +947,9 @@ pub fn check_with(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
 /// and the first such), how many twins there were, and each kept triangle's place in
 /// `triangles`. Repeated copies in either winding stay, to be counted as duplicates.
 pub fn split_twins(triangles: &[Tri]) -> (Vec<Tri>, usize, Vec<usize>) {
-    use std::collections::HashMap;
     // Per vertex set: the first copy's winding, and whether a twin was taken.
-    let mut seen: HashMap<Tri, (Tri, bool)> = HashMap::with_capacity(triangles.len());
+    let mut seen: HashMap<Tri, (Tri, bool), FxBuild> =
+        HashMap::with_capacity_and_hasher(triangles.len(), FxBuild::default());
     let (mut kept, mut index, mut twins) = (Vec::with_capacity(triangles.len()), Vec::new(), 0);
     for (i, &t) in triangles.iter().enumerate() {
         let rotations = |a: Tri| [a, [a[1], a[2], a[0]], [a[2], a[0], a[1]]];
@@ -893,16 +998,21 @@ fn check_welded(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         },
         &split,
     );
-    let kept: BTreeSet<u32> = wo.iter().flatten().copied().collect();
-    let used: BTreeSet<u32> = output.triangles.iter().flatten().copied().collect();
-    let mut lost = BTreeSet::new();
+    let n = input.positions.len().max(output.positions.len());
+    let kept = marks(n, wo.iter().flatten().copied());
+    let used = marks(n, output.triangles.iter().flatten().copied());
+    let is = |m: &[bool], i: u32| m.get(i as usize).copied().unwrap_or(false);
+    let mut lost = vec![false; n];
     for (t, w) in input.triangles.iter().zip(&wi) {
         for (&raw, &rep) in t.iter().zip(w) {
-            if kept.contains(&rep) && !used.contains(&raw) {
-                lost.insert(raw);
+            if is(&kept, rep) && !is(&used, raw) {
+                if let Some(x) = lost.get_mut(raw as usize) {
+                    *x = true;
+                }
             }
         }
     }
+    let lost: Vec<u32> = (0..n as u32).filter(|&i| lost[i as usize]).collect();
     // Counted, not a defect: a wedge whose whole attribute region was collapsed away (a face
     // of a flat-shaded model, where every face has its own wedges) is lost on purpose, and
     // the output alone cannot tell that from a region whose corners took another wedge.
@@ -940,7 +1050,6 @@ fn without_absent_parts(nv: usize, cleaned: &[Tri], output: &[Tri]) -> (Vec<Tri>
 }
 
 fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
-    let raw = analyse_with(input.positions, input.triangles, opts);
     let cleaned = clean(input.positions, input.triangles);
     let (cleaned, parts_removed) = if opts.parts {
         without_absent_parts(input.positions.len(), &cleaned, output.triangles)
@@ -948,6 +1057,14 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         (cleaned, 0)
     };
     let cin = analyse_with(input.positions, &cleaned, opts);
+    // `clean` and the parts only drop triangles: the same count is the same list, analysed once.
+    let raw_owned;
+    let raw = if cleaned.len() == input.triangles.len() {
+        &cin
+    } else {
+        raw_owned = analyse_with(input.positions, input.triangles, opts);
+        &raw_owned
+    };
     let out = analyse_with(output.positions, output.triangles, opts);
     let mut d = Vec::new();
 
@@ -1025,6 +1142,7 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
     }
     let topology_compared = ti.non_manifold_edges == 0;
     let mut new_boundary_vertices = 0;
+    let mut cracks = 0;
     if topology_compared {
         if ti.euler != to.euler {
             d.push(Defect::Euler {
@@ -1043,9 +1161,18 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
                 boundary_edges: to.boundary_edges,
             });
         }
-        for &v in out.boundary_vertices.difference(&cin.boundary_vertices) {
-            d.push(Defect::NewBoundaryVertex { vertex: v });
-            new_boundary_vertices += 1;
+        new_boundary_vertices = out
+            .boundary_vertices
+            .difference(&cin.boundary_vertices)
+            .count();
+        for &edge in &out.boundary_edges {
+            let inner = [edge.0, edge.1]
+                .into_iter()
+                .find(|v| !cin.boundary_vertices.contains(v));
+            if let Some(inner) = inner {
+                d.push(Defect::Crack { edge, inner });
+                cracks += 1;
+            }
         }
     }
 
@@ -1059,6 +1186,7 @@ fn check_split(input: MeshRef, output: MeshRef, opts: &Options) -> Verdict {
         out_of_range_triangles: to.out_of_range_triangles,
         new_vertices,
         new_boundary_vertices,
+        cracks,
         lost_wedges: 0,
         parts_removed,
         twins: (0, 0),
@@ -1138,9 +1266,74 @@ mod tests {
         h.drain(8..10);
         let v = check(&p, &t, &h);
         assert_eq!(v.new_boundary_vertices, 4, "{v}");
+        // The hole's four edges are the cracks, each named with an end inside the input.
+        assert_eq!(v.cracks, 4, "{v}");
+        assert!(v.defects.contains(&Defect::Crack {
+            edge: (5, 6),
+            inner: 5
+        }));
+        assert!(v.to_string().contains("crack at edge 5-6"), "{v}");
         assert!(v.defects.contains(&Defect::BoundaryLoops {
             input: 1,
             output: 2
+        }));
+    }
+
+    /// A 2 x 2 grid split on its middle column (vertices 1, 4, 7 copied as 9, 10, 11 for the
+    /// right half): the left half's seam shortened alone (4 collapsed into 1) is valid split,
+    /// and welded by position a crack along the right half's 1-4-7, named.
+    #[test]
+    fn a_seam_pulled_apart_is_a_crack_when_welded() {
+        let (mut p, t) = grid(2);
+        p.extend([p[1], p[4], p[7]]);
+        let right = |x: Tri| {
+            x.map(|v| match v {
+                1 => 9,
+                4 => 10,
+                7 => 11,
+                v => v,
+            })
+        };
+        let input: Vec<Tri> = vec![
+            t[0],
+            t[1],
+            t[4],
+            t[5],
+            right(t[2]),
+            right(t[3]),
+            right(t[6]),
+            right(t[7]),
+        ];
+        let mut output = input.clone();
+        // 4 -> 1 on the left: [0,1,4] goes, [0,4,3] -> [0,1,3], [3,4,7] -> [3,1,7].
+        output.splice(0..4, [[0, 1, 3], [3, 1, 7], t[5]]);
+        let opts = |welded| Options {
+            welded,
+            ..Default::default()
+        };
+        let verdict = |welded| {
+            check_with(
+                MeshRef {
+                    positions: &p,
+                    triangles: &input,
+                },
+                MeshRef {
+                    positions: &p,
+                    triangles: &output,
+                },
+                &opts(welded),
+            )
+        };
+        assert!(verdict(false).is_valid(), "{}", verdict(false));
+        let v = verdict(true);
+        assert_eq!(v.cracks, 2, "{v}");
+        assert!(v.defects.contains(&Defect::Crack {
+            edge: (1, 4),
+            inner: 4
+        }));
+        assert!(v.defects.contains(&Defect::Crack {
+            edge: (4, 7),
+            inner: 4
         }));
     }
 

@@ -8,14 +8,14 @@ use std::process::ExitCode;
 use anyhow::{bail, Result};
 use tinydecimate::cluster::{ClusterConfig, GridChoice};
 
-use crate::cluster::{cluster, defects, table_bytes, then_collapse, VertexMemory};
+use crate::cluster::{cluster, defects, table_bytes, then_collapse_to, VertexMemory};
 use crate::metro::{metro, MetroOptions};
 
 /// `host-sim cluster IN OUT (--target-triangles N | --cell SIZE) [--then-collapse N]`
 #[derive(Clone, Debug, clap::Args)]
 #[command(group = clap::ArgGroup::new("grid").required(true))]
 pub struct Args {
-    /// Input mesh (.obj, .ply, .stl).
+    /// Input mesh (.obj, .ply, .stl, .gltf, .glb).
     pub input: PathBuf,
     /// Output mesh (.obj or .ply); keeps the input's vertex numbering.
     pub output: PathBuf,
@@ -25,7 +25,10 @@ pub struct Args {
     /// Cells of this edge length (in the mesh's units).
     #[arg(long, group = "grid")]
     pub cell: Option<f32>,
-    /// Then run the collapse engine (`Config::new()`) to this many triangles.
+    /// Then run the collapse engine (`Config::new()`) to this many triangles. It reaches
+    /// them: when the collapses stop short, it clusters again, to halfway between the last
+    /// clustering's count and this one, and collapses again (each attempt is printed); a
+    /// clustering to this count itself needs no collapse.
     #[arg(long)]
     pub then_collapse: Option<usize>,
     /// The nearest-to-centre representative (12 B per cell, one pass) instead of the quadric
@@ -51,7 +54,7 @@ pub struct Args {
 
 /// `host-sim cluster`.
 pub fn run(args: &Args) -> Result<ExitCode> {
-    let mesh = crate::io::load(&args.input)?;
+    let mesh = crate::io::load_noting(&args.input)?;
     let grid = match (args.target_triangles, args.cell) {
         (Some(t), _) => GridChoice::TargetTriangles(t),
         (None, Some(c)) => GridChoice::CellSize(c),
@@ -69,8 +72,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             (out, r, dt, None)
         }
         Some(n) => {
-            let (out, r, c, dt) = then_collapse(&mesh, &config, quadric, n)?;
-            (out, r, dt, Some(c))
+            let (out, r, c, dt, attempts) = then_collapse_to(&mesh, &config, quadric, n)?;
+            (out, r, dt, Some((c, attempts)))
         }
     };
     crate::outln!(
@@ -83,8 +86,28 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     );
     crate::outln!("triangles in     {}", r.triangles_in);
     crate::outln!("clustered        {}", r.triangles_out);
-    if let Some(c) = &collapse {
-        crate::outln!("then collapsed   {}", c.triangles_out);
+    if let Some((c, attempts)) = &collapse {
+        // Every attempt but the last stopped short; the last is the one written.
+        for a in &attempts[..attempts.len() - 1] {
+            crate::outln!(
+                "short            clustered to {} (target {}), collapses stopped at {} ({:?}): \
+                 clustering again",
+                a.clustered,
+                a.cluster_target
+                    .map_or_else(|| "the cell size".to_string(), |t| t.to_string()),
+                a.collapsed,
+                a.stop
+            );
+        }
+        crate::outln!(
+            "then collapsed   {}{}",
+            c.triangles_out,
+            if c.target_reached {
+                String::new()
+            } else {
+                format!(" (short of {}: {:?})", c.target_triangles, c.stop)
+            }
+        );
     }
     crate::outln!(
         "dropped          {} collapsed into < 3 cells, {} duplicates ({} opposite winding)",

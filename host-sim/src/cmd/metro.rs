@@ -43,6 +43,13 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
             args.original.display(),
             args.simplified.display()
         );
+        // The counts the files were read with (a glTF: every primitive once, as `simplify`
+        // counts them).
+        crate::outln!(
+            "  triangles                {} (original), {} (simplified)",
+            a.triangles.len(),
+            b.triangles.len()
+        );
         crate::outln!("{r}");
         crate::outln!(
             "  time                     {:.2} s",

@@ -14,7 +14,7 @@ use tinydecimate::{Config, Target};
 
 use crate::io::{self, MeshData};
 use crate::metro::{metro, MetroOptions};
-use crate::pm::{decode_bytes, decode_with, encode_mesh, extent, Extent};
+use crate::pm::{decode_bytes, decode_with, encode_mesh_reporting, extent, Extent};
 
 /// `host-sim pm …`
 #[derive(Clone, Debug, clap::Args)]
@@ -60,7 +60,7 @@ pub struct StreamArgs {
 /// `host-sim pm encode IN OUT.tdpm`
 #[derive(Clone, Debug, clap::Args)]
 pub struct EncodeArgs {
-    /// Input mesh (OBJ, PLY or STL).
+    /// Input mesh (OBJ, PLY, STL or glTF).
     pub input: PathBuf,
     /// Output stream.
     pub output: PathBuf,
@@ -76,6 +76,16 @@ pub struct EncodeArgs {
     /// Largest chunk payload in bytes (each chunk costs 9 bytes of framing and checksum).
     #[arg(long, default_value_t = 256)]
     pub chunk: u16,
+    /// Largest normal turn of a triangle in one collapse, degrees (60 by default), as in
+    /// `simplify`: a larger one lets the base get smaller.
+    #[arg(long, allow_negative_numbers = true)]
+    pub max_turn: Option<f32>,
+    /// Smallest triangle quality a collapse may create (0.05 by default), as in `simplify`.
+    #[arg(long, allow_negative_numbers = true)]
+    pub min_quality: Option<f32>,
+    /// Turn feature detection off (every vertex may be collapsed), as in `simplify`.
+    #[arg(long)]
+    pub no_features: bool,
 }
 
 /// `host-sim pm decode IN.tdpm OUT`
@@ -125,13 +135,23 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
     if !(0.0..=1.0).contains(&a.base_ratio) {
         bail!("--base-ratio {}: must be in [0, 1]", a.base_ratio);
     }
-    let mesh = io::load(&a.input)?;
-    let config = match a.base_triangles {
+    let mesh = io::load_noting(&a.input)?;
+    let mut config = match a.base_triangles {
         Some(n) => Config::new().with_target(Target::Triangles(n)),
         None => Config::new().with_ratio(a.base_ratio),
     };
+    if let Some(x) = a.max_turn {
+        config.max_normal_turn_deg = x;
+    }
+    if let Some(x) = a.min_quality {
+        config.min_quality = x;
+    }
+    config.features = !a.no_features;
+    config
+        .validate()
+        .map_err(|e| anyhow!("configuration: {e}"))?;
     let start = Instant::now();
-    let (bytes, e, order) = encode_mesh(&mesh, &config, quantised, a.chunk)?;
+    let (bytes, e, order, report) = encode_mesh_reporting(&mesh, &config, quantised, a.chunk)?;
     let took = start.elapsed();
     std::fs::write(&a.output, &bytes).with_context(|| format!("writing {}", a.output.display()))?;
     let d = decode_bytes(&bytes, bytes.len(), None)?;
@@ -145,6 +165,9 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
         "base mesh        {} triangles, {} vertices, {} bytes (header, positions, triangles, framing)",
         h.base_triangles, h.base_vertices, e.base_bytes
     );
+    if let Some(line) = base_shortfall(&report, &config) {
+        eprintln!("{line}");
+    }
     crate::outln!("vertex splits    {}", e.splits);
     let per = |bits: u64| bits as f64 / 8.0 / e.splits.max(1) as f64;
     crate::outln!(
@@ -180,6 +203,39 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
         took.as_secs_f64() * 1e3
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// One line when the base mesh is larger than asked: what stopped the simplification (as
+/// `simplify`'s advice reads it) and what relaxes it; `None` when the base reached its target.
+fn base_shortfall(r: &tinydecimate::Report, config: &Config) -> Option<String> {
+    use crate::cmd::simplify::advice::{advise, Outcome};
+    let a = advise(&Outcome::from(r).in_use(config), "", "")?;
+    // `pm encode` has these options of `simplify`'s and no other.
+    let ours = ["--max-turn", "--min-quality", "--no-features"];
+    let relax: Vec<&str> = a
+        .relax
+        .iter()
+        .filter(|x| ours.contains(&x.option))
+        .map(|x| x.example)
+        .collect();
+    Some(format!(
+        "warning: base mesh {} triangles, more than the {} asked for: the collapses stopped \
+         ({:?}), {} refused most{}; {}",
+        r.triangles_out,
+        r.target_triangles,
+        r.stop,
+        a.limit,
+        if a.count > 0 {
+            format!(" ({} {})", a.count, a.unit)
+        } else {
+            String::new()
+        },
+        if relax.is_empty() {
+            "no option of pm encode relaxes it: this is the smallest base it makes".to_string()
+        } else {
+            format!("relax with {}: each lets it go further", relax.join(", "))
+        }
+    ))
 }
 
 fn decode(a: &DecodeArgs) -> Result<()> {

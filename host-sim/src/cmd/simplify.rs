@@ -1,6 +1,6 @@
-//! `host-sim simplify`: runs the library on a mesh file, prints its report, memory figures and
-//! (unless `--no-measure`) the validity check and the Metro error of the result, as text or
-//! (`--json`) as one JSON object.
+//! `host-sim simplify`: runs the library on a mesh file, prints its report, memory figures, the
+//! validity check of the file written (`crate::check::verdict`, as `host-sim check`) and, with
+//! `--measure`, the Metro error of the result, as text or (`--json`) as one JSON object.
 //!
 //! The output path and format are checked before anything else; the input may be standard
 //! input and the output standard output (`-`). Output files keep only the vertices the result
@@ -16,10 +16,10 @@ use tinydecimate::cost::Placement;
 use tinydecimate::{Config, CostKind, FeatureMode, Report, Schedule, Storage, Target};
 
 use crate::io::{Format, MeshData};
-use crate::simplify::{format_report, report_json, simplify_with};
+use crate::simplify::{report_json, simplify_with};
 use crate::workspace::{control_bytes, element_bytes, workspace_bytes, QUADRIC_BYTES};
 
-mod advice;
+pub mod advice;
 mod attributes;
 mod shading;
 mod textured;
@@ -123,13 +123,24 @@ fn ranged(
     }
 }
 
+/// A ratio of 0 asks for the empty mesh, which no simplification makes: refused.
 fn parse_ratio(v: &str) -> std::result::Result<f32, String> {
     ranged(
         v,
-        |x| (0.0..=1.0).contains(&x),
-        "0 to 1",
+        |x| x > 0.0 && x <= 1.0,
+        "above 0, at most 1",
         "the fraction of the input triangles to keep, 0.25 keeps a quarter",
     )
+}
+
+/// A count of 0 asks for the empty mesh: refused, as `--ratio 0` is.
+fn parse_triangles(v: &str) -> std::result::Result<usize, String> {
+    match v.trim().parse::<usize>() {
+        Ok(n) if n > 0 => Ok(n),
+        _ => Err(format!(
+            "{v:?}: accepted: a whole number of triangles, 1 or more"
+        )),
+    }
 }
 
 /// The error bound at control points on the command line: a percentage of the bounding-box diagonal
@@ -273,6 +284,31 @@ fn parse_error_limit(v: &str) -> std::result::Result<ErrorLimit, String> {
     parse_max_error(v).map(ErrorLimit::At)
 }
 
+/// `--format`: the output's format, instead of its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// PLY (binary little endian).
+    Ply,
+    /// STL (binary).
+    Stl,
+    /// Binary glTF (GLB), from a glTF input only: every attribute kept (`io::gltf::write`).
+    Glb,
+}
+
+impl OutputFormat {
+    /// The mesh-file format, `None` for GLB (written by the glTF path, `textured.rs`).
+    pub fn mesh(self) -> Option<Format> {
+        match self {
+            OutputFormat::Obj => Some(Format::Obj),
+            OutputFormat::Ply => Some(Format::Ply),
+            OutputFormat::Stl => Some(Format::Stl),
+            OutputFormat::Glb => None,
+        }
+    }
+}
+
 /// How vertices at identical positions are treated (`--seams`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 pub enum SeamsArg {
@@ -311,13 +347,14 @@ pub struct Args {
     /// properties. Otherwise only positions and faces are read: attributes are not carried,
     /// and a warning says which were dropped.
     pub input: PathBuf,
-    /// Output mesh (.obj, .ply or .stl; `-` writes standard output, OBJ unless --format says
-    /// otherwise, and the report then goes to stderr). Checked before simplifying. Vertices no
-    /// output triangle uses are dropped (see --keep-numbering; kept with `--placement optimal`).
+    /// Output mesh (.obj, .ply, .stl; .gltf or .glb from a glTF input; `-` writes standard
+    /// output, OBJ unless --format says otherwise, and the report then goes to stderr).
+    /// Checked before simplifying. Vertices no output triangle uses are dropped (see
+    /// --keep-numbering; kept with `--placement optimal`).
     pub output: PathBuf,
-    /// Output format, instead of the output's extension.
+    /// Output format, instead of the output's extension (`glb`: from a glTF input, to a file).
     #[arg(long, value_enum)]
-    pub format: Option<Format>,
+    pub format: Option<OutputFormat>,
     /// Keep every input vertex in the output file, so that its indices are the input's (what
     /// a firmware's index buffer into the same positions needs). STL has no numbering.
     #[arg(long)]
@@ -344,11 +381,13 @@ pub struct Args {
     /// every part stays); `keep` keeps every part, as a collapse never changes topology.
     #[arg(long, value_enum, default_value_t = PartsArg::Prune)]
     pub parts: PartsArg,
-    /// Target fraction of the input triangles, 0 to 1.
+    /// Target fraction of the input triangles, above 0, at most 1. Not with
+    /// --target-triangles.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
     pub ratio: Option<f32>,
-    /// Target triangle count (with --ratio, the higher target wins).
-    #[arg(long, group = "target")]
+    /// Target triangle count, 1 or more. Not with --ratio (one target count: give one of
+    /// them).
+    #[arg(long, group = "target", conflicts_with = "ratio", value_parser = parse_triangles)]
     pub target_triangles: Option<usize>,
     /// Error bound at control points (Zhu, Wang and Meng 2007): what is guaranteed is that
     /// no control point, i.e. no original triangle's centroid and no vertex of an original
@@ -423,8 +462,13 @@ pub struct Args {
     /// OBJ with vt/vn); with welded seams each position's first vertex's attributes are used.
     #[arg(long, value_parser = parse_attribute_weights)]
     pub attribute_weights: Option<AttributeWeights>,
-    /// Skip the validity check and the Metro measurement afterwards.
+    /// Measure the Metro error of the result (input vs output, both directions) and, on
+    /// textured parts, the UV stretch and texture deviation beside meshoptimizer's. Off by
+    /// default: it takes several times the simplification. The validity check always runs.
     #[arg(long)]
+    pub measure: bool,
+    /// Accepted for old scripts: the Metro error is off unless --measure.
+    #[arg(long, hide = true)]
     pub no_measure: bool,
     /// Metro face samples per triangle of the larger mesh.
     #[arg(long, default_value_t = 10.0, allow_negative_numbers = true, value_parser = parse_samples)]
@@ -438,6 +482,11 @@ pub struct Args {
 }
 
 impl Args {
+    /// `--format` as a mesh-file format (`None`: not given, or GLB).
+    pub fn mesh_format(&self) -> Option<Format> {
+        self.format.and_then(OutputFormat::mesh)
+    }
+
     /// The error limit asked for, or the default where the run measures one.
     pub fn error_limit(&self) -> ErrorLimit {
         match self.error_limit {
@@ -509,7 +558,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if let Some(code) = textured::run_if_attributes(args)? {
         return Ok(code);
     }
-    let out_format = crate::io::check_writable(&args.output, args.format)?;
+    let out_format = crate::io::check_writable(&args.output, args.mesh_format())?;
     if !args.force && crate::io::same_file(&args.input, &args.output) {
         bail!(
             "{}: the output is the input file and would overwrite it: give another output, or \
@@ -529,10 +578,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     };
     say(&run_text(args, &run));
     let mut json = run_json(args, &run);
-    let mut valid = true;
-    if !args.no_measure {
-        valid = measure(args, &run, &say, &mut json)?;
-    }
+    let valid = measure(args, &run, &say, &mut json)?;
     json["valid"] = serde_json::Value::Bool(valid);
     if args.json {
         crate::outln!("{}", serde_json::to_string_pretty(&json)?);
@@ -680,7 +726,17 @@ fn run_text(args: &Args, run: &Run) -> String {
             config.max_error, config.control_angle_deg
         );
     }
-    let _ = writeln!(text, "{}", format_report(report));
+    // An error bound alone: the report's target is the bound, not a count of 0.
+    let bound_alone = args.ratio.is_none() && args.target_triangles.is_none();
+    let target = args
+        .max_error
+        .filter(|_| bound_alone)
+        .map(|e| advice::bound_target(&e.to_string(), config.max_error, report));
+    let _ = writeln!(
+        text,
+        "{}",
+        crate::simplify::format_report_for(report, target.as_deref())
+    );
     if let Some((outcome, advice)) = advice_for(args, report) {
         text += &advice.text(&outcome, "  ");
     }
@@ -744,7 +800,7 @@ fn advice_for(args: &Args, report: &Report) -> Option<(advice::Outcome, advice::
     if args.ratio.is_none() && args.target_triangles.is_none() {
         return None;
     }
-    let outcome = advice::Outcome::from(report);
+    let outcome = advice::Outcome::from(report).in_use(&args.config());
     let input = args.input.display().to_string();
     let output = args.output.display().to_string();
     advice::advise(&outcome, &input, &output).map(|a| (outcome, a))
@@ -774,8 +830,8 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
     })
 }
 
-/// The check of the file as written and read back, and the Metro error (and the bound's
-/// figures): said with `say`, added to `json`. Whether the result is valid.
+/// The check of the file as written and read back and, with `--measure`, the Metro error
+/// (and the bound's figures): said with `say`, added to `json`. Whether the result is valid.
 fn measure(
     args: &Args,
     run: &Run,
@@ -797,71 +853,110 @@ fn measure(
     let mut text = String::new();
     // The library drops degenerate and duplicate triangles before it starts; the check
     // compares the output with the input as the library saw it (`meshcheck::clean`).
-    // One checker, one verdict: what `host-sim check` says of the file, as written and
-    // read back (an STL welded by position, a compact file matched back by position).
+    // One checker, one verdict: what `host-sim check` says of the file with the same
+    // --seams and --parts, as written and read back (an STL welded by position, a compact
+    // file matched back by position).
     let ext = format!("{out_format:?}");
     let as_read = crate::io::encode(out_format, written)
         .map_err(|e| anyhow!("{e}"))
         .and_then(|b| crate::io::parse_bytes(&b, &ext))
         .map_err(|e| anyhow!("reading back what was written: {e:#}"))?;
-    let (read, note, mut validity) = crate::check::verdict(mesh, &as_read, *moved)?;
-    // Pruned parts: an input part the output does not touch was removed on purpose.
-    let parts = args.parts == PartsArg::Prune;
-    if args.seams == SeamsArg::Weld {
-        // Welded seams: the result in the input's numbering (a written file matches twins by
-        // position in order, which cannot say which wedge a corner was), both welded by
-        // position, and the wedges of the kept positions.
-        validity = crate::check::compare_parts(mesh, out, *moved, true, parts);
-    } else if parts {
-        validity = crate::check::compare_parts(mesh, &read, *moved, false, true);
-    }
+    let promise = crate::check::Promise {
+        moved: *moved,
+        welded: args.seams == SeamsArg::Weld,
+        parts: args.parts == PartsArg::Prune,
+    };
+    let (_, note, validity) = crate::check::verdict(mesh, &as_read, promise)?;
     let valid = validity.is_valid();
     let _ = writeln!(
         text,
         "check (output vs the cleaned input: the input less its {} degenerate and {} \
-         duplicate triangles, as the library dropped them):",
-        report.degenerate_dropped, report.duplicates_dropped
+         duplicate triangles, as the library dropped them; {}):",
+        report.degenerate_dropped,
+        report.duplicates_dropped,
+        promise_words(promise)
     );
     if let Some(n) = &note {
         let _ = writeln!(text, "note: {n}");
     }
     let _ = writeln!(text, "{validity}");
-    let opts = crate::metro::MetroOptions {
-        samples_per_triangle: args.samples_per_triangle,
-        progress: true,
-        ..Default::default()
-    };
-    let m = crate::metro::metro(mesh, out, &opts);
-    let _ = writeln!(text, "metro (input vs output):");
-    let _ = writeln!(text, "{m}");
+    let m = args.measure.then(|| {
+        let opts = crate::metro::MetroOptions {
+            samples_per_triangle: args.samples_per_triangle,
+            progress: true,
+            ..Default::default()
+        };
+        crate::metro::metro(mesh, out, &opts)
+    });
+    match &m {
+        Some(m) => {
+            let _ = writeln!(text, "metro (input vs output):");
+            let _ = writeln!(text, "{m}");
+        }
+        None => {
+            let _ = writeln!(text, "{NOT_MEASURED}");
+        }
+    }
     if let (Some(emax), Some(emean)) = (report.max_error, report.mean_error) {
-        let pct = |x: f64| 100.0 * x / m.diagonal.max(f64::MIN_POSITIVE);
+        // Metro's unit too (`MetroReport::diagonal`).
+        let pct = |x: f64| 100.0 * x / mesh.bbox_diagonal().max(f64::MIN_POSITIVE);
         let _ = writeln!(
             text,
             "error bound (input units; % of the diagonal):\n\
              \x20 d_hold                   {:.6e} = {:.5} %\n\
              \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
-             \x20 E_mean (eq. 5)           {:.6e} = {:.5} %\n\
-             \x20 Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
+             \x20 E_mean (eq. 5)           {:.6e} = {:.5} %",
             config.max_error,
             pct(f64::from(config.max_error)),
             emax,
             pct(f64::from(emax)),
             emean,
             pct(f64::from(emean)),
-            m.a_to_b.max,
-            m.a_to_b.max_pct,
         );
+        if let Some(m) = &m {
+            let _ = writeln!(
+                text,
+                "  Metro max orig -> simpl  {:.6e} = {:.5} %  (sampled, not bounded)",
+                m.a_to_b.max, m.a_to_b.max_pct,
+            );
+        }
     }
     say(&text);
     json["check"] = serde_json::json!({
         "against": "cleaned input",
+        "seams": args.seams,
+        "parts": args.parts,
         "validity": validity,
         "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
         "valid": valid,
     });
-    json["metro"] = serde_json::to_value(&m)?;
+    json["metro"] = match &m {
+        Some(m) => serde_json::to_value(m)?,
+        None => serde_json::Value::Null,
+    };
     Ok(valid)
+}
+
+/// The report's line when the Metro error was not measured.
+pub(crate) const NOT_MEASURED: &str =
+    "error: not measured (--measure adds the Metro error, input vs output)";
+
+/// The check's promises in words (as `check` says them, `crate::cmd::check::against`).
+fn promise_words(p: crate::check::Promise) -> String {
+    let mut s = String::from(if p.welded {
+        "seams welded by position"
+    } else {
+        "seams split"
+    });
+    s += if p.parts {
+        ", parts gone whole allowed"
+    } else {
+        ", every part kept"
+    };
+    if p.moved {
+        s += ", kept vertices may have moved";
+    }
+    s
 }
 
 #[cfg(test)]

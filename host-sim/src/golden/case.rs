@@ -1,6 +1,6 @@
 //! The simplification cases of `tests/golden/cases.toml`: the manifest ([`CaseSpec`]), the
 //! mesh and configuration each one builds ([`Case`]), and the host's run of a case exactly as
-//! the firmware makes it ([`reference`]).
+//! the firmware makes it ([`fn@reference`]).
 
 use std::fmt::Write as _;
 use std::path::Path;

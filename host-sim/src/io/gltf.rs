@@ -875,7 +875,7 @@ pub fn write(
     Ok((out, None))
 }
 
-/// Writes [`write`]'s output to `path` (`.glb` or `.gltf`, the `.bin` beside it).
+/// Writes [`fn@write`]'s output to `path` (`.glb` or `.gltf`, the `.bin` beside it).
 pub fn save(path: &Path, file: &GltfFile, results: &[Triangles]) -> anyhow::Result<()> {
     let glb = path
         .extension()
@@ -912,4 +912,331 @@ pub fn attribute_summary(file: &GltfFile) -> String {
         }
     }
     m.keys().copied().collect::<Vec<_>>().join(", ")
+}
+
+// ---------------------------------------------------------------------------------------------
+// The scene, and the geometry the plain loader sees
+
+/// A transform, row-major, acting on column vectors.
+pub type Transform = [[f64; 4]; 4];
+
+const IDENTITY: Transform = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
+
+fn mul(a: &Transform, b: &Transform) -> Transform {
+    let mut m = [[0.0; 4]; 4];
+    for (r, row) in m.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v = (0..4).map(|k| a[r][k] * b[k][c]).sum();
+        }
+    }
+    m
+}
+
+fn numbers(v: Option<&Value>) -> Option<Vec<f64>> {
+    v?.as_array()?.iter().map(Value::as_f64).collect()
+}
+
+/// A node's local transform: its `matrix` (column-major in the file), else translation ·
+/// rotation · scale.
+fn local(node: &Value) -> Transform {
+    if let Some(m) = numbers(node.get("matrix")).filter(|m| m.len() == 16) {
+        let mut out = [[0.0; 4]; 4];
+        for c in 0..4 {
+            for r in 0..4 {
+                out[r][c] = m[c * 4 + r];
+            }
+        }
+        return out;
+    }
+    let t = numbers(node.get("translation"))
+        .filter(|v| v.len() == 3)
+        .unwrap_or(vec![0.0; 3]);
+    let [x, y, z, w] = numbers(node.get("rotation"))
+        .filter(|v| v.len() == 4)
+        .map_or([0.0, 0.0, 0.0, 1.0], |q| [q[0], q[1], q[2], q[3]]);
+    let s = numbers(node.get("scale"))
+        .filter(|v| v.len() == 3)
+        .unwrap_or(vec![1.0; 3]);
+    let r = [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - z * w),
+            2.0 * (x * z + y * w),
+        ],
+        [
+            2.0 * (x * y + z * w),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - x * w),
+        ],
+        [
+            2.0 * (x * z - y * w),
+            2.0 * (y * z + x * w),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ];
+    let mut m = IDENTITY;
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = r[i][j] * s[j];
+        }
+        m[i][3] = t[i];
+    }
+    m
+}
+
+/// One mesh placed in the scene by a node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placement {
+    /// The node.
+    pub node: usize,
+    /// The mesh it draws.
+    pub mesh: usize,
+    /// The node's world transform (composed down the node tree).
+    pub world: Transform,
+}
+
+/// Where the scene draws meshes, as a viewer does: every node of the default scene (or of the
+/// first, or every root node when there is no scene), depth first down the node tree, each
+/// with its world transform. A mesh several nodes name is drawn once per node (instancing);
+/// a node reached twice (a cycle, invalid glTF) is entered once.
+pub fn placements(json: &Value) -> Vec<Placement> {
+    let nodes = json.get("nodes").and_then(Value::as_array);
+    let n = nodes.map_or(0, Vec::len);
+    let scenes = json.get("scenes").and_then(Value::as_array);
+    let pick = json.get("scene").and_then(Value::as_u64).unwrap_or(0) as usize;
+    let roots: Vec<usize> = match scenes
+        .and_then(|s| s.get(pick))
+        .and_then(|s| s.get("nodes"))
+    {
+        Some(list) => numbers(Some(list))
+            .unwrap_or_default()
+            .into_iter()
+            .map(|n| n as usize)
+            .collect(),
+        None => {
+            // No scene: every node that is no other node's child.
+            let mut child = vec![false; n];
+            for node in nodes.into_iter().flatten() {
+                for c in numbers(node.get("children")).unwrap_or_default() {
+                    if let Some(x) = child.get_mut(c as usize) {
+                        *x = true;
+                    }
+                }
+            }
+            (0..n).filter(|&i| !child[i]).collect()
+        }
+    };
+    let mut out = Vec::new();
+    let mut seen = vec![false; n];
+    let mut stack: Vec<(usize, Transform)> =
+        roots.into_iter().rev().map(|r| (r, IDENTITY)).collect();
+    while let Some((k, parent)) = stack.pop() {
+        let (Some(node), Some(s)) = (nodes.and_then(|l| l.get(k)), seen.get_mut(k)) else {
+            continue;
+        };
+        if std::mem::replace(s, true) {
+            continue;
+        }
+        let world = mul(&parent, &local(node));
+        if let Some(m) = node.get("mesh").and_then(Value::as_u64) {
+            out.push(Placement {
+                node: k,
+                mesh: m as usize,
+                world,
+            });
+        }
+        for c in numbers(node.get("children"))
+            .unwrap_or_default()
+            .into_iter()
+            .rev()
+        {
+            stack.push((c as usize, world));
+        }
+    }
+    out
+}
+
+/// How the scene draws the triangle primitives, against how the file stores them (each
+/// primitive once, as `simplify` reads and counts them).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Instancing {
+    /// Triangles of the triangle primitives, each primitive once.
+    pub stored: usize,
+    /// Triangles the scene draws: each primitive once per node that places its mesh.
+    pub drawn: usize,
+    /// Meshes with triangles that the scene draws other than once: (mesh, times drawn).
+    pub meshes: Vec<(usize, usize)>,
+    /// Whether some node placing a mesh has a transform other than the identity.
+    pub transformed: bool,
+}
+
+impl Instancing {
+    /// Counts `file`'s triangles stored and drawn ([`placements`]).
+    pub fn of(file: &GltfFile) -> Instancing {
+        let places = placements(&file.json);
+        let mut times: BTreeMap<usize, usize> = BTreeMap::new();
+        for p in &file.primitives {
+            times.entry(p.mesh).or_insert(0);
+        }
+        for p in &places {
+            if let Some(t) = times.get_mut(&p.mesh) {
+                *t += 1;
+            }
+        }
+        let tris = |m: usize| -> usize {
+            file.primitives
+                .iter()
+                .filter(|p| p.mesh == m)
+                .map(|p| p.triangles.len())
+                .sum()
+        };
+        Instancing {
+            stored: file.primitives.iter().map(|p| p.triangles.len()).sum(),
+            drawn: times.iter().map(|(&m, &t)| t * tris(m)).sum(),
+            meshes: times.into_iter().filter(|&(_, t)| t != 1).collect(),
+            transformed: places.iter().any(|pl| {
+                pl.world != IDENTITY && file.primitives.iter().any(|p| p.mesh == pl.mesh)
+            }),
+        }
+    }
+
+    /// "mesh 1 drawn 2 times, mesh 3 not drawn" (empty when every mesh is drawn once).
+    pub fn meshes_text(&self) -> String {
+        self.meshes
+            .iter()
+            .map(|&(m, t)| match t {
+                0 => format!("mesh {m} in no node (not drawn)"),
+                t => format!("mesh {m} drawn {t} times"),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// The geometry of `file` as one mesh, as `simplify` sees the file: every triangle primitive
+/// once, in file order, in its mesh's own coordinates (node transforms are not applied, and a
+/// mesh several nodes place is counted once), its vertices numbered after the previous
+/// primitive's. With it, the notes: attributes not carried, primitives that are not
+/// triangles, and, when the scene draws the meshes otherwise (moved, instanced or not at
+/// all), how.
+pub fn geometry(file: &GltfFile) -> (crate::io::MeshData, crate::io::LoadNotes) {
+    let mut mesh = crate::io::MeshData::default();
+    let mut attributes: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut targets = 0;
+    for p in &file.primitives {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend_from_slice(&p.positions);
+        mesh.triangles
+            .extend(p.triangles.iter().map(|t| t.map(|i| base + i)));
+        for s in p.attributes.iter().filter(|s| s.semantic != "POSITION") {
+            *attributes.entry(s.semantic.as_str()).or_default() += 1;
+        }
+        targets += p.targets.len();
+    }
+    let mut notes = crate::io::LoadNotes::default();
+    let n = file.primitives.len();
+    notes.dropped = attributes
+        .iter()
+        .map(|(a, k)| format!("{a} ({k} of {n} primitives)"))
+        .collect();
+    if targets > 0 {
+        notes.dropped.push(format!("{targets} morph target(s)"));
+    }
+    for p in &file.passed_through {
+        notes.other.push(format!("{p} is not triangles: not read"));
+    }
+    let inst = Instancing::of(file);
+    if inst.transformed || !inst.meshes.is_empty() {
+        let mut s = format!(
+            "read as `simplify` reads glTF: each of the {n} triangle primitive(s) once, in its \
+             mesh's own coordinates ({} triangles; node transforms not applied)",
+            inst.stored
+        );
+        if !inst.meshes.is_empty() {
+            s += &format!(
+                "; the scene draws {} triangles: {}",
+                inst.drawn,
+                inst.meshes_text()
+            );
+        }
+        notes.other.push(s);
+    }
+    (mesh, notes)
+}
+
+/// Writes the simplified primitives (`results[k]` for `file.primitives[k]`, in the input's
+/// vertex numbering) to a file that is not glTF, in `format`, and prints on stderr one line
+/// naming what the format cannot hold and is not written. OBJ carries each primitive's
+/// texture coordinates and normals ([`crate::io::objattr::from_gltf`]); PLY and STL, and OBJ
+/// with `keep_numbering`, get positions and triangles ([`geometry`]'s numbering, kept or
+/// compacted). Returns what was written per vertex, e.g. "POSITION, NORMAL, TEXCOORD_0".
+pub fn save_other(
+    path: &Path,
+    format: crate::io::Format,
+    file: &GltfFile,
+    results: &[Triangles],
+    keep_numbering: bool,
+) -> anyhow::Result<String> {
+    use crate::io::Format;
+    if results.len() != file.primitives.len() {
+        anyhow::bail!("{}: one result per primitive", path.display());
+    }
+    let (written, not_written, what) = if format == Format::Obj && !keep_numbering {
+        let (obj, not_written) = crate::io::objattr::from_gltf(file);
+        let text = crate::io::objattr::write(&obj, results);
+        std::fs::write(path, text)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+        let mut written: Vec<&str> = vec!["POSITION"];
+        if !obj.vn_text.is_empty() {
+            written.push("NORMAL");
+        }
+        if !obj.vt_text.is_empty() {
+            written.push("texture coordinates");
+        }
+        (
+            written.join(", "),
+            not_written,
+            "OBJ holds positions, one set of texture coordinates and normals",
+        )
+    } else {
+        let (all, notes) = geometry(file);
+        let mut mesh = crate::io::MeshData {
+            positions: all.positions,
+            triangles: Vec::new(),
+        };
+        let mut base = 0u32;
+        for (p, tris) in file.primitives.iter().zip(results) {
+            mesh.triangles
+                .extend(tris.iter().map(|t| t.map(|i| base + i)));
+            base += p.positions.len() as u32;
+        }
+        if !keep_numbering {
+            mesh = crate::io::compact(&mesh).0;
+        }
+        crate::io::save_as(path, format, &mesh)?;
+        let mut not_written = notes.dropped;
+        let inst = Instancing::of(file);
+        if inst.transformed || !inst.meshes.is_empty() {
+            not_written.push("the scene's nodes (each primitive once, untransformed)".into());
+        }
+        let what = match format {
+            Format::Obj => "OBJ with the input's numbering holds positions only",
+            Format::Ply => "PLY is written with positions and triangles only",
+            Format::Stl => "STL holds positions and triangles only",
+        };
+        ("POSITION".to_string(), not_written, what)
+    };
+    if !not_written.is_empty() {
+        eprintln!(
+            "note: {}: {what}; not written: {}",
+            path.display(),
+            not_written.join(", ")
+        );
+    }
+    Ok(written)
 }

@@ -272,3 +272,136 @@ pub fn write(f: &ObjFile, results: &[Vec<[u32; 3]>]) -> String {
     }
     out
 }
+
+/// The texture coordinates primitive `p` of `file` is drawn with: `TEXCOORD_n` of its
+/// material's `baseColorTexture`, else `TEXCOORD_0`; `None` when the primitive has not that
+/// attribute.
+pub fn gltf_texcoord_name(
+    file: &crate::io::gltf::GltfFile,
+    p: &crate::io::gltf::Primitive,
+) -> Option<String> {
+    let material = &file.json["meshes"][p.mesh]["primitives"][p.index]["material"];
+    let n = material
+        .as_u64()
+        .and_then(|m| {
+            file.json["materials"][m as usize]["pbrMetallicRoughness"]["baseColorTexture"]
+                ["texCoord"]
+                .as_u64()
+        })
+        .unwrap_or(0);
+    let name = format!("TEXCOORD_{n}");
+    p.attributes
+        .iter()
+        .any(|s| s.semantic == name)
+        .then_some(name)
+}
+
+/// Element `i` of a NORMAL stream as floats: `FLOAT`, or normalized `BYTE` / `SHORT`
+/// (`KHR_mesh_quantization`).
+fn gltf_normal(s: &crate::io::gltf::Stream, i: usize) -> Option<[f32; 3]> {
+    let e = s.data.get(i * s.elem..(i + 1) * s.elem)?;
+    let at = |k: usize, w: usize| e.get(k * w..(k + 1) * w);
+    let mut out = [0.0f32; 3];
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = match (s.component_type, s.normalized) {
+            (5126, _) => {
+                let b = at(k, 4)?;
+                f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            }
+            (5120, true) => (f32::from(at(k, 1)?[0] as i8) / 127.0).max(-1.0),
+            (5122, true) => {
+                let b = at(k, 2)?;
+                (f32::from(i16::from_le_bytes([b[0], b[1]])) / 32767.0).max(-1.0)
+            }
+            _ => return None,
+        };
+    }
+    Some(out)
+}
+
+/// A glTF file's triangle primitives as an OBJ with attributes, to write with [`fn@write`]: one
+/// `v` per glTF vertex, all primitives' vertices in file order (so the OBJ's numbering is
+/// [`crate::io::gltf::geometry`]'s); one `vt` per vertex of a primitive with the texture
+/// coordinates its material reads ([`gltf_texcoord_name`]), written `u 1-v` because glTF's v
+/// runs down the image and OBJ's up; one `vn` per vertex of a primitive with NORMAL; each
+/// primitive its own group, `usemtl` its material's name (blanks made `_`; `material_N` when
+/// it has none, `default` without a material). Also returns what OBJ cannot hold and is not written (other
+/// attributes, morph targets, the materials themselves, node transforms), for one line of
+/// output.
+pub fn from_gltf(file: &crate::io::gltf::GltfFile) -> (ObjFile, Vec<String>) {
+    let mut f = ObjFile::default();
+    let mut skipped: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
+    let mut targets = false;
+    for p in &file.primitives {
+        let uv_name = gltf_texcoord_name(file, p);
+        let uv = uv_name
+            .as_ref()
+            .and_then(|n| p.attributes.iter().find(|s| &s.semantic == n));
+        let normal = p.attributes.iter().find(|s| s.semantic == "NORMAL");
+        let mut normals: Option<Vec<[f32; 3]>> =
+            normal.and_then(|s| (0..p.positions.len()).map(|i| gltf_normal(s, i)).collect());
+        if normal.is_some() && normals.is_none() {
+            skipped.insert("NORMAL (not float or normalized)".into());
+            normals = None;
+        }
+        for s in &p.attributes {
+            let written = s.semantic == "POSITION"
+                || (s.semantic == "NORMAL" && normals.is_some())
+                || Some(&s.semantic) == uv_name.as_ref();
+            if !written {
+                skipped.insert(s.semantic.clone());
+            }
+        }
+        targets |= !p.targets.is_empty();
+        let v0 = f.positions.len() as u32;
+        let t0 = f.vt_text.len() as u32;
+        let n0 = f.vn_text.len() as u32;
+        for q in &p.positions {
+            f.positions.push(*q);
+            f.v_text.push(format!("{} {} {}", q[0], q[1], q[2]));
+        }
+        if let Some(s) = uv {
+            for i in 0..p.positions.len() {
+                let [u, v] = crate::texrender::uv_of(s, i).unwrap_or([0.0; 2]);
+                f.vt_text.push(format!("{} {}", u as f32, (1.0 - v) as f32));
+            }
+        }
+        if let Some(ns) = &normals {
+            for n in ns {
+                f.vn_text.push(format!("{} {} {}", n[0], n[1], n[2]));
+            }
+        }
+        let material = file.json["meshes"][p.mesh]["primitives"][p.index]["material"]
+            .as_u64()
+            .map_or("default".to_string(), |m| {
+                file.json["materials"][m as usize]["name"]
+                    .as_str()
+                    .map(|n| n.split_whitespace().collect::<Vec<_>>().join("_"))
+                    .filter(|n| !n.is_empty())
+                    .unwrap_or(format!("material_{m}"))
+            });
+        let n = p.positions.len() as u32;
+        f.groups.push(Group {
+            material: Some(material),
+            vertices: (0..n)
+                .map(|i| (v0 + i, uv.map(|_| t0 + i), normals.as_ref().map(|_| n0 + i)))
+                .collect(),
+            triangles: p.triangles.clone(),
+        });
+    }
+    let mut not_written: Vec<String> = skipped.into_iter().collect();
+    if targets {
+        not_written.push("morph targets".into());
+    }
+    if file.json["materials"]
+        .as_array()
+        .is_some_and(|m| !m.is_empty())
+    {
+        not_written.push("materials (no .mtl; `usemtl` names only)".into());
+    }
+    let inst = crate::io::gltf::Instancing::of(file);
+    if inst.transformed || !inst.meshes.is_empty() {
+        not_written.push("the scene's nodes (each primitive once, untransformed)".into());
+    }
+    (f, not_written)
+}

@@ -126,7 +126,7 @@ impl Cost for Quadric {
         self.reference = mean_area2;
     }
 
-    /// `r2 · area2` ([`quadric_part`](super::quadric_part)): without the thin-part factor,
+    /// `r2 · area2` (the crate-private `quadric_part`): without the thin-part factor,
     /// whose reference area changes every round (a part's place in the order must not).
     fn part(&self, r2: f32, area2: f32) -> f32 {
         super::quadric_part(r2, area2)

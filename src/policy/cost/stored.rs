@@ -212,7 +212,7 @@ impl Cost for StoredQuadric<'_> {
         Some(math::add(m.p_to, x))
     }
 
-    /// `r2 · area2` ([`quadric_part`](super::quadric_part)).
+    /// `r2 · area2` (the crate-private `quadric_part`).
     fn part(&self, r2: f32, area2: f32) -> f32 {
         super::quadric_part(r2, area2)
     }

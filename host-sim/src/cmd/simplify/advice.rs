@@ -84,7 +84,7 @@ pub const RELIEF: &[Relief] = &[
 ];
 
 /// What a run did, as far as the advice needs it (a [`Report`]'s fields).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Outcome {
     /// Why it stopped.
     pub stop: Stop,
@@ -100,6 +100,20 @@ pub struct Outcome {
     pub feature_vertices: usize,
     /// Locked vertices (never in the queue).
     pub locked_vertices: usize,
+    /// The normal-turn limit in use, degrees (`Config::max_normal_turn_deg`).
+    pub max_turn: f32,
+    /// The quality limit in use (`Config::min_quality`).
+    pub min_quality: f32,
+}
+
+impl Outcome {
+    /// The limits `config` ran with (`From<&Report>` assumes `Config::new()`'s): the advice
+    /// names only values that relax them further.
+    pub fn in_use(mut self, config: &tinydecimate::Config) -> Outcome {
+        self.max_turn = config.max_normal_turn_deg;
+        self.min_quality = config.min_quality;
+        self
+    }
 }
 
 impl From<&Report> for Outcome {
@@ -112,6 +126,8 @@ impl From<&Report> for Outcome {
             refused: r.rejected.iter().map(|(_, n)| n).collect(),
             feature_vertices: r.feature_vertices,
             locked_vertices: r.locked_vertices,
+            max_turn: tinydecimate::Config::new().max_normal_turn_deg,
+            min_quality: tinydecimate::Config::new().min_quality,
         }
     }
 }
@@ -179,8 +195,17 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
         })
         .collect();
     counted.sort_by_key(|c| std::cmp::Reverse(c.1));
+    // An example must relax the limit in use: a larger turn than the one given (179 is the
+    // largest accepted), a quality of 0 unless it is 0 already; else the rule is not offered.
+    let example = |rule: Reject, example: &'static str| match rule {
+        Reject::NormalTurn if o.max_turn >= 179.0 => None,
+        Reject::NormalTurn if o.max_turn >= 120.0 => Some("--max-turn 179"),
+        Reject::Sliver if o.min_quality <= 0.0 => None,
+        _ => Some(example),
+    };
     let relaxable = |(r, n, unit): &(&Relief, usize, &'static str)| {
-        r.option.filter(|_| *n > 0).map(|(option, example)| Relax {
+        let (option, given) = r.option.filter(|_| *n > 0)?;
+        example(r.rule, given).map(|example| Relax {
             limit: r.rule.name(),
             count: *n,
             unit,
@@ -220,16 +245,19 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
             ("log_full", 0, "", "the collapse log is full")
         }
         Stop::ErrorLimit => {
-            // On purpose: what is left would cut corners. Raising the limit is the one lever.
+            // On purpose: what is left would cut corners. Raising the limit is the one lever,
+            // and only a value above the one in use changes anything: the report does not say
+            // what the next collapse would need, so the advice names the value that always
+            // goes further, `none`.
             relax = vec![Relax {
                 limit: "error_limit",
                 count: 0,
                 unit: "",
                 option: "--error-limit",
-                example: "--error-limit 5%",
+                example: "--error-limit none (or any value above the one in use)",
             }];
-            let why = "every collapse left is over the error limit: reaching the count would \
-                       cut corners";
+            let why = "every collapse left is over the error limit in use: reaching the count \
+                       would cut corners";
             ("error_limit", 0, "", why)
         }
         _ => match counted.first() {
@@ -237,7 +265,11 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
             _ => ("none", 0, "", "no collapse was refused"),
         },
     };
-    let (fallback, fallback_then_collapse) = fallbacks(input, output, o.target_triangles);
+    // A target of 0 triangles is the empty mesh: no command is worth advising to reach it.
+    let (fallback, fallback_then_collapse) = match fallbacks(input, output, o.target_triangles) {
+        Some((a, b)) => (Some(a), Some(b)),
+        None => (None, None),
+    };
     Some(Advice {
         stop: format!("{:?}", o.stop),
         limit,
@@ -245,19 +277,56 @@ pub fn advise(o: &Outcome, input: &str, output: &str) -> Option<Advice> {
         unit,
         why,
         relax,
-        fallback: Some(fallback),
-        fallback_then_collapse: Some(fallback_then_collapse),
+        fallback,
+        fallback_then_collapse,
     })
 }
 
+/// The target line of a run to an error bound alone (`--max-error` without a count): the error
+/// it ran to, `bound` as given (`0.5%` of the diagonal, or a distance) and `d_hold` in the
+/// input's units, and whether it was reached: yes when the bound is what stopped the run
+/// (every collapse left would break it), else no, with the limit that stopped it first and
+/// the option that relaxes it, read as [`advise`] reads a shortfall.
+pub fn bound_target(bound: &str, d_hold: f32, report: &Report) -> String {
+    let of = if bound.ends_with('%') {
+        " of the diagonal"
+    } else {
+        ""
+    };
+    let head = format!("error ≤ {bound}{of} = {d_hold:.6e}");
+    let o = Outcome {
+        target_reached: false,
+        ..Outcome::from(report)
+    };
+    let advice = match o.stop {
+        Stop::Target | Stop::Running => None,
+        _ => advise(&o, "", ""),
+    };
+    match advice {
+        Some(a) if a.limit != "bound" => {
+            let relax = a
+                .relax
+                .first()
+                .map_or(String::new(), |r| format!(": relax {}", r.example));
+            format!("{head} (reached: no, {} stopped it first{relax})", a.limit)
+        }
+        _ => format!("{head} (reached: yes, as far as the bound allows)"),
+    }
+}
+
 /// The two `host-sim cluster` commands that reach `n` triangles: clustering alone, and
-/// clustering to at most `2n` then collapsing.
-pub fn fallbacks(input: &str, output: &str, n: usize) -> (String, String) {
+/// clustering to at most `2n` then collapsing (`cluster --then-collapse` reaches its count:
+/// when the collapses stop short it clusters again, closer to the count, and collapses once
+/// more). `None` for `n` = 0, which only the empty mesh reaches.
+pub fn fallbacks(input: &str, output: &str, n: usize) -> Option<(String, String)> {
+    if n == 0 {
+        return None;
+    }
     let cluster = format!("host-sim cluster {input} {output} --target-triangles");
-    (
+    Some((
         format!("{cluster} {n}"),
         format!("{cluster} {} --then-collapse {n}", 2 * n),
-    )
+    ))
 }
 
 impl Advice {
@@ -330,6 +399,8 @@ mod tests {
                 .collect(),
             feature_vertices: features,
             locked_vertices: locked,
+            max_turn: 60.0,
+            min_quality: 0.05,
         }
     }
 
@@ -438,6 +509,12 @@ mod tests {
         assert_eq!(a.limit, "error_limit");
         assert_eq!(a.relax.len(), 1);
         assert_eq!(a.relax[0].option, "--error-limit");
+        // The value in use is not known here; `none` is the one that always goes further.
+        assert!(
+            a.relax[0].example.starts_with("--error-limit none"),
+            "{:?}",
+            a.relax
+        );
         let a = advise(&short(Stop::MaxPasses, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
         assert_eq!((a.limit, options(&a)), ("max_passes", vec!["--schedule"]));
         let a = advise(&short(Stop::MaxCost, &[("sliver", 5)], 0, 0), "a", "b").unwrap();
@@ -453,6 +530,40 @@ mod tests {
         let mut o = short(Stop::Target, &[("sliver", 5)], 0, 0);
         o.target_reached = true;
         assert_eq!(advise(&o, "a", "b"), None);
+    }
+
+    /// A limit already relaxed to the example's value is not advised again.
+    #[test]
+    fn advice_relaxes_the_limits_in_use() {
+        let o = short(
+            Stop::NoLegalCollapse,
+            &[("normal_turn", 900), ("sliver", 40)],
+            0,
+            0,
+        );
+        let a = advise(&o, "a", "b").unwrap();
+        let examples = |a: &Advice| a.relax.iter().map(|r| r.example).collect::<Vec<_>>();
+        assert_eq!(examples(&a), ["--max-turn 120", "--min-quality 0"]);
+        let mut c = Config::new();
+        c.max_normal_turn_deg = 120.0;
+        c.min_quality = 0.0;
+        let a = advise(&o.clone().in_use(&c), "a", "b").unwrap();
+        assert_eq!(examples(&a), ["--max-turn 179"]);
+        c.max_normal_turn_deg = 179.0;
+        let a = advise(&o.in_use(&c), "a", "b").unwrap();
+        assert!(a.relax.is_empty(), "{:?}", a.relax);
+    }
+
+    /// A target of 0 triangles gets no fallback: no command would be worth running.
+    #[test]
+    fn no_fallback_to_zero_triangles() {
+        let mut o = short(Stop::NoLegalCollapse, &[("sliver", 5)], 0, 0);
+        o.target_triangles = 0;
+        let a = advise(&o, "a", "b").unwrap();
+        assert_eq!((&a.fallback, &a.fallback_then_collapse), (&None, &None));
+        assert!(!a.text(&o, "").contains("--target-triangles 0"));
+        assert_eq!(fallbacks("a", "b", 0), None);
+        assert!(fallbacks("a", "b", 1).is_some());
     }
 
     /// A real run held back by a tight normal-turn limit: the report names it.

@@ -4,8 +4,9 @@
 //!
 //! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
 //! the same configuration; `--target-triangles N` is shared among the parts in proportion to
-//! their triangles. The validity check and the Metro error run per part, in the part's own
-//! coordinates (node transforms are not applied); the result is valid when every part is.
+//! their triangles. The validity check (and with `--measure` the Metro error and the texture
+//! figures) runs per part, in the part's own coordinates (node transforms are not applied);
+//! the result is valid when every part is.
 //! The attributes of every kept vertex are those of an input vertex, bit for bit, because the
 //! library's subset placement only moves triangles. Optimal placement moves vertices without
 //! interpolating attributes, so `--placement optimal` is refused here.
@@ -47,24 +48,38 @@ fn run_library(
     Ok((out.triangles, report, elapsed))
 }
 
+/// Whether the output is glTF: `--format glb`, or without `--format` a `.gltf` or `.glb` name.
+fn gltf_out(args: &Args) -> bool {
+    match args.format {
+        Some(f) => f == super::OutputFormat::Glb,
+        None => crate::io::gltf::is_gltf_path(&args.output),
+    }
+}
+
 /// Runs `simplify` here when the input or output is glTF, or the input is an OBJ with texture
 /// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
 pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     let (i, o) = (&args.input, &args.output);
     let gi = crate::io::gltf::is_gltf_path(i);
-    let go = crate::io::gltf::is_gltf_path(o);
+    let go = gltf_out(args);
     if gi || go {
-        if !(gi && go) {
+        if !gi {
             bail!(
-                "glTF is read and written only as glTF: give both {} and {} a .gltf or .glb \
-                 extension",
+                "glTF is written only from glTF: give {} a .gltf or .glb extension, or write {} \
+                 as OBJ, PLY or STL",
                 i.display(),
                 o.display()
             );
         }
         refuse_optimal(args)?;
-        // The output is checked before the long work, as on the plain path.
-        if o.is_dir() {
+        // The output is checked before the long work, as on the plain path. glTF in, another
+        // format out: the same parts simplified, written by `gltf::save_other`.
+        if crate::io::is_std(o) {
+            bail!("glTF input is written to a file, not to standard output: give an output path");
+        }
+        if !go {
+            crate::io::check_writable(o, args.mesh_format())?;
+        } else if o.is_dir() {
             bail!("{}: is a directory, not a file to write", o.display());
         }
         if !o.exists() {
@@ -80,8 +95,10 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     };
     if is_obj(i)
         && is_obj(o)
-        && crate::io::check_writable(o, args.format).is_ok()
-        && args.format.is_none_or(|f| f == crate::io::Format::Obj)
+        && crate::io::check_writable(o, args.mesh_format()).is_ok()
+        && args
+            .mesh_format()
+            .is_none_or(|f| f == crate::io::Format::Obj)
         && !args.keep_numbering
     {
         let t0 = Instant::now();
@@ -98,8 +115,10 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     };
     if is_ply(i)
         && is_ply(o)
-        && crate::io::check_writable(o, args.format).is_ok()
-        && args.format.is_none_or(|f| f == crate::io::Format::Ply)
+        && crate::io::check_writable(o, args.mesh_format()).is_ok()
+        && args
+            .mesh_format()
+            .is_none_or(|f| f == crate::io::Format::Ply)
         && !args.keep_numbering
     {
         let t0 = Instant::now();
@@ -223,35 +242,37 @@ fn simplify_parts(
             positions: mesh.positions.clone(),
             triangles: tris.clone(),
         };
-        let mut line = format!(
-            "  {label}: {} -> {} triangles (target {}, stop {:?}){}",
-            report.triangles_in,
-            report.triangles_out,
-            report.target_triangles,
-            report.stop,
-            if parts.len() == 1 {
-                format!("\n{}", crate::simplify::format_report(&report))
-            } else {
-                String::new()
-            }
+        let head = format!(
+            "  {label}: {} -> {} triangles (target {}, stop {:?})",
+            report.triangles_in, report.triangles_out, report.target_triangles, report.stop,
         );
+        // The report and the advice, each line its own.
+        let mut tail = if parts.len() == 1 {
+            format!("\n{}", crate::simplify::format_report(&report).trim_end())
+        } else {
+            String::new()
+        };
         // Why it stopped short, per part; the fallback is for the whole file (`finish`).
         let advice = super::advice_for(args, &report).map(|(outcome, mut a)| {
             a.fallback = None;
             a.fallback_then_collapse = None;
-            let _ = write!(line, "\n{}", a.text(&outcome, "    ").trim_end());
+            let _ = write!(tail, "\n{}", a.text(&outcome, "    ").trim_end());
             a
         });
-        let mut valid = true;
         let mut json = serde_json::json!({
             "part": label,
             "report": crate::simplify::report_json(&report),
             "advice": advice,
         });
-        if !args.no_measure {
-            let weld = args.seams == super::SeamsArg::Weld;
-            let v = crate::check::compare_opts(mesh, &result, false, weld);
-            valid = v.is_valid();
+        let weld = args.seams == super::SeamsArg::Weld;
+        let v = crate::check::compare_opts(mesh, &result, false, weld);
+        let valid = v.is_valid();
+        let mut verdict = String::from(if valid { "valid" } else { "NOT valid" });
+        json["valid"] = serde_json::Value::Bool(valid);
+        json["defects"] =
+            serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
+        json["metro"] = serde_json::Value::Null;
+        if args.measure {
             let opts = crate::metro::MetroOptions {
                 samples_per_triangle: args.samples_per_triangle,
                 progress: false,
@@ -259,35 +280,29 @@ fn simplify_parts(
             };
             let m = crate::metro::metro(mesh, &result, &opts);
             let _ = write!(
-                line,
-                ", {}, Metro max {:.4} % mean {:.4} % of the diagonal",
-                if valid { "valid" } else { "NOT valid" },
-                m.hausdorff_pct,
-                m.symmetric_mean_pct
+                verdict,
+                ", Metro max {:.4} % mean {:.4} % of the diagonal",
+                m.hausdorff_pct, m.symmetric_mean_pct
             );
-            if !valid {
-                for d in &v.defects {
-                    let _ = write!(line, "\n    {d}");
-                }
-            }
-            json["valid"] = serde_json::Value::Bool(valid);
-            json["defects"] =
-                serde_json::json!(v.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>());
             json["metro"] = serde_json::to_value(&m)?;
-            if let Some(uvs) = uvs {
-                let _ = write!(
-                    line,
-                    "{}{}",
-                    uv_stretch(mesh, keyed.as_ref(), uvs, &result, &mut json),
-                    super::attributes::meshopt_reference(
-                        mesh,
-                        uvs,
-                        &result,
-                        &attributes,
-                        &mut json
-                    )
-                );
-            }
+        }
+        // One part: the verdict on a line of its own after the report and the advice; several:
+        // after the part's one-line head.
+        let mut line = if parts.len() == 1 {
+            format!("{head}{tail}\n  check                  {verdict}")
+        } else {
+            format!("{head}, {verdict}{tail}")
+        };
+        for d in v.describe_by_kind(3).lines() {
+            let _ = write!(line, "\n  {d}");
+        }
+        if let (true, Some(uvs)) = (args.measure, uvs) {
+            let _ = write!(
+                line,
+                "{}{}",
+                uv_stretch(mesh, keyed.as_ref(), uvs, &result, &mut json),
+                super::attributes::meshopt_reference(mesh, uvs, &result, &attributes, &mut json)
+            );
         }
         out.push(Part {
             library,
@@ -429,14 +444,15 @@ fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result
     let valid = parts.iter().all(|p| p.valid);
     // A part stopped short: clustering reaches the file's count (on positions only; it reads
     // no glTF).
-    let fallback =
-        (parts.iter().any(|p| p.short) && !crate::gltf::is_gltf_path(&args.input)).then(|| {
+    let fallback = (parts.iter().any(|p| p.short) && !crate::gltf::is_gltf_path(&args.input))
+        .then(|| {
             super::advice::fallbacks(
                 &args.input.display().to_string(),
                 &args.output.display().to_string(),
                 parts.iter().map(|p| p.target).sum(),
             )
-        });
+        })
+        .flatten();
     if args.json {
         let mut j = serde_json::json!({
             "input": args.input.display().to_string(),
@@ -456,6 +472,9 @@ fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result
         let mut text = head;
         for p in parts {
             let _ = writeln!(text, "{}", p.line);
+        }
+        if !args.measure {
+            let _ = writeln!(text, "  {}", super::NOT_MEASURED);
         }
         let _ = writeln!(text, "  {}", times.text());
         if let Some((alone, then)) = &fallback {
@@ -513,17 +532,43 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
     let done = simplify_parts(args, &parts, &normals)?;
     let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
     let t0 = Instant::now();
-    crate::io::gltf::save(&args.output, &file, &results)?;
+    let kept = if gltf_out(args) {
+        if args.format == Some(super::OutputFormat::Glb) {
+            // GLB whatever the name says.
+            let (glb, _) = crate::io::gltf::write(&file, &results, true, "")
+                .map_err(|e| anyhow!("{}: {e}", args.output.display()))?;
+            std::fs::write(&args.output, glb)
+                .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
+        } else {
+            crate::io::gltf::save(&args.output, &file, &results)?;
+        }
+        format!(
+            "glTF, {} triangle primitive(s), attributes {} kept per vertex",
+            parts.len(),
+            crate::io::gltf::attribute_summary(&file)
+        )
+    } else {
+        let format = crate::io::output_format(&args.output, args.mesh_format())?;
+        let written = crate::io::gltf::save_other(
+            &args.output,
+            format,
+            &file,
+            &results,
+            args.keep_numbering,
+        )?;
+        format!(
+            "glTF to {}, {} triangle primitive(s), {written} written per vertex",
+            format!("{format:?}").to_uppercase(),
+            parts.len()
+        )
+    };
     times.write = t0.elapsed();
     let tin: usize = parts.iter().map(|(_, m, _, _)| m.triangles.len()).sum();
     let tout: usize = results.iter().map(Vec::len).sum();
     let head = format!(
-        "simplify {} -> {} (glTF, {} triangle primitive(s), attributes {} kept per vertex): \
-         {tin} -> {tout} triangles\n",
+        "simplify {} -> {} ({kept}): {tin} -> {tout} triangles\n",
         args.input.display(),
         args.output.display(),
-        parts.len(),
-        crate::io::gltf::attribute_summary(&file)
     );
     finish(args, head, &done, times)
 }
