@@ -7,6 +7,7 @@ use crate::Error;
 
 /// Checks capacities, indices and the positions the triangles use, and measures their
 /// bounding box (the unit frame). Reads only.
+#[inline(never)]
 pub(super) fn validate<'p, I: Index>(
     positions: &'p [[f32; 3]],
     triangles: &[[I; 3]],
@@ -71,6 +72,7 @@ pub(super) fn validate<'p, I: Index>(
 /// Corner lists of the first `nt` triangles: `head[v]` the first triangle holding `v`,
 /// `next[t][k]` the next triangle holding `t`'s vertex in slot `k`. Each list runs from the
 /// highest triangle number down.
+#[inline(never)]
 pub(super) fn link<I: Index, L: Index>(
     triangles: &[[I; 3]],
     nt: usize,
@@ -95,6 +97,7 @@ pub(super) fn link<I: Index, L: Index>(
 /// repeated copy, or the back of a double-sided triangle) by writing it degenerate; returns
 /// how many. Highest first: a list walk from triangle `t` visits only lower numbers, which
 /// are not yet written.
+#[inline(never)]
 pub(super) fn dedupe<I: Index, L: Index>(
     triangles: &mut [[I; 3]],
     nt: usize,

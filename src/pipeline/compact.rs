@@ -6,6 +6,7 @@ use crate::index::Index;
 
 /// Moves the triangles of the first `nt` without a repeated index to the front, in order;
 /// returns how many there are and how many were dropped.
+#[inline(never)]
 pub(super) fn compact<I: Index>(triangles: &mut [[I; 3]], nt: usize) -> (usize, usize) {
     let mut w = 0;
     for r in 0..nt {
@@ -26,6 +27,7 @@ pub(super) fn compact<I: Index>(triangles: &mut [[I; 3]], nt: usize) -> (usize, 
 }
 
 /// Clears the pass's locks and marks.
+#[inline(never)]
 pub(super) fn unlock(flags: &mut [u8]) {
     for f in flags.iter_mut() {
         *f &= flag::KIND;

@@ -51,6 +51,7 @@ fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
 }
 
 /// Zeroes the quadrics and adds every triangle's plane at its vertices.
+#[inline(never)]
 pub(super) fn face_quadrics<I: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
@@ -70,6 +71,7 @@ pub(super) fn face_quadrics<I: Index>(
 }
 
 /// Adds the border edge quadrics: for each open edge `v → border_next[v]`.
+#[inline(never)]
 pub(super) fn border_quadrics<I: Index, L: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],

@@ -27,8 +27,9 @@ use crate::legality::Reject;
 use crate::math::{self, V3};
 use crate::quadric::{self, VertexQuadric};
 
-/// Below this a squared cross product has no direction.
-const TINY: f32 = 1e-30;
+/// Below this a squared cross product (in the unit frame) has no direction: a triangle of area
+/// 5e-10 of the bounding box's face. Survivors must be above it, so fold tests never underflow.
+const TINY: f32 = 1e-18;
 /// `|n|² / (Σ edge²)²` below this: a normal that rounding decides (zero area).
 const FLAT: f32 = 1e-8;
 /// meshoptimizer's flip limit, `cos ≈ 0.25` (about 75°), squared.
@@ -47,22 +48,53 @@ fn after(frame: &Frame<'_>, tr: [usize; 3], a: usize, pb: V3) -> [V3; 3] {
     tr.map(|v| if v == a { pb } else { frame.at(v) })
 }
 
-/// Whether two triangles sharing an edge fold onto each other (normals scaled by powers of
-/// two first, so that no product leaves f32's range); a normal without direction counts as
-/// folded (refused, never guessed).
+/// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
+/// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
+/// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
+/// frame.
 #[inline]
 fn folded(n1: V3, n2: V3) -> bool {
-    let (u, v) = (math::pow2_normalize(n1), math::pow2_normalize(n2));
-    let (u2, v2) = (math::dot(u, u), math::dot(v, v));
-    if !(u2 > 0.0 && v2 > 0.0) {
+    let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
+    if !(v2 > TINY) {
         return true;
     }
-    let d = math::dot(u, v);
+    let d = math::dot(n1, n2);
     d < 0.0 && d * d > FOLD2 * u2 * v2
+}
+
+// Rule switches, for showing that each rule matters (`PIPELINE_RULE_OFF=<name>` at build
+// time switches one off; a constant, so a normal build carries no trace of it).
+const RULE_AREA: &str = "area";
+const RULE_FLIP: &str = "flip";
+const RULE_LINK: &str = "link";
+const RULE_LONE: &str = "lone";
+const RULE_DUPLICATE: &str = "duplicate";
+const RULE_FOLD: &str = "fold";
+
+/// Whether rule `name` is on in this build.
+#[inline(always)]
+const fn on(name: &str) -> bool {
+    let off = match option_env!("PIPELINE_RULE_OFF") {
+        Some(s) => s.as_bytes(),
+        None => b"",
+    };
+    let name = name.as_bytes();
+    if off.len() != name.len() {
+        return true;
+    }
+    let mut i = 0;
+    while i < off.len() {
+        if off[i] != name[i] {
+            return true;
+        }
+        i += 1;
+    }
+    false
 }
 
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 pub(super) fn perform<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &mut [[I; 3]],
@@ -111,7 +143,21 @@ pub(super) fn perform<I: Index, L: Index>(
     done
 }
 
+/// A surviving triangle of a's fan: its number, its other vertices (after and before a) and
+/// its normal after the collapse.
+#[derive(Clone, Copy)]
+struct Survivor {
+    t: usize,
+    x: usize,
+    y: usize,
+    n: V3,
+}
+
+/// Fans with more survivors than this are not collapsed (counted as locked).
+const MAX_FAN: usize = 48;
+
 /// Every rule for `a → b` on the current mesh (module documentation, in that order).
+#[inline(never)]
 fn check<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
@@ -130,9 +176,17 @@ fn check<I: Index, L: Index>(
     if ka == flag::BORDER && kb != flag::BORDER {
         return Err(Reject::Boundary);
     }
-    // 1. The edge and the vertices opposite it: o1 in (a, b, o1), o2 in (a, o2, b).
-    let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
-    for (_, tr, k) in fan(tris, next, head, a) {
+    // 1 and 2. One walk of a's fan: the vertices opposite a-b (o1 in (a, b, o1), o2 in
+    // (a, o2, b)), and each survivor's flip and area.
+    let (pa, pb) = (frame.at(a), frame.at(b));
+    let mut fan_a = [Survivor {
+        t: NONE,
+        x: NONE,
+        y: NONE,
+        n: [0.0; 3],
+    }; MAX_FAN];
+    let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
+    for (t, tr, k) in fan(tris, next, head, a) {
         if dead(tr) {
             continue;
         }
@@ -141,11 +195,34 @@ fn check<I: Index, L: Index>(
         if x == b {
             o1 = y;
             n_ab += 1;
-        } else if y == b {
+            continue;
+        }
+        if y == b {
             o2 = x;
             n_ab += 1;
+            continue;
         }
+        let (px, py) = (frame.at(x), frame.at(y));
+        let n0 = normal([pa, px, py]);
+        let n1 = normal([pb, px, py]);
+        let abd = math::dot(n1, n1);
+        let (ex, ey, exy) = (math::sub(px, pb), math::sub(py, pb), math::sub(px, py));
+        let s = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
+        if const { on(RULE_AREA) } && !(abd > TINY && abd > FLAT * s * s) {
+            return Err(Reject::Sliver);
+        }
+        let ndp = math::dot(n0, n1);
+        let abc = math::dot(n0, n0);
+        if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
+            return Err(Reject::NormalTurn);
+        }
+        match fan_a.get_mut(ns) {
+            Some(slot) => *slot = Survivor { t, x, y, n: n1 },
+            None => return Err(Reject::Locked),
+        }
+        ns += 1;
     }
+    let fan_a = fan_a.get(..ns).unwrap_or(&[]);
     let want = if ka == flag::BORDER { 1 } else { 2 };
     if n_ab != want {
         return Err(if n_ab > 2 {
@@ -157,125 +234,100 @@ fn check<I: Index, L: Index>(
         });
     }
 
-    // 2. Flip and zero area, on a's surviving triangles.
-    let (pa, pb) = (frame.at(a), frame.at(b));
-    for (_, tr, k) in fan(tris, next, head, a) {
-        let (x, y) = others(tr, k);
-        if dead(tr) || x == b || y == b {
-            continue;
-        }
-        let (px, py) = (frame.at(x), frame.at(y));
-        let n0 = normal([pa, px, py]);
-        let n1 = normal([pb, px, py]);
-        let abd = math::dot(n1, n1);
-        let (ex, ey, exy) = (math::sub(px, pb), math::sub(py, pb), math::sub(px, py));
-        let s = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
-        if !(abd > TINY && abd > FLAT * s * s) {
-            return Err(Reject::Sliver);
-        }
-        let ndp = math::dot(n0, n1);
-        let abc = math::dot(n0, n0);
-        if ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd {
-            return Err(Reject::NormalTurn);
-        }
-    }
-
     // 3. Link condition by marks; duplicates; b's triangles across b-o1 and b-o2.
-    for (_, tr, k) in fan(tris, next, head, a) {
-        if !dead(tr) {
-            let (x, y) = others(tr, k);
-            mark(flags, x, true);
-            mark(flags, y, true);
-        }
+    for s in fan_a {
+        mark(flags, s.x, true);
+        mark(flags, s.y, true);
     }
     let mut verdict = Ok(());
     let (mut nb, mut on_o1, mut on_o2, mut opposite) = (0, 0, 0, false);
-    for (_, tr, k) in fan(tris, next, head, b) {
+    let (mut across1, mut across2) = (NONE, NONE);
+    for (t, tr, k) in fan(tris, next, head, b) {
         if dead(tr) {
             continue;
         }
         nb += 1;
         let (x, y) = others(tr, k);
-        for w in [x, y] {
-            if w != a && w != o1 && w != o2 && flags_of(flags, w) & flag::MARK != 0 {
-                verdict = Err(Reject::Link);
-            }
-        }
         if x == a || y == a {
             continue;
         }
-        on_o1 += usize::from(x == o1 || y == o1);
-        on_o2 += usize::from(x == o2 || y == o2);
+        for w in [x, y] {
+            if const { on(RULE_LINK) } && w != o1 && w != o2 && flags_of(flags, w) & flag::MARK != 0 {
+                verdict = Err(Reject::Link);
+            }
+        }
+        if x == o1 || y == o1 {
+            on_o1 += 1;
+            across1 = t;
+        }
+        if x == o2 || y == o2 {
+            on_o2 += 1;
+            across2 = t;
+        }
         opposite |= (x == o1 && y == o2) || (x == o2 && y == o1);
     }
-    for (_, tr, k) in fan(tris, next, head, a) {
-        if !dead(tr) {
-            let (x, y) = others(tr, k);
-            mark(flags, x, false);
-            mark(flags, y, false);
-        }
+    for s in fan_a {
+        mark(flags, s.x, false);
+        mark(flags, s.y, false);
     }
     verdict?;
     if on_o1 > 1 || on_o2 > 1 {
         // b's edge to o1 or o2 is non-manifold (b locked).
         return Err(Reject::Locked);
     }
-    if na == 1 && nb == 1 {
+    if const { on(RULE_LONE) } && na == 1 && nb == 1 {
         // A lone triangle would vanish (a component, a boundary loop).
         return Err(Reject::Boundary);
     }
-    if opposite
-        && fan(tris, next, head, a).any(|(_, tr, k)| {
-            let (x, y) = others(tr, k);
-            !dead(tr) && ((x == o1 && y == o2) || (x == o2 && y == o1))
-        })
+    if const { on(RULE_DUPLICATE) }
+        && opposite
+        && fan_a
+            .iter()
+            .any(|s| (s.x == o1 && s.y == o2) || (s.x == o2 && s.y == o1))
     {
         return Err(Reject::Duplicate);
     }
+    if !const { on(RULE_FOLD) } {
+        return Ok(());
+    }
 
     // 4. Folds: each survivor against its neighbours after the collapse.
-    for (t, tr, k) in fan(tris, next, head, a) {
-        let (x, y) = others(tr, k);
-        if dead(tr) || x == b || y == b {
-            continue;
+    let unchanged = |t: usize| normal(tri(tris, t).map(|v| frame.at(v)));
+    for s in fan_a {
+        // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
+        // the one on a-o1 dies; across the spoke to o2 likewise.
+        match fan_a.iter().find(|u| u.y == s.x) {
+            Some(u) => {
+                if folded(s.n, u.n) {
+                    return Err(Reject::Fold);
+                }
+            }
+            None if s.x == o1 && across1 != NONE => {
+                if folded(s.n, unchanged(across1)) {
+                    return Err(Reject::Fold);
+                }
+            }
+            None => {}
         }
-        let n1 = normal([pb, frame.at(x), frame.at(y)]);
-        // Across the spoke to x (and to y when its partner dies): a's other triangle on it,
-        // or b's when the one on a-x dies.
-        for w in [x, y] {
-            if w == y && w != o1 && w != o2 {
-                continue;
-            }
-            for (u, s, _) in fan(tris, next, head, a) {
-                if u != t && !dead(s) && slot(s, w).is_some() && slot(s, b).is_none() {
-                    if folded(n1, normal(after(frame, s, a, pb))) {
-                        return Err(Reject::Fold);
-                    }
-                }
-            }
-            if w == o1 || w == o2 {
-                for (_, s, _) in fan(tris, next, head, b) {
-                    if !dead(s) && slot(s, w).is_some() && slot(s, a).is_none() {
-                        if folded(n1, normal(after(frame, s, a, pb))) {
-                            return Err(Reject::Fold);
-                        }
-                    }
-                }
-            }
+        if s.y == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
+            return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched from an end whose list is current.
-        let from = if flags_of(flags, x) & flag::PASS == 0 {
-            x
-        } else if flags_of(flags, y) & flag::PASS == 0 {
-            y
+        let (from, other) = if flags_of(flags, s.x) & flag::PASS == 0 {
+            (s.x, s.y)
+        } else if flags_of(flags, s.y) & flag::PASS == 0 {
+            (s.y, s.x)
         } else {
             return Err(Reject::Fold);
         };
-        let other = if from == x { y } else { x };
-        for (u, s, _) in fan(tris, next, head, from) {
-            if u != t && !dead(s) && slot(s, other).is_some() {
-                if folded(n1, normal(after(frame, s, a, pb))) {
+        let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
+        for (u, tr, _) in fan(tris, next, head, from) {
+            if u != s.t && !dead(tr) && slot(tr, other).is_some() {
+                if folded(s.n, normal(after(frame, tr, a, pb))) {
                     return Err(Reject::Fold);
+                }
+                if manifold {
+                    break;
                 }
             }
         }
@@ -296,6 +348,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 
 /// `a → b`: a's corners rewritten to b, a's quadric added to b's, border successors kept,
 /// both ends locked for the pass. Returns the triangles that died.
+#[inline(never)]
 fn collapse<I: Index, L: Index>(
     tris: &mut [[I; 3]],
     (head, next): (&[L], &[[L; 3]]),

@@ -6,20 +6,21 @@
 
 use super::{flag, flags_of, link, set_link, tri, Frame};
 use crate::index::Index;
+use crate::math::V3;
 use crate::quadric::{self, VertexQuadric};
 
-/// Offers `a → b` at its price, keeping the cheaper (ties: the lower target).
+/// Offers `a → b` (b at `pb`) at its price, keeping the cheaper (ties: the lower target).
 #[inline]
 fn offer<L: Index>(
-    frame: &Frame<'_>,
     quadrics: &[VertexQuadric],
     target: &mut [L],
     cost: &mut [f32],
     a: usize,
     b: usize,
+    pb: V3,
 ) {
     let Some(q) = quadrics.get(a) else { return };
-    let e = quadric::error(q, frame.at(b));
+    let e = quadric::error(q, pb);
     let Some(c) = cost.get_mut(a) else { return };
     if e < *c || (e == *c && b < link(target, a)) {
         *c = e;
@@ -28,6 +29,7 @@ fn offer<L: Index>(
 }
 
 /// Prices every allowed collapse of the live triangles' edges.
+#[inline(never)]
 pub(super) fn pick<I: Index, L: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
@@ -43,23 +45,29 @@ pub(super) fn pick<I: Index, L: Index>(
     }
     for t in 0..triangles.len() {
         let tr = tri(triangles, t);
-        for e in 0..3 {
-            let (i0, i1) = match e {
-                0 => (tr[0], tr[1]),
-                1 => (tr[1], tr[2]),
-                _ => (tr[2], tr[0]),
+        let k = tr.map(|v| flags_of(flags, v) & flag::KIND);
+        if k == [flag::LOCKED; 3] {
+            continue;
+        }
+        let p = tr.map(|v| frame.at(v));
+        for (e0, e1) in [(0, 1), (1, 2), (2, 0)] {
+            let (Some(&i0), Some(&i1), Some(&k0), Some(&k1), Some(&p0), Some(&p1)) = (
+                tr.get(e0),
+                tr.get(e1),
+                k.get(e0),
+                k.get(e1),
+                p.get(e0),
+                p.get(e1),
+            ) else {
+                continue;
             };
-            let k0 = flags_of(flags, i0) & flag::KIND;
             if k0 == flag::MANIFOLD {
                 // The other direction comes from the triangle across.
-                offer(frame, quadrics, target, cost, i0, i1);
-            } else if k0 == flag::BORDER
-                && flags_of(flags, i1) & flag::KIND == flag::BORDER
-                && link(border_next, i0) == i1
-            {
+                offer(quadrics, target, cost, i0, i1, p1);
+            } else if k0 == flag::BORDER && k1 == flag::BORDER && link(border_next, i0) == i1 {
                 // An open edge has no triangle across: both directions here.
-                offer(frame, quadrics, target, cost, i0, i1);
-                offer(frame, quadrics, target, cost, i1, i0);
+                offer(quadrics, target, cost, i0, i1, p1);
+                offer(quadrics, target, cost, i1, i0, p0);
             }
         }
     }

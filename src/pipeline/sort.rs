@@ -21,6 +21,7 @@ pub(super) fn key(cost: f32) -> usize {
 }
 
 /// Writes the vertices with a candidate into `order` by cost; returns how many.
+#[inline(never)]
 pub(super) fn sort<L: Index>(
     target: &[L],
     cost: &[f32],
