@@ -6,7 +6,8 @@
 use super::{fan, flag, link, others, set_link, NONE};
 use crate::index::Index;
 
-/// Writes every vertex's kind and border successor; returns the number of locked vertices.
+/// Writes every vertex's kind and border successor; returns the number of locked vertices. `scratch`: two links per vertex,
+/// contents on entry and exit meaningless.
 #[inline(never)]
 pub(super) fn classify<I: Index, L: Index>(
     triangles: &[[I; 3]],
@@ -15,8 +16,12 @@ pub(super) fn classify<I: Index, L: Index>(
     next: &[[L; 3]],
     flags: &mut [u8],
     border_next: &mut [L],
+    (counts, across): (&mut [L], &mut [L]),
 ) -> usize {
     let tris = triangles.get(..nt).unwrap_or(&[]);
+    for c in counts.iter_mut() {
+        *c = L::ZERO;
+    }
     let mut locked = 0;
     for (v, f) in flags.iter_mut().enumerate() {
         set_link(border_next, v, NONE);
@@ -25,11 +30,14 @@ pub(super) fn classify<I: Index, L: Index>(
             continue;
         }
         // The fan as (after, before) pairs; a larger fan is locked.
-        let mut pairs = [(NONE, NONE); MAX_FAN];
+        let mut pairs = [(0u32, 0u32); MAX_FAN];
         let mut count = 0usize;
         for (_, tr, k) in fan(tris, next, head, v) {
             match pairs.get_mut(count) {
-                Some(p) => *p = others(tr, k),
+                Some(p) => {
+                    let (x, y) = others(tr, k);
+                    *p = (x as u32, y as u32);
+                }
                 None => {
                     count = MAX_FAN + 1;
                     break;
@@ -37,11 +45,11 @@ pub(super) fn classify<I: Index, L: Index>(
             }
             count += 1;
         }
-        let kind = match pairs.get(..count) {
-            Some(pairs) => kind_of(pairs),
-            None => flag::LOCKED,
+        let (kind, end) = match pairs.get(..count) {
+            Some(pairs) => kind_of(pairs, counts, across),
+            None => (flag::LOCKED, NONE),
         };
-        if let (flag::BORDER, Some(end)) = (kind, pairs.get(..count).and_then(open_end)) {
+        if kind == flag::BORDER {
             set_link(border_next, v, end);
         }
         if kind == flag::LOCKED {
@@ -53,57 +61,73 @@ pub(super) fn classify<I: Index, L: Index>(
 }
 
 /// Fans larger than this are locked.
-const MAX_FAN: usize = 64;
+const MAX_FAN: usize = 32;
 
-/// The kind of a vertex from its fan's (after, before) pairs.
-fn kind_of(pairs: &[(usize, usize)]) -> u8 {
-    let (mut open_out, mut open_in, mut start) = (0, 0, 0);
+/// Per neighbour in `counts`: triangles with it after v (low byte) and before v (times 256).
+const IN: usize = 256;
+
+#[inline]
+fn bump<L: Index>(s: &mut [L], v: usize, by: usize) {
+    if let Some(c) = s.get_mut(v) {
+        *c = L::narrow(c.to_usize() + by);
+    }
+}
+
+/// The kind of a vertex from its fan's (after, before) pairs, and for a border vertex the
+/// vertex across its open out-edge. Linear: each neighbour's counts of triangles with it after
+/// and before v in `counts`, and in `across` the pair with it before v (left zero / stale).
+fn kind_of<L: Index>(pairs: &[(u32, u32)], counts: &mut [L], across: &mut [L]) -> (u8, usize) {
     for (i, &(x, y)) in pairs.iter().enumerate() {
-        // How many triangles have x after v, x before v, y before, y after.
-        let (mut x_out, mut x_in, mut y_in, mut y_out) = (0, 0, 0, 0);
-        for &(a, b) in pairs {
-            x_out += usize::from(a == x);
-            x_in += usize::from(b == x);
-            y_in += usize::from(b == y);
-            y_out += usize::from(a == y);
+        let (x, y) = (x as usize, y as usize);
+        bump(counts, x, 1);
+        bump(counts, y, IN);
+        set_link(across, y, i);
+    }
+    let (mut open_out, mut open_in, mut start, mut end, mut bad) = (0, 0, 0, NONE, false);
+    for (i, &(x, y)) in pairs.iter().enumerate() {
+        let (x, y) = (x as usize, y as usize);
+        let (cx, cy) = (link(counts, x), link(counts, y));
+        // x: once after v, at most once before; y: once before, at most once after.
+        if cx % IN != 1 || cx / IN > 1 || cy / IN != 1 || cy % IN > 1 {
+            bad = true;
         }
-        if x_out != 1 || y_in != 1 || x_in > 1 || y_out > 1 {
-            return flag::LOCKED;
+        if cx / IN == 0 {
+            open_out += 1;
+            end = x;
         }
-        open_out += usize::from(x_in == 0);
-        if y_out == 0 {
+        if cy % IN == 0 {
             open_in += 1;
             start = i;
         }
     }
-    if open_out != open_in || open_out > 1 {
-        return flag::LOCKED;
-    }
-    // One fan? Walk it across its spokes from the open end (or anywhere): the triangle
-    // across spoke v-x has x before v.
-    let mut cur = start;
     let mut steps = 0usize;
-    while steps <= pairs.len() {
-        steps += 1;
-        let Some(&(x, _)) = pairs.get(cur) else { break };
-        match pairs.iter().position(|&(_, y)| y == x) {
-            Some(j) if j != start => cur = j,
-            _ => break,
+    if !bad && open_out == open_in && open_out <= 1 {
+        // One fan? Walk it across its spokes from the open end (or anywhere): the triangle
+        // across spoke v-x has x before v.
+        let mut cur = start;
+        while steps <= pairs.len() {
+            steps += 1;
+            let Some(&(x, _)) = pairs.get(cur) else { break };
+            let x = x as usize;
+            if link(counts, x) / IN == 0 {
+                break;
+            }
+            let j = link(across, x);
+            if j == start {
+                break;
+            }
+            cur = j;
         }
     }
-    if steps != pairs.len() {
-        flag::LOCKED
-    } else if open_out == 1 {
-        flag::BORDER
-    } else {
-        flag::MANIFOLD
+    for &(x, y) in pairs {
+        set_link(counts, x as usize, 0);
+        set_link(counts, y as usize, 0);
     }
-}
-
-/// The vertex across the open out-edge of a border fan.
-fn open_end(pairs: &[(usize, usize)]) -> Option<usize> {
-    pairs
-        .iter()
-        .find(|&&(x, _)| !pairs.iter().any(|&(_, y)| y == x))
-        .map(|&(x, _)| x)
+    if bad || open_out != open_in || open_out > 1 || steps != pairs.len() {
+        (flag::LOCKED, NONE)
+    } else if open_out == 1 {
+        (flag::BORDER, end)
+    } else {
+        (flag::MANIFOLD, NONE)
+    }
 }

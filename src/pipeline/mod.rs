@@ -336,7 +336,15 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         let valid = nt;
 
         // classify
-        let locked = classify::classify(triangles, nt, head, next, flags, border_next);
+        let locked = classify::classify(
+            triangles,
+            nt,
+            head,
+            next,
+            flags,
+            border_next,
+            (&mut *target, &mut *order),
+        );
 
         // fill
         fill::face_quadrics(&frame, triangles, nt, quadrics);
@@ -355,7 +363,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             }
             let tris = triangles.get(..nt).unwrap_or(&[]);
             pick::pick(&frame, tris, flags, border_next, quadrics, target, cost);
-            let m = sort::sort(target, cost, order, histogram);
+            let m = sort::sort(flags, target, cost, order, histogram);
             if m == 0 {
                 break Stop::NoLegalCollapse;
             }

@@ -147,14 +147,29 @@ pub(super) fn perform<I: Index, L: Index>(
 /// its normal after the collapse.
 #[derive(Clone, Copy)]
 struct Survivor {
-    t: usize,
-    x: usize,
-    y: usize,
+    t: u32,
+    x: u32,
+    y: u32,
     n: V3,
 }
 
+impl Survivor {
+    #[inline]
+    fn t(&self) -> usize {
+        self.t as usize
+    }
+    #[inline]
+    fn x(&self) -> usize {
+        self.x as usize
+    }
+    #[inline]
+    fn y(&self) -> usize {
+        self.y as usize
+    }
+}
+
 /// Fans with more survivors than this are not collapsed (counted as locked).
-const MAX_FAN: usize = 48;
+const MAX_FAN: usize = 32;
 
 /// Every rule for `a → b` on the current mesh (module documentation, in that order).
 #[inline(never)]
@@ -180,9 +195,9 @@ fn check<I: Index, L: Index>(
     // (a, o2, b)), and each survivor's flip and area.
     let (pa, pb) = (frame.at(a), frame.at(b));
     let mut fan_a = [Survivor {
-        t: NONE,
-        x: NONE,
-        y: NONE,
+        t: 0,
+        x: 0,
+        y: 0,
         n: [0.0; 3],
     }; MAX_FAN];
     let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
@@ -217,7 +232,14 @@ fn check<I: Index, L: Index>(
             return Err(Reject::NormalTurn);
         }
         match fan_a.get_mut(ns) {
-            Some(slot) => *slot = Survivor { t, x, y, n: n1 },
+            Some(slot) => {
+                *slot = Survivor {
+                    t: t as u32,
+                    x: x as u32,
+                    y: y as u32,
+                    n: n1,
+                }
+            }
             None => return Err(Reject::Locked),
         }
         ns += 1;
@@ -236,8 +258,8 @@ fn check<I: Index, L: Index>(
 
     // 3. Link condition by marks; duplicates; b's triangles across b-o1 and b-o2.
     for s in fan_a {
-        mark(flags, s.x, true);
-        mark(flags, s.y, true);
+        mark(flags, s.x(), true);
+        mark(flags, s.y(), true);
     }
     let mut verdict = Ok(());
     let (mut nb, mut on_o1, mut on_o2, mut opposite) = (0, 0, 0, false);
@@ -267,8 +289,8 @@ fn check<I: Index, L: Index>(
         opposite |= (x == o1 && y == o2) || (x == o2 && y == o1);
     }
     for s in fan_a {
-        mark(flags, s.x, false);
-        mark(flags, s.y, false);
+        mark(flags, s.x(), false);
+        mark(flags, s.y(), false);
     }
     verdict?;
     if on_o1 > 1 || on_o2 > 1 {
@@ -283,7 +305,7 @@ fn check<I: Index, L: Index>(
         && opposite
         && fan_a
             .iter()
-            .any(|s| (s.x == o1 && s.y == o2) || (s.x == o2 && s.y == o1))
+            .any(|s| (s.x() == o1 && s.y() == o2) || (s.x() == o2 && s.y() == o1))
     {
         return Err(Reject::Duplicate);
     }
@@ -302,27 +324,27 @@ fn check<I: Index, L: Index>(
                     return Err(Reject::Fold);
                 }
             }
-            None if s.x == o1 && across1 != NONE => {
+            None if s.x() == o1 && across1 != NONE => {
                 if folded(s.n, unchanged(across1)) {
                     return Err(Reject::Fold);
                 }
             }
             None => {}
         }
-        if s.y == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
+        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
             return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched from an end whose list is current.
-        let (from, other) = if flags_of(flags, s.x) & flag::PASS == 0 {
-            (s.x, s.y)
-        } else if flags_of(flags, s.y) & flag::PASS == 0 {
-            (s.y, s.x)
+        let (from, other) = if flags_of(flags, s.x()) & flag::PASS == 0 {
+            (s.x(), s.y())
+        } else if flags_of(flags, s.y()) & flag::PASS == 0 {
+            (s.y(), s.x())
         } else {
             return Err(Reject::Fold);
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
         for (u, tr, _) in fan(tris, next, head, from) {
-            if u != s.t && !dead(tr) && slot(tr, other).is_some() {
+            if u != s.t() && !dead(tr) && slot(tr, other).is_some() {
                 if folded(s.n, normal(after(frame, tr, a, pb))) {
                     return Err(Reject::Fold);
                 }

@@ -2,7 +2,7 @@
 //! (meshoptimizer's `sortEdgeCollapses`: 8 bits of exponent and 4 of mantissa), stable, so
 //! equal keys stay in vertex order.
 
-use super::{link, BINS, NONE};
+use super::{flag, link, BINS, NONE};
 use crate::index::Index;
 
 /// `2⁻⁴⁸`'s 12-bit key: costs below it share bin 0.
@@ -20,9 +20,11 @@ pub(super) fn key(cost: f32) -> usize {
     }
 }
 
-/// Writes the vertices with a candidate into `order` by cost; returns how many.
+/// Writes the vertices with a candidate (and still there) into `order` by cost; returns how
+/// many.
 #[inline(never)]
 pub(super) fn sort<L: Index>(
+    flags: &[u8],
     target: &[L],
     cost: &[f32],
     order: &mut [L],
@@ -33,7 +35,7 @@ pub(super) fn sort<L: Index>(
     }
     let mut m = 0usize;
     for (v, c) in cost.iter().enumerate() {
-        if link(target, v) == NONE {
+        if link(target, v) == NONE || flags.get(v).is_none_or(|f| f & flag::KIND == flag::GONE) {
             continue;
         }
         if let Some(h) = histogram.get_mut(key(*c)) {
@@ -48,7 +50,7 @@ pub(super) fn sort<L: Index>(
         sum += n;
     }
     for (v, c) in cost.iter().enumerate() {
-        if link(target, v) == NONE {
+        if link(target, v) == NONE || flags.get(v).is_none_or(|f| f & flag::KIND == flag::GONE) {
             continue;
         }
         if let Some(h) = histogram.get_mut(key(*c)) {
