@@ -66,7 +66,10 @@ fn every_fixture_at_50_25_10_percent_is_valid() {
             }
             // On clean meshes the topology was compared (Euler characteristic, loops).
             if v.topology_compared {
-                assert!(v.euler_unchanged() && v.boundary_loops_unchanged(), "{name}");
+                assert!(
+                    v.euler_unchanged() && v.boundary_loops_unchanged(),
+                    "{name}"
+                );
             }
         }
     }
@@ -114,7 +117,10 @@ fn two_runs_give_the_same_bytes() {
         .simplify(&m.positions, &mut tris, &Config::new().with_ratio(0.1))
         .unwrap();
     tris.truncate(r.triangles_out);
-    assert_eq!(tris, a.triangles, "u16 links, another workspace: same bytes");
+    assert_eq!(
+        tris, a.triangles,
+        "u16 links, another workspace: same bytes"
+    );
 }
 
 #[test]
@@ -187,11 +193,68 @@ fn bytes_per_triangle_with_u16_links() {
     // The cow: 2 903 vertices, 5 804 triangles.
     type Cow = FastWorkspace<u16, 2903, 5804>;
     let per = Cow::BYTES as f64 / 5804.0;
-    eprintln!("FastWorkspace<u16, 2903, 5804>::BYTES = {} ({per:.2} B per triangle)", Cow::BYTES);
+    eprintln!(
+        "FastWorkspace<u16, 2903, 5804>::BYTES = {} ({per:.2} B per triangle)",
+        Cow::BYTES
+    );
     assert!(per <= 36.0, "{per}");
     // Without the fixed histogram, V = T/2.
     type Half = FastWorkspace<u16, 32_000, 64_000>;
     let per = Half::BYTES as f64 / 64_000.0;
-    eprintln!("FastWorkspace<u16, 32000, 64000>::BYTES = {} ({per:.2} B per triangle)", Half::BYTES);
+    eprintln!(
+        "FastWorkspace<u16, 32000, 64000>::BYTES = {} ({per:.2} B per triangle)",
+        Half::BYTES
+    );
     assert!(per <= 36.0, "{per}");
+}
+
+#[test]
+fn small_closed_meshes_keep_their_topology() {
+    // A tetrahedron: every collapse would turn a's last triangle into a copy of one of b's,
+    // turned over (the link condition passes: the common neighbours are the two opposite
+    // vertices); the duplicate rule refuses it, and so does the fold rule (a copy turned over
+    // faces the other way). An octahedron and an icosahedron towards nothing.
+    let tetra = MeshData {
+        positions: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    };
+    let octa = MeshData {
+        positions: vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ],
+        triangles: vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+    };
+    for (what, m) in [
+        ("tetrahedron", tetra),
+        ("octahedron", octa),
+        ("icosahedron", icosphere(0)),
+    ] {
+        let (out, r) = run(&m, 0.0);
+        let v = verdict(&m, &out);
+        eprintln!(
+            "{what}: {} -> {} {:?}",
+            r.triangles_in, r.triangles_out, r.stop
+        );
+        assert!(v.is_valid(), "{what}: {r:?}\n{}", v.describe(10));
+        assert_eq!(r.stop, Stop::NoLegalCollapse, "{what}");
+    }
 }

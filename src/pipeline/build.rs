@@ -130,4 +130,3 @@ pub(super) fn dedupe<I: Index, L: Index>(
     }
     count
 }
-

@@ -55,11 +55,10 @@ fn after(frame: &Frame<'_>, tr: [usize; 3], a: usize, pb: V3) -> [V3; 3] {
 #[inline]
 fn folded(n1: V3, n2: V3) -> bool {
     let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
-    if !(v2 > TINY) {
-        return true;
-    }
+    // Written so that NaN refuses too.
+    let directed = v2 > TINY;
     let d = math::dot(n1, n2);
-    d < 0.0 && d * d > FOLD2 * u2 * v2
+    !directed || (d < 0.0 && d * d > FOLD2 * u2 * v2)
 }
 
 // Rule switches, for showing that each rule matters (`PIPELINE_RULE_OFF=<name>` at build
@@ -70,10 +69,12 @@ const RULE_LINK: &str = "link";
 const RULE_LONE: &str = "lone";
 const RULE_DUPLICATE: &str = "duplicate";
 const RULE_FOLD: &str = "fold";
+const RULE_BORDER: &str = "border";
+const RULE_LOCKED: &str = "locked";
 
 /// Whether rule `name` is on in this build.
 #[inline(always)]
-const fn on(name: &str) -> bool {
+pub(super) const fn on(name: &str) -> bool {
     let off = match option_env!("PIPELINE_RULE_OFF") {
         Some(s) => s.as_bytes(),
         None => b"",
@@ -185,10 +186,10 @@ fn check<I: Index, L: Index>(
         flags_of(flags, a) & flag::KIND,
         flags_of(flags, b) & flag::KIND,
     );
-    if ka == flag::LOCKED || ka == flag::GONE || kb == flag::GONE {
+    if (const { on(RULE_LOCKED) } && ka == flag::LOCKED) || ka == flag::GONE || kb == flag::GONE {
         return Err(Reject::Locked);
     }
-    if ka == flag::BORDER && kb != flag::BORDER {
+    if const { on(RULE_BORDER) } && ka == flag::BORDER && kb != flag::BORDER {
         return Err(Reject::Boundary);
     }
     // 1 and 2. One walk of a's fan: the vertices opposite a-b (o1 in (a, b, o1), o2 in
@@ -246,6 +247,11 @@ fn check<I: Index, L: Index>(
     }
     let fan_a = fan_a.get(..ns).unwrap_or(&[]);
     let want = if ka == flag::BORDER { 1 } else { 2 };
+    let want = if const { on(RULE_BORDER) } {
+        want
+    } else {
+        n_ab.clamp(1, 2)
+    };
     if n_ab != want {
         return Err(if n_ab > 2 {
             Reject::Locked
@@ -274,7 +280,8 @@ fn check<I: Index, L: Index>(
             continue;
         }
         for w in [x, y] {
-            if const { on(RULE_LINK) } && w != o1 && w != o2 && flags_of(flags, w) & flag::MARK != 0 {
+            if const { on(RULE_LINK) } && w != o1 && w != o2 && flags_of(flags, w) & flag::MARK != 0
+            {
                 verdict = Err(Reject::Link);
             }
         }
@@ -318,18 +325,13 @@ fn check<I: Index, L: Index>(
     for s in fan_a {
         // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
         // the one on a-o1 dies; across the spoke to o2 likewise.
-        match fan_a.iter().find(|u| u.y == s.x) {
-            Some(u) => {
-                if folded(s.n, u.n) {
-                    return Err(Reject::Fold);
-                }
-            }
-            None if s.x() == o1 && across1 != NONE => {
-                if folded(s.n, unchanged(across1)) {
-                    return Err(Reject::Fold);
-                }
-            }
-            None => {}
+        let spoke = match fan_a.iter().find(|u| u.y == s.x) {
+            Some(u) => folded(s.n, u.n),
+            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1)),
+            None => false,
+        };
+        if spoke {
+            return Err(Reject::Fold);
         }
         if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
             return Err(Reject::Fold);
@@ -387,7 +389,8 @@ fn collapse<I: Index, L: Index>(
             let mut p = NONE;
             for (_, tr, k) in fan(tris, next, head, a) {
                 let (_, y) = others(tr, k);
-                if !dead(tr) && !fan(tris, next, head, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
+                if !dead(tr)
+                    && !fan(tris, next, head, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
                 {
                     p = y;
                 }

@@ -61,7 +61,12 @@ pub(super) fn pick<I: Index, L: Index>(
             ) else {
                 continue;
             };
-            if k0 == flag::MANIFOLD {
+            let free = |k: u8| {
+                k == flag::MANIFOLD
+                    || (!const { super::perform::on("border") } && k == flag::BORDER)
+                    || (!const { super::perform::on("locked") } && k == flag::LOCKED)
+            };
+            if free(k0) {
                 // The other direction comes from the triangle across.
                 offer(quadrics, target, cost, i0, i1, p1);
             } else if k0 == flag::BORDER && k1 == flag::BORDER && link(border_next, i0) == i1 {
