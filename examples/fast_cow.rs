@@ -62,7 +62,10 @@ fn main() {
         r.triangles_in, r.triangles_out, r.collapses, r.passes, r.stop
     );
     // `FAST_COW_REPS=n`: the best of n more runs (host time).
-    if let Some(n) = std::env::var("FAST_COW_REPS").ok().and_then(|n| n.parse::<u32>().ok()) {
+    if let Some(n) = std::env::var("FAST_COW_REPS")
+        .ok()
+        .and_then(|n| n.parse::<u32>().ok())
+    {
         let mut best = dt;
         for _ in 0..n {
             let mut t = input.clone();

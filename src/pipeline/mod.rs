@@ -35,6 +35,13 @@
 //! along their border edge and a lone triangle is never collapsed away, so the Euler
 //! characteristic, the boundary loops and the components are kept.
 
+//! Prototype status (measured on x86-64, `examples/fast_cow.rs`): the cow to 10 % takes
+//! 25.2 M instructions for the library call (callgrind), 9.7 k per collapse, against 12.5 M
+//! for `meshopt::simplify` 0.7.0 on the same input; check 41 %, pick 21 %, classify 11 %. Metro
+//! mean error at the same count: geometric mean 0.89x meshoptimizer over 8 shared meshes at
+//! 50/25/10 % (Hausdorff 1.22x). Fans over 32 triangles are locked (classify) or not
+//! collapsed (check).
+
 mod build;
 mod classify;
 mod compact;
