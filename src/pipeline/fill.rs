@@ -1,5 +1,5 @@
 //! fill: per-vertex quadrics, once (meshoptimizer's `fillFaceQuadrics` and
-//! `fillEdgeQuadrics`): each triangle's plane quadric (Garland and Heckbert 1997) with
+//! `fillEdgeQuadrics`): each triangle's plane quadric (Garland's, Cheng, Pan and Shi 1998 §2.3 eq. 3) with
 //! meshoptimizer's `sqrt(area)` weight, added at its three vertices; and for each border edge
 //! a plane through the edge perpendicular to its triangle, weighted by the edge's length
 //! times 10, plus the triangle's plane at the same weight, added at both ends, so that

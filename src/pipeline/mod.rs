@@ -2,9 +2,9 @@
 //! memory, with every output valid.
 //!
 //! The pipeline follows `meshopt_simplifyEdge` of Arseny Kapoulkine's meshoptimizer
-//! (`src/simplifier.cpp`): per-vertex plane quadrics accumulated once (Garland and Heckbert
-//! 1997, "Surface Simplification Using Quadric Error Metrics": the fundamental error quadric
-//! `K_p = p pᵀ` of each triangle's plane, summed at its vertices and added on collapse), then
+//! (`src/simplifier.cpp`): per-vertex plane quadrics accumulated once (Garland's quadric
+//! error metric as Cheng, Pan and Shi 1998 use it, §2.3: the quadric `K_p = p pᵀ` of each
+//! triangle's plane, eq. 3, summed at its vertices and added on collapse; see `crate::quadric`), then
 //! passes that price every candidate once from the quadrics, order them by a counting sort on
 //! the top bits of the float cost, and collapse in that order while locking both ends of each
 //! collapse for the rest of the pass; a pass ends at its error goal (1.5 times the cost of the
