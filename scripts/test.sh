@@ -28,6 +28,8 @@ command -v defmt-print >/dev/null || cargo install defmt-print --locked
 
 echo "== host tests"
 cargo test --workspace --release
+# The fast mode (feature `fast`, a prototype): every fixture at 50/25/10 %, valid.
+cargo test --release --features fast --test pipeline
 
 echo "== golden outputs on the host (libm, micromath)"
 cargo run -q -p host-sim --release -- golden --check --backend libm

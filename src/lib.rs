@@ -102,6 +102,8 @@ mod mesh;
 #[cfg(feature = "seams")]
 pub mod model;
 pub mod operator;
+#[cfg(feature = "fast")]
+pub mod pipeline;
 mod policy;
 pub mod progressive;
 mod quadric;

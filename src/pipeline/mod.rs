@@ -1,0 +1,421 @@
+//! Fast mode (engine v4 prototype): meshoptimizer's edge-collapse pipeline in fixed caller
+//! memory, with every output valid.
+//!
+//! The pipeline follows `meshopt_simplifyEdge` of Arseny Kapoulkine's meshoptimizer
+//! (`src/simplifier.cpp`): per-vertex plane quadrics accumulated once (Garland's quadric
+//! error metric as Cheng, Pan and Shi 1998 use it, §2.3: the quadric `K_p = p pᵀ` of each
+//! triangle's plane, eq. 3, summed at its vertices and added on collapse; see `crate::quadric`), then
+//! passes that price every candidate once from the quadrics, order them by a counting sort on
+//! the top bits of the float cost, and collapse in that order while locking both ends of each
+//! collapse for the rest of the pass; a pass ends at its error goal (1.5 times the cost of the
+//! collapse that would reach the pass's goal, as meshoptimizer), the quadrics of collapsed
+//! pairs are merged and the triangle buffer compacted, and the next pass runs on the smaller
+//! mesh. Placement is the subset one of Lin 2007 §2 (a vertex collapses onto an existing
+//! vertex), so the positions are only read and may stay in flash.
+//!
+//! ```text
+//! build     validate, drop degenerate and duplicate triangles, corner lists
+//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex
+//! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics
+//! loop {
+//!   pick      each vertex's cheapest collapse its kind allows, from its quadric
+//!   sort      counting sort on the cost's top 12 bits
+//!   perform   in order, to the pass's error goal: skip locked ends, check, collapse, lock both
+//!   compact   drop dead triangles, rebuild the corner lists
+//! }
+//! ```
+//!
+//! Differences from meshoptimizer, each for a promise this crate makes: a vertex keeps one
+//! candidate (its cheapest allowed collapse) instead of one per edge, so the sort buffer is one
+//! link per vertex; quadrics are 10 floats without meshoptimizer's weight (so a cost is the
+//! weighted sum of squared distances, not its mean); the checks are not only its flip test
+//! (`hasTriangleFlips`, on unnormalised cross products, no square root) but also the link
+//! condition by marks (Cheng, Pan and Shi 1998 §3.2(1)), no duplicate triangle, no fold
+//! across any edge of a changed triangle, no zero-area triangle; border vertices only slide
+//! along their border edge and a lone triangle is never collapsed away, so the Euler
+//! characteristic, the boundary loops and the components are kept.
+//!
+//! A prototype: neither the crate's default nor the CLI's yet. Not in it: welded seams, parts,
+//! the error limit (a finite one is refused: costs are not normalised), the error bound and
+//! `step(budget)`. A vertex with more than 32 triangles is locked, and a collapse whose moving
+//! vertex would keep more is refused, so the checks run on fixed fan buffers.
+//! `examples/fast_cow.rs` runs it on one mesh, for callgrind and timing.
+
+mod build;
+mod classify;
+mod compact;
+mod fill;
+mod perform;
+mod pick;
+mod sort;
+
+use crate::error::Capacity;
+use crate::index::Index;
+use crate::math::V3;
+use crate::quadric::VertexQuadric;
+use crate::report::{Rejections, Report, Stop};
+use crate::{Config, ConfigField, Error};
+
+/// Bins of the counting sort (12 bits of the cost: 8 of exponent, 4 of mantissa, from 2⁻⁴⁸).
+pub(crate) const BINS: usize = 1024;
+
+/// "No vertex" / "no triangle" as `usize`.
+pub(crate) const NONE: usize = usize::MAX;
+
+/// Per-vertex flag bits.
+pub(crate) mod flag {
+    /// Kind bits.
+    pub const KIND: u8 = 3;
+    /// An interior vertex whose triangles form one disk.
+    pub const MANIFOLD: u8 = 0;
+    /// A vertex whose triangles form one open fan: slides along its border edges only.
+    pub const BORDER: u8 = 1;
+    /// Non-manifold, pinched or inconsistently wound: never moves (others may move onto it).
+    pub const LOCKED: u8 = 2;
+    /// No triangle (unused or collapsed away).
+    pub const GONE: u8 = 3;
+    /// An end of a collapse in this pass.
+    pub const PASS: u8 = 4;
+    /// Scratch mark (the link condition).
+    pub const MARK: u8 = 8;
+}
+
+/// The fast mode's working memory, sized at compile time (it can be a `static`).
+///
+/// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
+/// * `V`, `T`: the largest mesh it takes (vertices, triangles).
+///
+/// Per vertex: a quadric (10 `f32`, 40 B), four links (corner-list head, border successor,
+/// candidate target, sort slot), a candidate cost (`f32`) and a flag byte; per triangle three
+/// corner links; plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
+/// `V ≈ T/2` that is about 32.5 bytes per triangle ([`FastWorkspace::BYTES`]).
+pub struct FastWorkspace<L: Index, const V: usize, const T: usize> {
+    quadrics: [VertexQuadric; V],
+    head: [L; V],
+    border_next: [L; V],
+    target: [L; V],
+    cost: [f32; V],
+    order: [L; V],
+    flags: [u8; V],
+    next: [[L; 3]; T],
+    histogram: [L; BINS],
+}
+
+impl<L: Index, const V: usize, const T: usize> Default for FastWorkspace<L, V, T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A run's state that every step reads: the positions in the unit frame.
+#[derive(Clone, Copy)]
+pub(crate) struct Frame<'p> {
+    positions: &'p [[f32; 3]],
+    min: V3,
+    scale: f32,
+}
+
+impl Frame<'_> {
+    /// Position of `v`, translated by the bounding box's corner and scaled by a power of two
+    /// to an extent in `[1, 2)` (meshoptimizer's `rescalePositions`).
+    #[inline]
+    pub(crate) fn at(&self, v: usize) -> V3 {
+        let p = self.positions.get(v).copied().unwrap_or([0.0; 3]);
+        [
+            (p[0] - self.min[0]) * self.scale,
+            (p[1] - self.min[1]) * self.scale,
+            (p[2] - self.min[2]) * self.scale,
+        ]
+    }
+}
+
+/// Triangle `t` as `usize` indices (`NONE` if out of range).
+#[inline]
+pub(crate) fn tri<I: Index>(tris: &[[I; 3]], t: usize) -> [usize; 3] {
+    match tris.get(t) {
+        Some(x) => [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()],
+        None => [NONE; 3],
+    }
+}
+
+/// Whether a triangle has a repeated index (collapsed away in this pass).
+#[inline]
+pub(crate) fn dead(tr: [usize; 3]) -> bool {
+    tr[0] == tr[1] || tr[1] == tr[2] || tr[0] == tr[2]
+}
+
+/// The slot of `v` in `tr`.
+#[inline]
+pub(crate) fn slot(tr: [usize; 3], v: usize) -> Option<usize> {
+    if tr[0] == v {
+        Some(0)
+    } else if tr[1] == v {
+        Some(1)
+    } else if tr[2] == v {
+        Some(2)
+    } else {
+        None
+    }
+}
+
+/// The vertices after and before slot `k` in winding order.
+#[inline]
+pub(crate) fn others(tr: [usize; 3], k: usize) -> (usize, usize) {
+    match k {
+        0 => (tr[1], tr[2]),
+        1 => (tr[2], tr[0]),
+        _ => (tr[0], tr[1]),
+    }
+}
+
+/// Link `i` of `s` as `usize` (`NONE` for NIL or out of range).
+#[inline]
+pub(crate) fn link<L: Index>(s: &[L], i: usize) -> usize {
+    match s.get(i) {
+        Some(&l) if l != L::NIL => l.to_usize(),
+        _ => NONE,
+    }
+}
+
+/// Sets link `i` of `s` (NIL for `NONE`).
+#[inline]
+pub(crate) fn set_link<L: Index>(s: &mut [L], i: usize, v: usize) {
+    if let Some(x) = s.get_mut(i) {
+        *x = if v == NONE { L::NIL } else { L::narrow(v) };
+    }
+}
+
+/// Flag byte of `v` (`GONE` if out of range).
+#[inline]
+pub(crate) fn flags_of(f: &[u8], v: usize) -> u8 {
+    f.get(v).copied().unwrap_or(flag::GONE)
+}
+
+/// The triangles around one vertex: its corner list, one corner per triangle that holds it.
+pub(crate) struct Fan<'m, L: Index, I: Index> {
+    tris: &'m [[I; 3]],
+    next: &'m [[L; 3]],
+    v: usize,
+    t: usize,
+    guard: usize,
+}
+
+impl<L: Index, I: Index> Iterator for Fan<'_, L, I> {
+    /// Triangle, its vertices, the slot of the vertex.
+    type Item = (usize, [usize; 3], usize);
+
+    #[inline]
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.guard == 0 {
+            return None;
+        }
+        self.guard -= 1;
+        let t = self.t;
+        let tr = tri(self.tris, t);
+        let k = slot(tr, self.v)?;
+        self.t = match self.next.get(t).and_then(|n| n.get(k)) {
+            Some(&l) if l != L::NIL => l.to_usize(),
+            _ => NONE,
+        };
+        Some((t, tr, k))
+    }
+}
+
+/// The fan of `v`, from its list head.
+#[inline]
+pub(crate) fn fan<'m, L: Index, I: Index>(
+    tris: &'m [[I; 3]],
+    next: &'m [[L; 3]],
+    head: &[L],
+    v: usize,
+) -> Fan<'m, L, I> {
+    Fan {
+        tris,
+        next,
+        v,
+        t: link(head, v),
+        guard: tris.len(),
+    }
+}
+
+/// What one pass or one run counted.
+#[derive(Default)]
+pub(crate) struct Stats {
+    pub(crate) collapses: usize,
+    pub(crate) rejected: Rejections,
+}
+
+impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
+    /// Size of the workspace in bytes: all of the fast mode's RAM apart from the caller's
+    /// triangle buffer, positions and a bounded stack frame.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// Bins of the counting sort's histogram.
+    pub const BINS: usize = BINS;
+
+    /// An empty workspace; `const` and all zero bits, so a `static` goes to `.bss`.
+    pub const fn new() -> Self {
+        FastWorkspace {
+            quadrics: [[0.0; 10]; V],
+            head: [L::ZERO; V],
+            border_next: [L::ZERO; V],
+            target: [L::ZERO; V],
+            cost: [0.0; V],
+            order: [L::ZERO; V],
+            flags: [0; V],
+            next: [[L::ZERO; 3]; T],
+            histogram: [L::ZERO; BINS],
+        }
+    }
+
+    /// Simplifies `triangles` in place towards [`Config::target`], with read-only `positions`.
+    ///
+    /// On success the first `report.triangles_out` entries of `triangles` hold the result,
+    /// every index an input vertex; the rest of the buffer is meaningless. Of the [`Config`]
+    /// only `target` and `max_passes` are used (the whole configuration is validated); a
+    /// finite `error_limit` is refused ([`ConfigField::ErrorLimit`]): the costs here are
+    /// weighted sums of squared distances, not distances.
+    ///
+    /// Errors, all returned before the triangle buffer is touched: [`Error::InvalidConfig`],
+    /// [`Error::Capacity`], [`Error::IndexOutOfRange`], [`Error::NonFinitePosition`].
+    pub fn simplify<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        config.validate()?;
+        if config.error_limit.is_finite() {
+            return Err(Error::InvalidConfig {
+                field: ConfigField::ErrorLimit,
+            });
+        }
+        let (cv, ct) = (V.min(L::COUNT), T.min(L::COUNT));
+        let frame = build::validate(positions, triangles, cv, ct)?;
+        let nv = positions.len();
+        let short = Error::Capacity {
+            what: Capacity::Vertices,
+            needed: nv,
+            available: cv,
+        };
+        let FastWorkspace {
+            quadrics,
+            head,
+            border_next,
+            target,
+            cost,
+            order,
+            flags,
+            next,
+            histogram,
+        } = self;
+        let (
+            Some(quadrics),
+            Some(head),
+            Some(border_next),
+            Some(target),
+            Some(cost),
+            Some(order),
+            Some(flags),
+        ) = (
+            quadrics.get_mut(..nv),
+            head.get_mut(..nv),
+            border_next.get_mut(..nv),
+            target.get_mut(..nv),
+            cost.get_mut(..nv),
+            order.get_mut(..nv),
+            flags.get_mut(..nv),
+        )
+        else {
+            return Err(short);
+        };
+        let triangles_in = triangles.len();
+
+        // build
+        let (mut nt, degenerate) = compact::compact(triangles, triangles_in);
+        build::link(triangles, nt, head, next);
+        let duplicates = build::dedupe(triangles, nt, next);
+        if duplicates > 0 {
+            nt = compact::compact(triangles, nt).0;
+            build::link(triangles, nt, head, next);
+        }
+        let valid = nt;
+
+        // classify
+        let locked = classify::classify(
+            triangles,
+            nt,
+            head,
+            next,
+            flags,
+            border_next,
+            (&mut *target, &mut *order),
+        );
+
+        // fill
+        fill::face_quadrics(&frame, triangles, nt, quadrics);
+        fill::border_quadrics(&frame, triangles, nt, flags, border_next, quadrics);
+
+        let target_triangles = config.target.triangles(valid);
+        let mut stats = Stats::default();
+        let mut passes = 0u32;
+        let mut pass_triangles = heapless::Vec::new();
+        let stop = loop {
+            if nt <= target_triangles {
+                break Stop::Target;
+            }
+            if passes >= config.max_passes {
+                break Stop::MaxPasses;
+            }
+            let tris = triangles.get(..nt).unwrap_or(&[]);
+            pick::pick(&frame, tris, flags, border_next, quadrics, target, cost);
+            let m = sort::sort(flags, target, cost, order, histogram);
+            if m == 0 {
+                break Stop::NoLegalCollapse;
+            }
+            let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
+            let goal = nt - target_triangles;
+            let done = perform::perform(
+                &frame,
+                tris,
+                (&*head, &*next),
+                flags,
+                border_next,
+                quadrics,
+                (&*target, &*cost, order.get(..m).unwrap_or(&[])),
+                goal,
+                &mut stats,
+            );
+            passes += 1;
+            nt = compact::compact(triangles, nt).0;
+            build::link(triangles, nt, head, next);
+            compact::unlock(flags);
+            let _ = pass_triangles.push(nt as u32);
+            if done == 0 {
+                break Stop::NoLegalCollapse;
+            }
+        };
+        Ok(Report {
+            triangles_in,
+            degenerate_dropped: degenerate,
+            duplicates_dropped: duplicates,
+            twins: 0,
+            triangles_out: nt,
+            target_triangles,
+            target_reached: nt <= target_triangles,
+            stop,
+            collapses: stats.collapses,
+            vertices_removed: stats.collapses,
+            parts_removed: 0,
+            locked_vertices: locked,
+            feature_vertices: 0,
+            passes,
+            pass_triangles,
+            rejected: stats.rejected,
+            over_limit: 0,
+            collapse_error: 0.0,
+            max_error: None,
+            mean_error: None,
+        })
+    }
+}

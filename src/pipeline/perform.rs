@@ -1,0 +1,435 @@
+//! perform: the pass's collapses in cost order (meshoptimizer's `performEdgeCollapses`).
+//!
+//! A candidate is skipped when either end is already an end of a collapse in this pass (so a
+//! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
+//! at its goal or at its error goal: 1.5 times the cost of the candidate that would reach the
+//! goal, once a sixth of the goal is done. Each candidate is checked on the current mesh, the
+//! rules in order of cost, each where it can fire:
+//!
+//! 1. the edge: two triangles on a-b (one for a border vertex: its border edge);
+//! 2. meshoptimizer's flip test (`hasTriangleFlip`) on each surviving triangle of a's fan:
+//!    unnormalised normals before and after, refused when they turn by 75° or more (no square
+//!    root: the dot product's sign and its square); and zero area (a cross product that
+//!    rounding decides);
+//! 3. the link condition by marks: a's neighbours marked, b's walked; a common neighbour
+//!    other than the vertices opposite a-b would pinch the surface or add a non-manifold edge;
+//!    no duplicate triangle (a's triangle on both opposite vertices against b's); a lone
+//!    triangle is never collapsed away;
+//! 4. no fold: each surviving triangle against its neighbours across its three edges after
+//!    the collapse (unit normals' dot below -0.9, as the shared checker).
+//!
+//! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
+//! degenerate: compact drops them), adds a's quadric to b's, and locks both ends.
+
+use super::{dead, fan, flag, flags_of, link, others, set_link, slot, tri, Frame, Stats, NONE};
+use crate::index::Index;
+use crate::legality::Reject;
+use crate::math::{self, V3};
+use crate::quadric::{self, VertexQuadric};
+
+/// Below this a squared cross product (in the unit frame) has no direction: a triangle of area
+/// 5e-10 of the bounding box's face. Survivors must be above it, so fold tests never underflow.
+const TINY: f32 = 1e-18;
+/// `|n|² / (Σ edge²)²` below this: a normal that rounding decides (zero area).
+const FLAT: f32 = 1e-8;
+/// meshoptimizer's flip limit, `cos ≈ 0.25` (about 75°), squared.
+const FLIP2: f32 = 0.0625;
+/// The checker's fold limit, `-0.9`, squared.
+const FOLD2: f32 = 0.81;
+
+#[inline]
+fn normal(p: [V3; 3]) -> V3 {
+    math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
+}
+
+/// The positions of `tr` after `a` moves onto `b` (at `pb`).
+#[inline]
+fn after(frame: &Frame<'_>, tr: [usize; 3], a: usize, pb: V3) -> [V3; 3] {
+    tr.map(|v| if v == a { pb } else { frame.at(v) })
+}
+
+/// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
+/// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
+/// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
+/// frame.
+#[inline]
+fn folded(n1: V3, n2: V3) -> bool {
+    let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
+    // Written so that NaN refuses too.
+    let directed = v2 > TINY;
+    let d = math::dot(n1, n2);
+    !directed || (d < 0.0 && d * d > FOLD2 * u2 * v2)
+}
+
+// Rule switches, for showing that each rule matters (`PIPELINE_RULE_OFF=<name>` at build
+// time switches one off; a constant, so a normal build carries no trace of it).
+const RULE_AREA: &str = "area";
+const RULE_FLIP: &str = "flip";
+const RULE_LINK: &str = "link";
+const RULE_LONE: &str = "lone";
+const RULE_DUPLICATE: &str = "duplicate";
+const RULE_FOLD: &str = "fold";
+const RULE_BORDER: &str = "border";
+const RULE_LOCKED: &str = "locked";
+
+/// Whether rule `name` is on in this build.
+#[inline(always)]
+pub(super) const fn on(name: &str) -> bool {
+    let off = match option_env!("PIPELINE_RULE_OFF") {
+        Some(s) => s.as_bytes(),
+        None => b"",
+    };
+    let name = name.as_bytes();
+    if off.len() != name.len() {
+        return true;
+    }
+    let mut i = 0;
+    while i < off.len() {
+        if off[i] != name[i] {
+            return true;
+        }
+        i += 1;
+    }
+    false
+}
+
+/// Runs one pass over `order`; returns the collapses made.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+pub(super) fn perform<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    tris: &mut [[I; 3]],
+    (head, next): (&[L], &[[L; 3]]),
+    flags: &mut [u8],
+    border_next: &mut [L],
+    quadrics: &mut [VertexQuadric],
+    (target, cost, order): (&[L], &[f32], &[L]),
+    goal: usize,
+    stats: &mut Stats,
+) -> usize {
+    let m = order.len();
+    let cost_of = |v: usize| cost.get(v).copied().unwrap_or(f32::INFINITY);
+    let mut edge_goal = goal / 2;
+    let (mut removed, mut done, mut worst) = (0usize, 0usize, 0.0f32);
+    for i in 0..m {
+        if removed >= goal {
+            break;
+        }
+        let a = link(order, i);
+        let c = cost_of(a);
+        let error_goal = if edge_goal < m {
+            1.5 * cost_of(link(order, edge_goal))
+        } else {
+            f32::INFINITY
+        };
+        if c > error_goal && c > worst && removed > goal / 6 {
+            break;
+        }
+        let b = link(target, a);
+        if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
+            continue;
+        }
+        if let Err(r) = check(frame, tris, (head, next), flags, a, b) {
+            stats.rejected.count(r);
+            edge_goal += 1;
+            continue;
+        }
+        removed += collapse(tris, (head, next), flags, border_next, quadrics, a, b);
+        done += 1;
+        if c > worst {
+            worst = c;
+        }
+    }
+    stats.collapses += done;
+    done
+}
+
+/// A surviving triangle of a's fan: its number, its other vertices (after and before a) and
+/// its normal after the collapse.
+#[derive(Clone, Copy)]
+struct Survivor {
+    t: u32,
+    x: u32,
+    y: u32,
+    n: V3,
+}
+
+impl Survivor {
+    #[inline]
+    fn t(&self) -> usize {
+        self.t as usize
+    }
+    #[inline]
+    fn x(&self) -> usize {
+        self.x as usize
+    }
+    #[inline]
+    fn y(&self) -> usize {
+        self.y as usize
+    }
+}
+
+/// Fans with more survivors than this are not collapsed (counted as locked).
+const MAX_FAN: usize = 32;
+
+/// Every rule for `a → b` on the current mesh (module documentation, in that order).
+#[inline(never)]
+fn check<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    tris: &[[I; 3]],
+    (head, next): (&[L], &[[L; 3]]),
+    flags: &mut [u8],
+    a: usize,
+    b: usize,
+) -> Result<(), Reject> {
+    let (ka, kb) = (
+        flags_of(flags, a) & flag::KIND,
+        flags_of(flags, b) & flag::KIND,
+    );
+    if (const { on(RULE_LOCKED) } && ka == flag::LOCKED) || ka == flag::GONE || kb == flag::GONE {
+        return Err(Reject::Locked);
+    }
+    if const { on(RULE_BORDER) } && ka == flag::BORDER && kb != flag::BORDER {
+        return Err(Reject::Boundary);
+    }
+    // 1 and 2. One walk of a's fan: the vertices opposite a-b (o1 in (a, b, o1), o2 in
+    // (a, o2, b)), and each survivor's flip and area.
+    let (pa, pb) = (frame.at(a), frame.at(b));
+    let mut fan_a = [Survivor {
+        t: 0,
+        x: 0,
+        y: 0,
+        n: [0.0; 3],
+    }; MAX_FAN];
+    let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
+    for (t, tr, k) in fan(tris, next, head, a) {
+        if dead(tr) {
+            continue;
+        }
+        na += 1;
+        let (x, y) = others(tr, k);
+        if x == b {
+            o1 = y;
+            n_ab += 1;
+            continue;
+        }
+        if y == b {
+            o2 = x;
+            n_ab += 1;
+            continue;
+        }
+        let (px, py) = (frame.at(x), frame.at(y));
+        let n0 = normal([pa, px, py]);
+        let n1 = normal([pb, px, py]);
+        let abd = math::dot(n1, n1);
+        let (ex, ey, exy) = (math::sub(px, pb), math::sub(py, pb), math::sub(px, py));
+        let s = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
+        if const { on(RULE_AREA) } && !(abd > TINY && abd > FLAT * s * s) {
+            return Err(Reject::Sliver);
+        }
+        let ndp = math::dot(n0, n1);
+        let abc = math::dot(n0, n0);
+        if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
+            return Err(Reject::NormalTurn);
+        }
+        match fan_a.get_mut(ns) {
+            Some(slot) => {
+                *slot = Survivor {
+                    t: t as u32,
+                    x: x as u32,
+                    y: y as u32,
+                    n: n1,
+                }
+            }
+            None => return Err(Reject::Locked),
+        }
+        ns += 1;
+    }
+    let fan_a = fan_a.get(..ns).unwrap_or(&[]);
+    let want = if ka == flag::BORDER { 1 } else { 2 };
+    let want = if const { on(RULE_BORDER) } {
+        want
+    } else {
+        n_ab.clamp(1, 2)
+    };
+    if n_ab != want {
+        return Err(if n_ab > 2 {
+            Reject::Locked
+        } else if ka == flag::BORDER {
+            Reject::Boundary
+        } else {
+            Reject::Link
+        });
+    }
+
+    // 3. Link condition by marks; duplicates; b's triangles across b-o1 and b-o2.
+    for s in fan_a {
+        mark(flags, s.x(), true);
+        mark(flags, s.y(), true);
+    }
+    let mut verdict = Ok(());
+    let (mut nb, mut on_o1, mut on_o2, mut opposite) = (0, 0, 0, false);
+    let (mut across1, mut across2) = (NONE, NONE);
+    for (t, tr, k) in fan(tris, next, head, b) {
+        if dead(tr) {
+            continue;
+        }
+        nb += 1;
+        let (x, y) = others(tr, k);
+        if x == a || y == a {
+            continue;
+        }
+        for w in [x, y] {
+            if const { on(RULE_LINK) } && w != o1 && w != o2 && flags_of(flags, w) & flag::MARK != 0
+            {
+                verdict = Err(Reject::Link);
+            }
+        }
+        if x == o1 || y == o1 {
+            on_o1 += 1;
+            across1 = t;
+        }
+        if x == o2 || y == o2 {
+            on_o2 += 1;
+            across2 = t;
+        }
+        opposite |= (x == o1 && y == o2) || (x == o2 && y == o1);
+    }
+    for s in fan_a {
+        mark(flags, s.x(), false);
+        mark(flags, s.y(), false);
+    }
+    verdict?;
+    if on_o1 > 1 || on_o2 > 1 {
+        // b's edge to o1 or o2 is non-manifold (b locked).
+        return Err(Reject::Locked);
+    }
+    if const { on(RULE_LONE) } && na == 1 && nb == 1 {
+        // A lone triangle would vanish (a component, a boundary loop).
+        return Err(Reject::Boundary);
+    }
+    if const { on(RULE_DUPLICATE) }
+        && opposite
+        && fan_a
+            .iter()
+            .any(|s| (s.x() == o1 && s.y() == o2) || (s.x() == o2 && s.y() == o1))
+    {
+        return Err(Reject::Duplicate);
+    }
+    if !const { on(RULE_FOLD) } {
+        return Ok(());
+    }
+
+    // 4. Folds: each survivor against its neighbours after the collapse.
+    let unchanged = |t: usize| normal(tri(tris, t).map(|v| frame.at(v)));
+    for s in fan_a {
+        // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
+        // the one on a-o1 dies; across the spoke to o2 likewise.
+        let spoke = match fan_a.iter().find(|u| u.y == s.x) {
+            Some(u) => folded(s.n, u.n),
+            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1)),
+            None => false,
+        };
+        if spoke {
+            return Err(Reject::Fold);
+        }
+        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
+            return Err(Reject::Fold);
+        }
+        // Across the outer edge x-y: searched from an end whose list is current.
+        let (from, other) = if flags_of(flags, s.x()) & flag::PASS == 0 {
+            (s.x(), s.y())
+        } else if flags_of(flags, s.y()) & flag::PASS == 0 {
+            (s.y(), s.x())
+        } else {
+            return Err(Reject::Fold);
+        };
+        let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
+        for (u, tr, _) in fan(tris, next, head, from) {
+            if u != s.t() && !dead(tr) && slot(tr, other).is_some() {
+                if folded(s.n, normal(after(frame, tr, a, pb))) {
+                    return Err(Reject::Fold);
+                }
+                if manifold {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[inline]
+fn mark(flags: &mut [u8], v: usize, on: bool) {
+    if let Some(f) = flags.get_mut(v) {
+        if on {
+            *f |= flag::MARK;
+        } else {
+            *f &= !flag::MARK;
+        }
+    }
+}
+
+/// `a → b`: a's corners rewritten to b, a's quadric added to b's, border successors kept,
+/// both ends locked for the pass. Returns the triangles that died.
+#[inline(never)]
+fn collapse<I: Index, L: Index>(
+    tris: &mut [[I; 3]],
+    (head, next): (&[L], &[[L; 3]]),
+    flags: &mut [u8],
+    border_next: &mut [L],
+    quadrics: &mut [VertexQuadric],
+    a: usize,
+    b: usize,
+) -> usize {
+    if flags_of(flags, a) & flag::KIND == flag::BORDER {
+        if link(border_next, a) == b {
+            // ... p → a → b ...: p's open edge now ends at b. p is the neighbour before a
+            // that no triangle of a has after it.
+            let mut p = NONE;
+            for (_, tr, k) in fan(tris, next, head, a) {
+                let (_, y) = others(tr, k);
+                if !dead(tr)
+                    && !fan(tris, next, head, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
+                {
+                    p = y;
+                }
+            }
+            if flags_of(flags, p) & flag::KIND == flag::BORDER {
+                set_link(border_next, p, b);
+            }
+        } else {
+            // ... b → a → q ...: b's open edge now ends at q.
+            let q = link(border_next, a);
+            set_link(border_next, b, q);
+        }
+    }
+    let mut dying = 0;
+    let mut t = link(head, a);
+    let mut guard = tris.len();
+    let nb = I::narrow(b);
+    while t != NONE && guard > 0 {
+        guard -= 1;
+        let tr = tri(tris, t);
+        let Some(k) = slot(tr, a) else { break };
+        if !dead(tr) && slot(tr, b).is_some() {
+            dying += 1;
+        }
+        if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
+            *c = nb;
+        }
+        t = next.get(t).map_or(NONE, |n| link(n, k));
+    }
+    if let Some(&qa) = quadrics.get(a) {
+        if let Some(q) = quadrics.get_mut(b) {
+            *q = quadric::add(q, &qa);
+        }
+    }
+    if let Some(f) = flags.get_mut(a) {
+        *f = flag::GONE | flag::PASS;
+    }
+    if let Some(f) = flags.get_mut(b) {
+        *f |= flag::PASS;
+    }
+    dying
+}
