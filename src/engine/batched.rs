@@ -86,22 +86,15 @@ impl Pass {
 /// A pass aims at no more than `live / PASS_SHARE` collapses (about half the live triangles
 /// for 4), however far the target is: meshoptimizer aims each pass at the target, but with the
 /// memoryless cost a pass that aims far ends up collapsing past prices that its locked vertices
-/// would have undercut. Over the shared meshes (`host-sim bench --modes default,batched`) the
-/// geometric mean of the Metro mean ratios to the greedy order falls from 1.008 (no cap) to
-/// 0.980, the worst row from 1.199x to 1.136x and the rows worse by more than 2 % from 15 to 9,
-/// for 5 % more instructions on the cow (13 passes instead of 12); 8 gives 0.980, 1.079x and 8
-/// rows for 13 % more, with up to 26 passes at 10 %.
+/// would have undercut. The choice and its measurement: docs/speed.md, batched schedule.
 #[cfg(feature = "batched")]
 const PASS_SHARE: usize = 4;
 
 #[cfg(feature = "batched")]
 /// The pass's limit over the price of the candidate that would reach the pass's goal.
 /// meshoptimizer takes 1.5 (`1.5f * edge_collapses[collapse_order[edge_collapse_goal]].error`);
-/// with the memoryless cost 1.0 gives a lower mean error against the greedy order over the
-/// shared meshes (measured before [`PASS_SHARE`], `host-sim bench --modes default,batched`:
-/// geometric mean of the Metro mean ratios 1.008 against 1.039, 1.028 at 1.2, 1.061 at 2.0)
-/// for the same instructions (the cow to 10 %: 12 passes against 10, 73.6 M against 72.6 M in
-/// the engine, a build without LTO).
+/// with the memoryless cost 1.0 gives a lower mean error for the same instructions
+/// (docs/speed.md, batched schedule).
 const PASS_LIMIT: f32 = 1.0;
 
 #[cfg(feature = "batched")]
