@@ -579,16 +579,7 @@ fn texture_coordinates(
     file: &crate::io::gltf::GltfFile,
     p: &crate::io::gltf::Primitive,
 ) -> Option<Vec<[f32; 2]>> {
-    let material = &file.json["meshes"][p.mesh]["primitives"][p.index]["material"];
-    let n = material
-        .as_u64()
-        .and_then(|m| {
-            file.json["materials"][m as usize]["pbrMetallicRoughness"]["baseColorTexture"]
-                ["texCoord"]
-                .as_u64()
-        })
-        .unwrap_or(0);
-    let name = format!("TEXCOORD_{n}");
+    let name = crate::io::objattr::gltf_texcoord_name(file, p)?;
     let stream = p.attributes.iter().find(|s| s.semantic == name)?;
     (0..p.positions.len())
         .map(|i| crate::texrender::uv_of(stream, i).map(|uv| uv.map(|c| c as f32)))
