@@ -27,9 +27,9 @@ bash scripts/install-qemu.sh
 command -v defmt-print >/dev/null || cargo install defmt-print --locked
 
 echo "== host tests"
+# host-sim enables the library's `fast` feature, so the fast mode's tests (tests/pipeline.rs,
+# tests/error_limit.rs) run here too.
 cargo test --workspace --release
-# The fast mode (feature `fast`, a prototype): every fixture at 50/25/10 %, valid.
-cargo test --release --features fast --test pipeline
 
 echo "== golden outputs on the host (libm, micromath)"
 cargo run -q -p host-sim --release -- golden --check --backend libm

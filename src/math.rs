@@ -29,6 +29,16 @@ pub(crate) fn rsqrt(x: f32) -> f32 {
     }
 }
 
+/// `√x` for `x ≥ 0` through [`rsqrt`] (0 below [`TINY2`] or for non-finite `x`).
+#[inline]
+pub(crate) fn sqrt(x: f32) -> f32 {
+    if x > TINY2 && x.is_finite() {
+        x * rsqrt(x)
+    } else {
+        0.0
+    }
+}
+
 /// Cosine of an angle in degrees in `[0, 180]` (configuration only).
 pub(crate) fn cos_deg(deg: f32) -> f32 {
     let x = deg * (core::f32::consts::PI / 180.0);

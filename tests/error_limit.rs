@@ -161,3 +161,27 @@ fn diagonal(m: &MeshData) -> f32 {
     }
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>().sqrt()
 }
+
+/// The fast mode (`pipeline::FastWorkspace`) prices from its quadrics over their weights, the
+/// same mean squared distance as the stored quadric: the same promises on the spike.
+#[cfg(feature = "fast")]
+#[test]
+fn the_limit_holds_in_the_fast_mode() {
+    use tinydecimate::pipeline::FastWorkspace;
+    let (m, apex) = spike();
+    let fast = |config: &Config| {
+        let mut ws: Box<FastWorkspace<u16, 400, 600>> = Box::new(FastWorkspace::new());
+        let mut tris = m.triangles.clone();
+        let r = ws.simplify(&m.positions, &mut tris, config).expect("fast");
+        output(&m.positions, tris, r)
+    };
+    let config = Config::new().with_target(Target::Triangles(8));
+    let limit = 0.05;
+    let (_, r) = fast(&config);
+    assert_eq!(r.collapse_error, 0.0, "tracked only with a limit");
+    let (_, r) = fast(&config.with_error_limit(1e6));
+    assert_eq!(r.over_limit, 0);
+    assert!(r.collapse_error > 2.0 * limit, "{r:?}");
+    let (out, r) = fast(&config.with_error_limit(limit));
+    assert_limited("fast", &m, apex, &out, &r, limit);
+}

@@ -138,11 +138,14 @@ pub enum Method {
     /// tinydecimate, `Config::new().with_schedule(Schedule::Batched)`: the default's cost
     /// and rules in meshoptimizer's passes.
     Batched,
+    /// tinydecimate's fast mode, `pipeline::FastWorkspace` with `Config::new()`:
+    /// meshoptimizer's pipeline with every output valid (`host-sim simplify --engine fast`).
+    Fast,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 10] = [
+    pub const ALL: [Method; 11] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -153,6 +156,7 @@ impl Method {
         Method::VertexDecimation,
         Method::Energy,
         Method::Batched,
+        Method::Fast,
     ];
 
     /// The operator of our modes.
@@ -191,13 +195,16 @@ impl Method {
             Method::VertexDecimation => "vertex decimation",
             Method::Energy => "Hoppe's energy",
             Method::Batched => "batched quadric",
+            Method::Fast => "fast mode",
         }
     }
 
     /// The library configuration (before the ratio); `None` for meshoptimizer.
     pub fn config(self) -> Option<Config> {
         match self {
-            Method::Default | Method::VertexDecimation | Method::Energy => Some(Config::new()),
+            Method::Default | Method::VertexDecimation | Method::Energy | Method::Fast => {
+                Some(Config::new())
+            }
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
@@ -219,6 +226,7 @@ impl Method {
             Method::VertexDecimation => "`VertexDecimation::new()` with `Config::new()`",
             Method::Energy => "`Energy` (κ = 0.01) with `Config::new()`",
             Method::Batched => "`Config::new().with_schedule(Schedule::Batched)`",
+            Method::Fast => "`pipeline::FastWorkspace` with `Config::new()`",
         }
     }
 
@@ -597,6 +605,7 @@ fn run_method(
                     weld: true,
                     prune,
                     energy: (method == Method::Energy).then_some(tinydecimate::cost::Energy::KAPPA),
+                    fast: method == Method::Fast,
                     ..Default::default()
                 };
                 // The error limit measures a collapse or a removal (not a triangle collapse).
@@ -614,10 +623,14 @@ fn run_method(
                 };
                 // Vertex decimation runs without wedges and parts (`simplify_with`).
                 let edge = method.operator() == crate::simplify::OperatorArg::Edge;
-                let bytes = workspace_bytes(v, t).0
-                    + quadrics
-                    + if edge { wedge_bytes(mesh) } else { 0 }
-                    + part_bytes(v, &config, prune && edge);
+                let bytes = if method == Method::Fast {
+                    crate::simplify::fast_bytes(v, t)
+                } else {
+                    workspace_bytes(v, t).0
+                        + quadrics
+                        + if edge { wedge_bytes(mesh) } else { 0 }
+                        + part_bytes(v, &config, prune && edge)
+                };
                 (out, elapsed, bytes, Some(report))
             }
             (None, _) => {

@@ -2,6 +2,7 @@
 //! call) and [`simplify_with`] (stored quadrics, the error bound, a progress bar), and the
 //! report in words ([`format_report`]) and as JSON ([`report_json`]).
 
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
@@ -9,6 +10,7 @@ use tinydecimate::bound::Controls;
 use tinydecimate::cost::{
     AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
 };
+use tinydecimate::pipeline::FastWorkspace;
 use tinydecimate::{
     Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse, VertexDecimation,
 };
@@ -106,6 +108,10 @@ pub struct Run {
     /// Hoppe's energy with this κ (`tinydecimate::cost::Energy`, subset placement) instead of
     /// the configuration's built-in cost; one `Samples` per vertex.
     pub energy: Option<f32>,
+    /// The fast mode (`tinydecimate::pipeline::FastWorkspace`, [`simplify_fast`]) instead of
+    /// the exact engine: seams welded by position when `weld` (the output keeps the welded
+    /// numbering), no parts, wedges, bound or other cost.
+    pub fast: bool,
 }
 
 /// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
@@ -165,7 +171,22 @@ pub fn simplify_with_attributes(
         lock_seam_corners,
         prune,
         energy,
+        fast,
     } = *run;
+    if fast {
+        if attributes.is_some()
+            || energy.is_some()
+            || placement.is_some()
+            || bounded
+            || operator != OperatorArg::Edge
+        {
+            return Err(anyhow!(
+                "--engine fast runs its own edge collapse on stored quadrics: it takes no \
+                 --max-error, --quadric, --cost energy, --operator or attributes"
+            ));
+        }
+        return simplify_fast(mesh, config, weld);
+    }
     // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
     // its run is welded by position, and the output keeps the welded numbering.
     let removal = matches!(
@@ -359,6 +380,79 @@ pub fn simplify_with_attributes(
         report,
         elapsed,
     ))
+}
+
+/// The fast mode's workspaces: `u16` links below 65 535 vertices and triangles, `u32` links up
+/// to [`FAST_VERTICES`] and [`FAST_TRIANGLES`] (statics: zero pages until used).
+static FAST_SMALL: Mutex<FastWorkspace<u16, 65_535, 65_535>> = Mutex::new(FastWorkspace::new());
+static FAST_LARGE: Mutex<FastWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES>> =
+    Mutex::new(FastWorkspace::new());
+
+/// The largest mesh `--engine fast` takes, in vertices.
+pub const FAST_VERTICES: usize = 1 << 20;
+/// The largest mesh `--engine fast` takes, in triangles.
+pub const FAST_TRIANGLES: usize = 1 << 21;
+
+/// Runs the fast mode on `mesh` (seams welded by position first when `weld`): the library
+/// call `FastWorkspace::simplify` on a workspace of the smallest link type that fits. The wall
+/// time is that of the weld and the library call.
+pub fn simplify_fast(
+    mesh: &MeshData,
+    config: &Config,
+    weld: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    let mut tris = mesh.triangles.clone();
+    let mut order = vec![0u32; if weld { mesh.positions.len() } else { 0 }];
+    let mut wedges = vec![[0u32; 3]; if weld { tris.len() } else { 0 }];
+    let small = mesh.positions.len() < 65_535 && tris.len() < 65_535;
+    let start = Instant::now();
+    if weld && shares_positions(&mesh.positions) {
+        tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
+            .map_err(library_error)?;
+    }
+    let report = if small {
+        FAST_SMALL
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify(&mesh.positions, &mut tris, config)
+    } else {
+        FAST_LARGE
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify(&mesh.positions, &mut tris, config)
+    }
+    .map_err(library_error)?;
+    let elapsed = start.elapsed();
+    tris.truncate(report.triangles_out);
+    Ok((
+        MeshData {
+            positions: mesh.positions.clone(),
+            triangles: tris,
+        },
+        report,
+        elapsed,
+    ))
+}
+
+/// Bytes a fast-mode workspace sized exactly for `v` vertices and `t` triangles takes
+/// (`FastWorkspace::BYTES`, per element from the library's own sizes), with `u16` links when
+/// both are below 65 535.
+pub fn fast_bytes(v: usize, t: usize) -> usize {
+    const P: usize = 1024;
+    macro_rules! per {
+        ($l:ty) => {{
+            let pv =
+                (FastWorkspace::<$l, { 2 * P }, 0>::BYTES - FastWorkspace::<$l, P, 0>::BYTES) / P;
+            let pt =
+                (FastWorkspace::<$l, 0, { 2 * P }>::BYTES - FastWorkspace::<$l, 0, P>::BYTES) / P;
+            FastWorkspace::<$l, 0, 0>::BYTES + v * pv + t * pt
+        }};
+    }
+    if v < 65_535 && t < 65_535 {
+        per!(u16)
+    } else {
+        per!(u32)
+    }
 }
 
 /// The report, every field, one per line.

@@ -18,15 +18,6 @@ fn valence<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, v: usize) -> usize {
     mesh.corners(v).take(1 << 16).count()
 }
 
-/// `√x` for `x ≥ 0` through the math module's `1/√` (0 below the tiny threshold).
-fn sqrt(x: f32) -> f32 {
-    if x > math::TINY2 && x.is_finite() {
-        x * math::rsqrt(x)
-    } else {
-        0.0
-    }
-}
-
 /// `A (α + rc)` of triangle `tri` (eq. 3 without the error term), and its area `A`;
 /// `None` if not finite.
 pub(crate) fn weight<L: Index, I: Index>(
@@ -41,7 +32,7 @@ pub(crate) fn weight<L: Index, I: Index>(
     ];
     let l = e.map(|x| math::dot(x, x));
     let n = math::cross(e[0], math::scale(e[2], -1.0));
-    let area = 0.5 * sqrt(math::dot(n, n));
+    let area = 0.5 * math::sqrt(math::dot(n, n));
     // cos β_k at vertex k: between the edges leaving it.
     let mut sum = 0.0;
     for (u, w) in [(0usize, 2usize), (1, 0), (2, 1)] {

@@ -235,15 +235,6 @@ impl Fan {
     }
 }
 
-/// `√x` for `x ≥ 0` through the math module's `1/√` (0 below the tiny threshold).
-fn sqrt(x: f32) -> f32 {
-    if x > math::TINY2 && x.is_finite() {
-        x * math::rsqrt(x)
-    } else {
-        0.0
-    }
-}
-
 /// Distance from `p` to the line through `a` and `b`; `None` if `a` and `b` coincide.
 fn line_distance(p: V3, a: V3, b: V3) -> Option<f32> {
     let e = math::sub(b, a);
@@ -252,7 +243,7 @@ fn line_distance(p: V3, a: V3, b: V3) -> Option<f32> {
         return None;
     }
     let c = math::cross(math::sub(p, a), e);
-    Some(sqrt(math::dot(c, c) / l2))
+    Some(math::sqrt(math::dot(c, c) / l2))
 }
 
 /// Classifies `v` and measures its distance; `None` if it is never removed now (complex,
@@ -296,7 +287,7 @@ pub(crate) fn classify<L: Index, I: Index>(
         let (px, py) = (mesh.p(x), mesh.p(y));
         let n = math::cross(math::sub(px, pv), math::sub(py, pv));
         let l2 = math::dot(n, n);
-        let a2 = sqrt(l2);
+        let a2 = math::sqrt(l2);
         *units.get_mut(k)? = math::unit_of(n, l2);
         // Σ n(f) A(f) and Σ c(f) A(f), each area twice over (it cancels).
         sum_n = math::add(sum_n, n);
@@ -585,7 +576,7 @@ fn fit2(pv: V3, pos: &[V3; MAX_RING], tris: &[[u8; 3]]) -> (f32, f32, f32) {
         let a = at(t[0]);
         let n = math::cross(math::sub(at(t[1]), a), math::sub(at(t[2]), a));
         let l2 = math::dot(n, n);
-        let l = sqrt(l2);
+        let l = math::sqrt(l2);
         if l > 0.0 {
             let d = math::dot(n, math::sub(pv, a));
             e += d * d / l;
@@ -680,7 +671,7 @@ pub(crate) fn plan(
             pos.get(wrap(k + 1, n)).copied().unwrap_or(pv),
         );
         let c = math::cross(math::sub(a, pv), math::sub(b, pv));
-        old2 += sqrt(math::dot(c, c));
+        old2 += math::sqrt(math::dot(c, c));
     }
     let thin = if old2 > 0.0 {
         1.0 + reference / old2

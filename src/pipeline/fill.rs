@@ -26,16 +26,6 @@ fn add_to(q: &mut [VertexQuadric], v: usize, x: &VertexQuadric) {
     }
 }
 
-/// `√x` for a positive normal `x`, through the one math path.
-#[inline]
-fn sqrt(x: f32) -> f32 {
-    if x > math::TINY2 && x.is_finite() {
-        x * math::rsqrt(x)
-    } else {
-        0.0
-    }
-}
-
 /// The plane quadric of triangle `p` with weight `sqrt(area) · w`, zero without area.
 #[inline]
 fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
@@ -47,7 +37,7 @@ fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
     let inv = math::rsqrt(l2);
     let n = math::scale(c, inv);
     let area = 0.5 * l2 * inv;
-    plane(n, -math::dot(n, p[0]), sqrt(area) * w)
+    plane(n, -math::dot(n, p[0]), math::sqrt(area) * w)
 }
 
 /// Zeroes the quadrics and adds every triangle's plane at its vertices.
@@ -102,7 +92,7 @@ pub(super) fn border_quadrics<I: Index, L: Index>(
                 continue;
             }
             let n = math::scale(perp, math::rsqrt(pl2));
-            let w = sqrt(l2) * BORDER_WEIGHT;
+            let w = math::sqrt(l2) * BORDER_WEIGHT;
             let q = quadric::add(
                 &plane(n, -math::dot(n, p0), w),
                 &triangle([p0, p1, p2], BORDER_WEIGHT),

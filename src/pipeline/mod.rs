@@ -27,17 +27,21 @@
 //!
 //! Differences from meshoptimizer, each for a promise this crate makes: a vertex keeps one
 //! candidate (its cheapest allowed collapse) instead of one per edge, so the sort buffer is one
-//! link per vertex; quadrics are 10 floats without meshoptimizer's weight (so a cost is the
-//! weighted sum of squared distances, not its mean); the checks are not only its flip test
+//! link per vertex; the checks are not only its flip test
 //! (`hasTriangleFlips`, on unnormalised cross products, no square root) but also the link
 //! condition by marks (Cheng, Pan and Shi 1998 §3.2(1)), no duplicate triangle, no fold
 //! across any edge of a changed triangle, no zero-area triangle; border vertices only slide
 //! along their border edge and a lone triangle is never collapsed away, so the Euler
 //! characteristic, the boundary loops and the components are kept.
 //!
+//! Candidates are ordered by price: the source's quadric at the target, a weighted sum of
+//! squared distances, so a collapse over little area goes first. Its error, checked against
+//! [`Config::error_limit`] as for the stored quadric, is the price over the sum of the planes'
+//! weights (the quadric's trace): a weighted mean squared distance, a distance in the input's
+//! units once its root is taken.
+//!
 //! A prototype: neither the crate's default nor the CLI's yet. Not in it: welded seams, parts,
-//! the error limit (a finite one is refused: costs are not normalised), the error bound and
-//! `step(budget)`. A vertex with more than 32 triangles is locked, and a collapse whose moving
+//! the error bound and `step(budget)`. A vertex with more than 32 triangles is locked, and a collapse whose moving
 //! vertex would keep more is refused, so the checks run on fixed fan buffers.
 //! `examples/fast_cow.rs` runs it on one mesh, for callgrind and timing.
 
@@ -51,10 +55,10 @@ mod sort;
 
 use crate::error::Capacity;
 use crate::index::Index;
-use crate::math::V3;
+use crate::math::{self, V3};
 use crate::quadric::VertexQuadric;
 use crate::report::{Rejections, Report, Stop};
-use crate::{Config, ConfigField, Error};
+use crate::{Config, Error};
 
 /// Bins of the counting sort (12 bits of the cost: 8 of exponent, 4 of mantissa, from 2⁻⁴⁸).
 pub(crate) const BINS: usize = 1024;
@@ -243,6 +247,10 @@ pub(crate) fn fan<'m, L: Index, I: Index>(
 pub(crate) struct Stats {
     pub(crate) collapses: usize,
     pub(crate) rejected: Rejections,
+    /// Candidates not collapsed because their price was over the error limit.
+    pub(crate) over_limit: u32,
+    /// The largest error of a collapse made (unit frame, squared).
+    pub(crate) worst: f32,
 }
 
 impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
@@ -272,9 +280,10 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     ///
     /// On success the first `report.triangles_out` entries of `triangles` hold the result,
     /// every index an input vertex; the rest of the buffer is meaningless. Of the [`Config`]
-    /// only `target` and `max_passes` are used (the whole configuration is validated); a
-    /// finite `error_limit` is refused ([`ConfigField::ErrorLimit`]): the costs here are
-    /// weighted sums of squared distances, not distances.
+    /// only `target`, `max_passes` and `error_limit` are used (the whole configuration is
+    /// validated): no collapse whose error, as a distance, is over `error_limit`; a run
+    /// stopped by it reports [`Stop::ErrorLimit`], with the largest error made as
+    /// `collapse_error` and the refusals as `over_limit`.
     ///
     /// Errors, all returned before the triangle buffer is touched: [`Error::InvalidConfig`],
     /// [`Error::Capacity`], [`Error::IndexOutOfRange`], [`Error::NonFinitePosition`].
@@ -285,11 +294,6 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         config: &Config,
     ) -> Result<Report, Error> {
         config.validate()?;
-        if config.error_limit.is_finite() {
-            return Err(Error::InvalidConfig {
-                field: ConfigField::ErrorLimit,
-            });
-        }
         let (cv, ct) = (V.min(L::COUNT), T.min(L::COUNT));
         let frame = build::validate(positions, triangles, cv, ct)?;
         let nv = positions.len();
@@ -355,6 +359,9 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         // fill
         fill::face_quadrics(&frame, triangles, nt, quadrics);
         fill::border_quadrics(&frame, triangles, nt, flags, border_next, quadrics);
+        // The limit as a price: a squared distance in the unit frame.
+        let limit = config.error_limit * frame.scale;
+        let limit = limit * limit;
 
         let target_triangles = config.target.triangles(valid);
         let mut stats = Stats::default();
@@ -375,6 +382,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             }
             let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
             let goal = nt - target_triangles;
+            let refused = stats.over_limit;
             let done = perform::perform(
                 &frame,
                 tris,
@@ -383,7 +391,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 border_next,
                 quadrics,
                 (&*target, &*cost, order.get(..m).unwrap_or(&[])),
-                goal,
+                (goal, limit),
                 &mut stats,
             );
             passes += 1;
@@ -392,8 +400,17 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             compact::unlock(flags);
             let _ = pass_triangles.push(nt as u32);
             if done == 0 {
-                break Stop::NoLegalCollapse;
+                break if stats.over_limit > refused {
+                    Stop::ErrorLimit
+                } else {
+                    Stop::NoLegalCollapse
+                };
             }
+        };
+        let collapse_error = if config.error_limit.is_finite() {
+            math::sqrt(stats.worst) / frame.scale
+        } else {
+            0.0
         };
         Ok(Report {
             triangles_in,
@@ -412,8 +429,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             passes,
             pass_triangles,
             rejected: stats.rejected,
-            over_limit: 0,
-            collapse_error: 0.0,
+            over_limit: stats.over_limit,
+            collapse_error,
             max_error: None,
             mean_error: None,
         })

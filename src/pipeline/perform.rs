@@ -18,6 +18,9 @@
 //! 4. no fold: each surviving triangle against its neighbours across its three edges after
 //!    the collapse (unit normals' dot below -0.9, as the shared checker).
 //!
+//! A candidate over the error limit (its error, the price as a mean squared distance in the
+//! unit frame, above the limit's square) is never collapsed.
+//!
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
 //! degenerate: compact drops them), adds a's quadric to b's, and locks both ends.
 
@@ -93,6 +96,19 @@ pub(super) const fn on(name: &str) -> bool {
     false
 }
 
+/// The error of a's candidate at price `c`: the price over the sum of a's planes' weights,
+/// which is its quadric's trace (every plane's normal is a unit vector; `StoredQuadric::error2`
+/// likewise): a weighted mean squared distance in the unit frame, zero without weight.
+#[inline]
+fn error(quadrics: &[VertexQuadric], a: usize, c: f32) -> f32 {
+    let w = quadrics.get(a).map_or(0.0, |q| q[0] + q[4] + q[7]);
+    if w > 0.0 {
+        c / w
+    } else {
+        0.0
+    }
+}
+
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
@@ -104,7 +120,7 @@ pub(super) fn perform<I: Index, L: Index>(
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
     (target, cost, order): (&[L], &[f32], &[L]),
-    goal: usize,
+    (goal, limit): (usize, f32),
     stats: &mut Stats,
 ) -> usize {
     let m = order.len();
@@ -125,6 +141,12 @@ pub(super) fn perform<I: Index, L: Index>(
         if c > error_goal && c > worst && removed > goal / 6 {
             break;
         }
+        let e = error(quadrics, a, c);
+        if e > limit || e.is_nan() {
+            // Sorted by price, not by error: a later candidate may still be under.
+            stats.over_limit += 1;
+            continue;
+        }
         let b = link(target, a);
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
@@ -138,6 +160,9 @@ pub(super) fn perform<I: Index, L: Index>(
         done += 1;
         if c > worst {
             worst = c;
+        }
+        if e > stats.worst {
+            stats.worst = e;
         }
     }
     stats.collapses += done;

@@ -40,6 +40,20 @@ pub enum ScheduleArg {
     Batched,
 }
 
+/// Which engine, on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineArg {
+    /// The engine every other option configures: exact greedy order (or the passes of
+    /// --schedule), every cost, operator, bound, seam and part policy.
+    #[default]
+    Exact,
+    /// The fast mode (`tinydecimate::pipeline::FastWorkspace`, meshoptimizer's pipeline in
+    /// fixed memory): stored quadrics priced once per pass, collapses in sorted order, every
+    /// output valid. Positions only: seams welded by position (the output keeps the welded
+    /// numbering), no parts pruned; of the options it takes the target and --error-limit.
+    Fast,
+}
+
 /// Which cost, on the command line (`Config::with_cost`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum CostArg {
@@ -409,6 +423,9 @@ pub struct Args {
     /// --max-error for one).
     #[arg(long, value_parser = parse_error_limit)]
     pub error_limit: Option<ErrorLimit>,
+    /// Engine: `fast` is meshoptimizer's pipeline (positions only; target and --error-limit).
+    #[arg(long, value_enum, default_value_t = EngineArg::Exact)]
+    pub engine: EngineArg,
     /// Collapse schedule.
     #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
     pub schedule: ScheduleArg,
@@ -622,6 +639,10 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
             args.input.display()
         );
     }
+    let fast = args.engine == EngineArg::Fast;
+    if fast && args.schedule != ScheduleArg::Greedy {
+        bail!("--engine fast has its own passes: drop --schedule");
+    }
     let stored = args.quadric == QuadricArg::Stored;
     // Optimal placement moves vertices: only their numbering says which input vertex each
     // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
@@ -647,6 +668,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         lock_seam_corners: false,
         prune: args.parts == PartsArg::Prune,
         energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
+        fast,
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
@@ -699,7 +721,13 @@ fn run_text(args: &Args, run: &Run) -> String {
             ", unreferenced dropped"
         }
     );
-    if *stored {
+    if args.engine == EngineArg::Fast {
+        let _ = writeln!(
+            text,
+            "  engine                 fast (meshoptimizer's pipeline: stored quadrics, sorted \
+             passes, subset placement)"
+        );
+    } else if *stored {
         let _ = writeln!(
             text,
             "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
@@ -747,6 +775,18 @@ fn run_text(args: &Args, run: &Run) -> String {
     );
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let per_tri = |b: usize| b as f64 / t.max(1) as f64;
+    if args.engine == EngineArg::Fast {
+        let need = crate::simplify::fast_bytes(v, t);
+        let _ =
+            writeln!(
+            text,
+            "  workspace (right-size) {need} bytes: FastWorkspace for V = {v}, T = {t} with {} \
+             links ({:.2} bytes per input triangle)",
+            if v < 65_535 && t < 65_535 { "u16" } else { "u32" },
+            per_tri(need)
+        );
+        return text;
+    }
     let host = Storage::<u32>::bytes(v, t);
     let _ = writeln!(
         text,
@@ -816,6 +856,7 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "output_format": format!("{:?}", run.out_format),
         "output_vertices": run.written.positions.len(),
         "keep_numbering": run.keep_numbering,
+        "engine": format!("{:?}", args.engine),
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
         "operator": format!("{:?}", args.operator),
@@ -826,7 +867,11 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "report": report_json(&run.report),
         "advice": advice_for(args, &run.report).map(|(_, a)| a),
         "library_ms": run.elapsed.as_secs_f64() * 1e3,
-        "workspace_bytes": workspace_bytes(v, t).0,
+        "workspace_bytes": if args.engine == EngineArg::Fast {
+            crate::simplify::fast_bytes(v, t)
+        } else {
+            workspace_bytes(v, t).0
+        },
     })
 }
 

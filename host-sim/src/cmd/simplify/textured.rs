@@ -32,6 +32,12 @@ fn run_library(
     args: &Args,
     attributes: Option<&crate::simplify::Attributes>,
 ) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
+    if args.engine == super::EngineArg::Fast {
+        bail!(
+            "--engine fast takes positions only: it would weld the seams of these attributes \
+             away; use the default engine for glTF and OBJ with vt or vn"
+        );
+    }
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
     let run = crate::simplify::Run {

@@ -1,0 +1,153 @@
+//! `host-sim simplify --engine fast`: the fast mode (`tinydecimate::pipeline`) from the command
+//! line. Its outputs pass the shared check with `check`'s defaults (seams welded, parts may
+//! vanish whole), the error limit stops it as it stops the exact engine, and what it cannot
+//! run is refused with the option named. Each test runs the built binary.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{run, text};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures")
+        .join(name)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// A clean scan, a seam-split asset (welded by position), a raw CAD export and a multi-part
+/// model at 10 %: `simplify` says VALID, `check` agrees, and the JSON names the engine.
+#[test]
+fn fast_outputs_pass_check() {
+    let d = tempfile::tempdir().unwrap();
+    let mut failed = Vec::new();
+    for mesh in [
+        "stanford_bunny.obj",
+        "suzanne_seams.obj",
+        "pins.obj",
+        "wuson.obj",
+    ] {
+        let input = fixture(mesh);
+        let out = d.path().join(mesh);
+        let json = d.path().join(format!("{mesh}.json"));
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.1",
+            "--engine",
+            "fast",
+            "--json",
+        ]);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{mesh}: {so}");
+        std::fs::write(&json, &so).unwrap();
+        let j: serde_json::Value = serde_json::from_str(&so).unwrap();
+        assert_eq!(j["engine"], "Fast", "{mesh}");
+        assert_eq!(j["valid"], true, "{mesh}");
+        let c = run(&["check", s(&input), s(&out)]);
+        if c.status.code() != Some(0) {
+            failed.push(format!("{mesh}:\n{}", text(&c.stdout)));
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// The bunny to 1 % with a limit of 0.05 % of the diagonal stops on the limit, short of the
+/// target, with every collapse made under it; without a limit it reaches the count.
+#[test]
+fn the_error_limit_stops_the_fast_engine() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("stanford_bunny.obj");
+    let out = d.path().join("b.obj");
+    let report = |limit: &str| {
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.01",
+            "--engine",
+            "fast",
+            "--error-limit",
+            limit,
+            "--json",
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+        let j: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+        j["report"].clone()
+    };
+    let free = report("none");
+    assert_eq!(free["stop"], "Target", "{free}");
+    let limited = report("0.05%");
+    assert_eq!(limited["stop"], "ErrorLimit", "{limited}");
+    assert!(limited["over_limit"].as_u64().unwrap() > 0, "{limited}");
+    assert!(
+        limited["triangles_out"].as_u64().unwrap() > 2 * free["triangles_out"].as_u64().unwrap(),
+        "{limited}"
+    );
+    // 0.05 % of the bunny's diagonal (about 0.25 units): every collapse under it.
+    let diagonal = 0.2502f64;
+    assert!(
+        limited["collapse_error"].as_f64().unwrap() <= 0.0005 * diagonal * 1.001,
+        "{limited}"
+    );
+}
+
+/// What the fast mode does not run is refused before any work, the option named.
+#[test]
+fn what_the_fast_engine_cannot_run_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("cow.obj");
+    let out = d.path().join("c.obj");
+    for (extra, named) in [
+        (&["--schedule", "passes"][..], "--schedule"),
+        (&["--quadric", "stored"][..], "--quadric"),
+        (&["--operator", "triangle"][..], "--operator"),
+        (&["--max-error", "1%"][..], "--max-error"),
+    ] {
+        let mut args = vec![
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.5",
+            "--engine",
+            "fast",
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert_ne!(o.status.code(), Some(0), "{extra:?}");
+        let e = text(&o.stderr);
+        assert!(e.contains(named), "{extra:?}: {e}");
+        assert!(!out.exists(), "{extra:?}: an output was written");
+    }
+    // Attributes: the fast mode would weld their seams away.
+    let textured = d.path().join("quad.obj");
+    std::fs::write(
+        &textured,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    let o = run(&[
+        "simplify",
+        s(&textured),
+        s(&out),
+        "--ratio",
+        "0.5",
+        "--engine",
+        "fast",
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(
+        text(&o.stderr).contains("positions only"),
+        "{}",
+        text(&o.stderr)
+    );
+    assert!(!out.exists());
+}
