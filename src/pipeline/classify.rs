@@ -3,7 +3,7 @@
 //! across its open out-edge), locked (anything else: an edge with more than two triangles or
 //! two wound the same way, or a pinched fan), gone (no triangle).
 
-use super::{fan, flag, link, others, set_link, NONE};
+use super::{fan, flag, link, list, others, set_link, NONE};
 use crate::index::Index;
 
 /// Writes every vertex's kind and border successor; returns the number of locked vertices. `scratch`: two links per vertex,
@@ -12,8 +12,7 @@ use crate::index::Index;
 pub(super) fn classify<I: Index, L: Index>(
     triangles: &[[I; 3]],
     nt: usize,
-    head: &[L],
-    next: &[[L; 3]],
+    (first, lists): (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
     (counts, across): (&mut [L], &mut [L]),
@@ -23,39 +22,43 @@ pub(super) fn classify<I: Index, L: Index>(
         *c = L::ZERO;
     }
     let mut locked = 0;
-    for (v, f) in flags.iter_mut().enumerate() {
+    for v in 0..flags.len() {
         set_link(border_next, v, NONE);
-        if link(head, v) == NONE {
-            *f = flag::GONE;
-            continue;
-        }
-        // The fan as (after, before) pairs; a larger fan is locked.
-        let mut pairs = [(0u32, 0u32); MAX_FAN];
-        let mut count = 0usize;
-        for (_, tr, k) in fan(tris, next, head, v) {
-            match pairs.get_mut(count) {
-                Some(p) => {
-                    let (x, y) = others(tr, k);
-                    *p = (x as u32, y as u32);
+        let l = list(first, flags, lists, v);
+        let kind = if l.is_empty() {
+            flag::GONE
+        } else {
+            // The fan as (after, before) pairs; a larger fan is locked.
+            let mut pairs = [(0u32, 0u32); MAX_FAN];
+            let mut count = 0usize;
+            for (_, tr, k) in fan(tris, (first, lists), flags, v) {
+                match pairs.get_mut(count) {
+                    Some(p) => {
+                        let (x, y) = others(tr, k);
+                        *p = (x as u32, y as u32);
+                    }
+                    None => {
+                        count = MAX_FAN + 1;
+                        break;
+                    }
                 }
-                None => {
-                    count = MAX_FAN + 1;
-                    break;
-                }
+                count += 1;
             }
-            count += 1;
-        }
-        let (kind, end) = match pairs.get(..count) {
-            Some(pairs) => kind_of(pairs, counts, across),
-            None => (flag::LOCKED, NONE),
+            let (kind, end) = match pairs.get(..count) {
+                Some(pairs) => kind_of(pairs, counts, across),
+                None => (flag::LOCKED, NONE),
+            };
+            if kind == flag::BORDER {
+                set_link(border_next, v, end);
+            }
+            if kind == flag::LOCKED {
+                locked += 1;
+            }
+            kind
         };
-        if kind == flag::BORDER {
-            set_link(border_next, v, end);
+        if let Some(f) = flags.get_mut(v) {
+            *f = (*f & flag::HIGH) | kind;
         }
-        if kind == flag::LOCKED {
-            locked += 1;
-        }
-        *f = kind;
     }
     locked
 }

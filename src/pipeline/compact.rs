@@ -30,6 +30,6 @@ pub(super) fn compact<I: Index>(triangles: &mut [[I; 3]], nt: usize) -> (usize, 
 #[inline(never)]
 pub(super) fn unlock(flags: &mut [u8]) {
     for f in flags.iter_mut() {
-        *f &= flag::KIND;
+        *f &= flag::KIND | flag::HIGH;
     }
 }

@@ -21,7 +21,9 @@
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
 //! degenerate: compact drops them), adds a's quadric to b's, and locks both ends.
 
-use super::{dead, fan, flag, flags_of, link, others, set_link, slot, tri, Frame, Stats, NONE};
+use super::{
+    dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
+};
 use crate::index::Index;
 use crate::legality::Reject;
 use crate::math::{self, V3};
@@ -99,7 +101,7 @@ pub(super) const fn on(name: &str) -> bool {
 pub(super) fn perform<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &mut [[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
@@ -129,12 +131,12 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        if let Err(r) = check(frame, tris, (head, next), flags, a, b) {
+        if let Err(r) = check(frame, tris, adj, flags, a, b) {
             stats.rejected.count(r);
             edge_goal += 1;
             continue;
         }
-        removed += collapse(tris, (head, next), flags, border_next, quadrics, a, b);
+        removed += collapse(tris, adj, flags, border_next, quadrics, a, b);
         done += 1;
         if c > worst {
             worst = c;
@@ -177,7 +179,7 @@ const MAX_FAN: usize = 32;
 fn check<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
     a: usize,
     b: usize,
@@ -202,7 +204,7 @@ fn check<I: Index, L: Index>(
         n: [0.0; 3],
     }; MAX_FAN];
     let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
-    for (t, tr, k) in fan(tris, next, head, a) {
+    for (t, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
         }
@@ -270,7 +272,7 @@ fn check<I: Index, L: Index>(
     let mut verdict = Ok(());
     let (mut nb, mut on_o1, mut on_o2, mut opposite) = (0, 0, 0, false);
     let (mut across1, mut across2) = (NONE, NONE);
-    for (t, tr, k) in fan(tris, next, head, b) {
+    for (t, tr, k) in fan(tris, adj, flags, b) {
         if dead(tr) {
             continue;
         }
@@ -345,7 +347,7 @@ fn check<I: Index, L: Index>(
             return Err(Reject::Fold);
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
-        for (u, tr, _) in fan(tris, next, head, from) {
+        for (u, tr, _) in fan(tris, adj, flags, from) {
             if u != s.t() && !dead(tr) && slot(tr, other).is_some() {
                 if folded(s.n, normal(after(frame, tr, a, pb))) {
                     return Err(Reject::Fold);
@@ -375,7 +377,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
     tris: &mut [[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
@@ -387,10 +389,10 @@ fn collapse<I: Index, L: Index>(
             // ... p → a → b ...: p's open edge now ends at b. p is the neighbour before a
             // that no triangle of a has after it.
             let mut p = NONE;
-            for (_, tr, k) in fan(tris, next, head, a) {
+            for (_, tr, k) in fan(tris, adj, flags, a) {
                 let (_, y) = others(tr, k);
                 if !dead(tr)
-                    && !fan(tris, next, head, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
+                    && !fan(tris, adj, flags, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
                 {
                     p = y;
                 }
@@ -405,11 +407,9 @@ fn collapse<I: Index, L: Index>(
         }
     }
     let mut dying = 0;
-    let mut t = link(head, a);
-    let mut guard = tris.len();
     let nb = I::narrow(b);
-    while t != NONE && guard > 0 {
-        guard -= 1;
+    for &t in list(adj.0, flags, adj.1, a) {
+        let t = t.to_usize();
         let tr = tri(tris, t);
         let Some(k) = slot(tr, a) else { break };
         if !dead(tr) && slot(tr, b).is_some() {
@@ -418,7 +418,6 @@ fn collapse<I: Index, L: Index>(
         if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
             *c = nb;
         }
-        t = next.get(t).map_or(NONE, |n| link(n, k));
     }
     if let Some(&qa) = quadrics.get(a) {
         if let Some(q) = quadrics.get_mut(b) {
@@ -426,7 +425,7 @@ fn collapse<I: Index, L: Index>(
         }
     }
     if let Some(f) = flags.get_mut(a) {
-        *f = flag::GONE | flag::PASS;
+        *f = (*f & flag::HIGH) | flag::GONE | flag::PASS;
     }
     if let Some(f) = flags.get_mut(b) {
         *f |= flag::PASS;
