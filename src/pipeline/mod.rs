@@ -448,7 +448,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 flags,
                 border_next,
                 quadrics,
-                (&*target, &*cost, order.get(..m).unwrap_or(&[])),
+                (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
                 goal,
                 &mut stats,
             );

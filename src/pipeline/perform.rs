@@ -105,7 +105,7 @@ pub(super) fn perform<I: Index, L: Index>(
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
-    (target, cost, order): (&[L], &[f32], &[L]),
+    (target, cost, order): (&mut [L], &[f32], &[L]),
     goal: usize,
     stats: &mut Stats,
 ) -> usize {
@@ -131,12 +131,14 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        if let Err(r) = check(frame, tris, adj, flags, a, b) {
+        if let Err(r) = check(frame, tris, adj, flags, target, a, b) {
             stats.rejected.count(r);
             edge_goal += 1;
             continue;
         }
         removed += collapse(tris, adj, flags, border_next, quadrics, a, b);
+        // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
+        set_link(target, b, a);
         done += 1;
         if c > worst {
             worst = c;
@@ -181,6 +183,7 @@ fn check<I: Index, L: Index>(
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     flags: &mut [u8],
+    target: &[L],
     a: usize,
     b: usize,
 ) -> Result<(), Reject> {
@@ -338,22 +341,36 @@ fn check<I: Index, L: Index>(
         if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
             return Err(Reject::Fold);
         }
-        // Across the outer edge x-y: searched from an end whose list is current.
-        let (from, other) = if flags_of(flags, s.x()) & flag::PASS == 0 {
-            (s.x(), s.y())
+        // Across the outer edge x-y: searched in the list of an end that has not moved or
+        // been moved onto in this pass, else in x's list and the list of the vertex that
+        // moved onto x (all of x's triangles now).
+        let (from, other, also) = if flags_of(flags, s.x()) & flag::PASS == 0 {
+            (s.x(), s.y(), NONE)
         } else if flags_of(flags, s.y()) & flag::PASS == 0 {
-            (s.y(), s.x())
+            (s.y(), s.x(), NONE)
         } else {
-            return Err(Reject::Fold);
+            (s.x(), s.y(), link(target, s.x()))
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
-        for (u, tr, _) in fan(tris, adj, flags, from) {
-            if u != s.t() && !dead(tr) && slot(tr, other).is_some() {
+        let lists = [from, also].map(|v| {
+            if v == NONE {
+                &[][..]
+            } else {
+                list(adj.0, flags, adj.1, v)
+            }
+        });
+        'search: for &u in lists.iter().flat_map(|l| l.iter()) {
+            let u = u.to_usize();
+            if u == s.t() {
+                continue;
+            }
+            let tr = tri(tris, u);
+            if slot(tr, other).is_some() && !dead(tr) {
                 if folded(s.n, normal(after(frame, tr, a, pb))) {
                     return Err(Reject::Fold);
                 }
                 if manifold {
-                    break;
+                    break 'search;
                 }
             }
         }
