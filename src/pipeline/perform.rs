@@ -44,12 +44,6 @@ fn normal(p: [V3; 3]) -> V3 {
     math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
 }
 
-/// The positions of `tr` after `a` moves onto `b` (at `pb`).
-#[inline]
-fn after(frame: &Frame<'_>, tr: [usize; 3], a: usize, pb: V3) -> [V3; 3] {
-    tr.map(|v| if v == a { pb } else { frame.at(v) })
-}
-
 /// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
 /// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
 /// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
@@ -148,14 +142,16 @@ pub(super) fn perform<I: Index, L: Index>(
     done
 }
 
-/// A surviving triangle of a's fan: its number, its other vertices (after and before a) and
-/// its normal after the collapse.
+/// A surviving triangle of a's fan: its number, its other vertices (after and before a), their
+/// positions and its normal after the collapse.
 #[derive(Clone, Copy)]
 struct Survivor {
     t: u32,
     x: u32,
     y: u32,
     n: V3,
+    px: V3,
+    py: V3,
 }
 
 impl Survivor {
@@ -200,13 +196,9 @@ fn check<I: Index, L: Index>(
     // 1 and 2. One walk of a's fan: the vertices opposite a-b (o1 in (a, b, o1), o2 in
     // (a, o2, b)), and each survivor's flip and area.
     let (pa, pb) = (frame.at(a), frame.at(b));
-    let mut fan_a = [Survivor {
-        t: 0,
-        x: 0,
-        y: 0,
-        n: [0.0; 3],
-    }; MAX_FAN];
-    let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
+    // Not zeroed: a fan rarely fills it.
+    let mut fan_a = heapless::Vec::<Survivor, MAX_FAN>::new();
+    let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
     for (t, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
@@ -237,20 +229,19 @@ fn check<I: Index, L: Index>(
         if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
             return Err(Reject::NormalTurn);
         }
-        match fan_a.get_mut(ns) {
-            Some(slot) => {
-                *slot = Survivor {
-                    t: t as u32,
-                    x: x as u32,
-                    y: y as u32,
-                    n: n1,
-                }
-            }
-            None => return Err(Reject::Locked),
+        let s = Survivor {
+            t: t as u32,
+            x: x as u32,
+            y: y as u32,
+            n: n1,
+            px,
+            py,
+        };
+        if fan_a.push(s).is_err() {
+            return Err(Reject::Locked);
         }
-        ns += 1;
     }
-    let fan_a = fan_a.get(..ns).unwrap_or(&[]);
+    let fan_a = fan_a.as_slice();
     let want = if ka == flag::BORDER { 1 } else { 2 };
     let want = if const { on(RULE_BORDER) } {
         want
@@ -366,7 +357,18 @@ fn check<I: Index, L: Index>(
             }
             let tr = tri(tris, u);
             if slot(tr, other).is_some() && !dead(tr) {
-                if folded(s.n, normal(after(frame, tr, a, pb))) {
+                let p = tr.map(|v| {
+                    if v == s.x() {
+                        s.px
+                    } else if v == s.y() {
+                        s.py
+                    } else if v == a {
+                        pb
+                    } else {
+                        frame.at(v)
+                    }
+                });
+                if folded(s.n, normal(p)) {
                     return Err(Reject::Fold);
                 }
                 if manifold {
