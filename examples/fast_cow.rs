@@ -62,7 +62,10 @@ fn main() {
         r.triangles_in, r.triangles_out, r.collapses, r.passes, r.stop
     );
     if std::env::var("FAST_COW_DEBUG").is_ok() {
-        println!("passes {:?} rejected [{}]", r.pass_triangles, r.rejected);
+        println!(
+            "passes {:?} rejected [{}] locked {}",
+            r.pass_triangles, r.rejected, r.locked_vertices
+        );
     }
     // `FAST_COW_REPS=n`: the best of n more runs (host time).
     if let Some(n) = std::env::var("FAST_COW_REPS")

@@ -3,11 +3,10 @@
 //! across its open out-edge), locked (anything else: an edge with more than two triangles or
 //! two wound the same way, or a pinched fan), gone (no triangle).
 
-use super::{fan, flag, link, list, others, set_link, NONE};
+use super::{fan, flag, list, others, set_link, NONE};
 use crate::index::Index;
 
-/// Writes every vertex's kind and border successor; returns the number of locked vertices. `scratch`: two links per vertex,
-/// contents on entry and exit meaningless.
+/// Writes every vertex's kind and border successor; returns the number of locked vertices.
 #[inline(never)]
 pub(super) fn classify<I: Index, L: Index>(
     triangles: &[[I; 3]],
@@ -15,12 +14,8 @@ pub(super) fn classify<I: Index, L: Index>(
     (first, lists): (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    (counts, across): (&mut [L], &mut [L]),
 ) -> usize {
     let tris = triangles.get(..nt).unwrap_or(&[]);
-    for c in counts.iter_mut() {
-        *c = L::ZERO;
-    }
     let mut locked = 0;
     for v in 0..flags.len() {
         set_link(border_next, v, NONE);
@@ -45,7 +40,7 @@ pub(super) fn classify<I: Index, L: Index>(
                 count += 1;
             }
             let (kind, end) = match pairs.get(..count) {
-                Some(pairs) => kind_of(pairs, counts, across),
+                Some(pairs) => kind_of(pairs),
                 None => (flag::LOCKED, NONE),
             };
             if kind == flag::BORDER {
@@ -66,67 +61,89 @@ pub(super) fn classify<I: Index, L: Index>(
 /// Fans larger than this are locked.
 const MAX_FAN: usize = 32;
 
-/// Per neighbour in `counts`: triangles with it after v (low byte) and before v (times 256).
-const IN: usize = 256;
-
-#[inline]
-fn bump<L: Index>(s: &mut [L], v: usize, by: usize) {
-    if let Some(c) = s.get_mut(v) {
-        *c = L::narrow(c.to_usize() + by);
-    }
-}
+/// Slots of the small hash table of a fan's before-vertices (twice the largest fan).
+const SLOTS: usize = 2 * MAX_FAN;
 
 /// The kind of a vertex from its fan's (after, before) pairs, and for a border vertex the
-/// vertex across its open out-edge. Linear: each neighbour's counts of triangles with it after
-/// and before v in `counts`, and in `across` the pair with it before v (left zero / stale).
-fn kind_of<L: Index>(pairs: &[(u32, u32)], counts: &mut [L], across: &mut [L]) -> (u8, usize) {
-    for (i, &(x, y)) in pairs.iter().enumerate() {
-        let (x, y) = (x as usize, y as usize);
-        bump(counts, x, 1);
-        bump(counts, y, IN);
-        set_link(across, y, i);
-    }
-    let (mut open_out, mut open_in, mut start, mut end, mut bad) = (0, 0, 0, NONE, false);
-    for (i, &(x, y)) in pairs.iter().enumerate() {
-        let (x, y) = (x as usize, y as usize);
-        let (cx, cy) = (link(counts, x), link(counts, y));
-        // x: once after v, at most once before; y: once before, at most once after.
-        if cx % IN != 1 || cx / IN > 1 || cy / IN != 1 || cy % IN > 1 {
-            bad = true;
-        }
-        if cx / IN == 0 {
-            open_out += 1;
-            end = x;
-        }
-        if cy % IN == 0 {
-            open_in += 1;
-            start = i;
-        }
-    }
-    let mut steps = 0usize;
-    if !bad && open_out == open_in && open_out <= 1 {
-        // One fan? Walk it across its spokes from the open end (or anywhere): the triangle
-        // across spoke v-x has x before v.
-        let mut cur = start;
-        while steps <= pairs.len() {
-            steps += 1;
-            let Some(&(x, _)) = pairs.get(cur) else { break };
-            let x = x as usize;
-            if link(counts, x) / IN == 0 {
-                break;
+/// vertex across its open out-edge. The triangle across spoke v-x is the one with x before v,
+/// found in a small hash table of the before-vertices. Manifold or border needs each
+/// before-vertex once and each match taken once (a repeated after-vertex either takes a match
+/// twice or leaves two triangles without one), as many unmatched after- as before-vertices
+/// (at most one: the open ends), and following the matches from the open end (or anywhere)
+/// must visit every triangle. No scratch memory.
+fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize) {
+    let n = pairs.len();
+    let hash = |v: u32| (v.wrapping_mul(0x9e37_79b1) >> 26) as usize;
+    let mut keys = [u32::MAX; SLOTS];
+    let mut vals = [0u8; SLOTS];
+    let mut bad = false;
+    for (j, &(_, y)) in pairs.iter().enumerate() {
+        let mut h = hash(y);
+        for _ in 0..SLOTS {
+            match keys.get(h) {
+                Some(&k) if k == u32::MAX => {
+                    if let (Some(k), Some(v)) = (keys.get_mut(h), vals.get_mut(h)) {
+                        *k = y;
+                        *v = j as u8;
+                    }
+                    break;
+                }
+                Some(&k) if k == y => {
+                    bad = true;
+                    break;
+                }
+                _ => h = (h + 1) % SLOTS,
             }
-            let j = link(across, x);
-            if j == start {
-                break;
-            }
-            cur = j;
         }
     }
-    for &(x, y) in pairs {
-        set_link(counts, x as usize, 0);
-        set_link(counts, y as usize, 0);
+    let mut next = [u8::MAX; MAX_FAN];
+    let (mut seen, mut open_out, mut end) = (0u32, 0, NONE);
+    for (&(x, _), nx) in pairs.iter().zip(next.iter_mut()) {
+        let mut h = hash(x);
+        let mut found = None;
+        for _ in 0..SLOTS {
+            match keys.get(h) {
+                Some(&k) if k == x => {
+                    found = vals.get(h).copied();
+                    break;
+                }
+                Some(&k) if k != u32::MAX => h = (h + 1) % SLOTS,
+                _ => break,
+            }
+        }
+        match found {
+            Some(j) => {
+                let bit = 1u32.checked_shl(j as u32).unwrap_or(0);
+                bad |= seen & bit != 0;
+                seen |= bit;
+                *nx = j;
+            }
+            None => {
+                open_out += 1;
+                end = x as usize;
+            }
+        }
     }
-    if bad || open_out != open_in || open_out > 1 || steps != pairs.len() {
+    let all = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    let open = all & !seen;
+    let open_in = open.count_ones();
+    if bad || open_out != open_in || open_out > 1 {
+        return (flag::LOCKED, NONE);
+    }
+    let start = if open == 0 {
+        0
+    } else {
+        31 - open.leading_zeros() as usize
+    };
+    let (mut cur, mut steps) = (start, 0usize);
+    while steps <= n {
+        steps += 1;
+        match next.get(cur) {
+            Some(&j) if (j as usize) < n && j as usize != start => cur = j as usize,
+            _ => break,
+        }
+    }
+    if steps != n {
         (flag::LOCKED, NONE)
     } else if open_out == 1 {
         (flag::BORDER, end)

@@ -405,7 +405,6 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
-            (&mut *target, &mut *order),
         );
 
         // fill
