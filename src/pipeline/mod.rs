@@ -431,10 +431,10 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 flags,
                 border_next,
                 quadrics,
-                target,
-                cost,
+                (&mut *target, &mut *cost),
+                histogram,
             );
-            let m = sort::sort(flags, target, cost, order, histogram);
+            let m = sort::sort(target, cost, order, histogram);
             if m == 0 {
                 break Stop::NoLegalCollapse;
             }

@@ -4,15 +4,16 @@
 //! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
 //! along its border edge (either direction); a locked vertex never moves.
 
-use super::{fan, flag, flags_of, link, others, Frame, NONE};
+use super::sort::key;
+use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
 use crate::index::Index;
 use crate::quadric::{self, VertexQuadric};
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
 /// the vertex after it in each triangle (the triangle across offers the other direction), a
 /// border vertex along its open edges only, either way. One vertex at a time, so its quadric
-/// and its best candidate stay in registers; ties go to the lower target.
-#[allow(clippy::too_many_arguments)]
+/// and its best candidate stay in registers; ties go to the lower target. Counts each
+/// candidate's sort key in `histogram` (the counting sort's first pass).
 #[inline(never)]
 pub(super) fn pick<I: Index, L: Index>(
     frame: &Frame<'_>,
@@ -21,9 +22,12 @@ pub(super) fn pick<I: Index, L: Index>(
     flags: &[u8],
     border_next: &[L],
     quadrics: &[VertexQuadric],
-    target: &mut [L],
-    cost: &mut [f32],
+    (target, cost): (&mut [L], &mut [f32]),
+    histogram: &mut [L; BINS],
 ) {
+    for h in histogram.iter_mut() {
+        *h = L::ZERO;
+    }
     let free = |k: u8| {
         k == flag::MANIFOLD
             || (!const { super::perform::on("border") } && k == flag::BORDER)
@@ -59,6 +63,13 @@ pub(super) fn pick<I: Index, L: Index>(
             }
         }
         *ca = best;
-        *ta = if to == NONE { L::NIL } else { L::narrow(to) };
+        *ta = if to == NONE {
+            L::NIL
+        } else {
+            if let Some(h) = histogram.get_mut(key(best)) {
+                *h = L::narrow(h.to_usize() + 1);
+            }
+            L::narrow(to)
+        };
     }
 }
