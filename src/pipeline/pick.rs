@@ -14,6 +14,7 @@ use crate::quadric::{self, VertexQuadric};
 /// border vertex along its open edges only, either way. One vertex at a time, so its quadric
 /// and its best candidate stay in registers; ties go to the lower target. Counts each
 /// candidate's sort key in `histogram` (the counting sort's first pass).
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(super) fn pick<I: Index, L: Index>(
     frame: &Frame<'_>,
