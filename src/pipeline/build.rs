@@ -70,8 +70,9 @@ pub(super) fn validate<'p, I: Index>(
 }
 
 /// Fan lists of the first `nt` triangles (a counting sort of their corners by vertex, as
-/// meshoptimizer's `buildTriangleAdjacency`): `v`'s list is `lists[end(v - 1)..end(v)]`, its
-/// triangles from the highest number down.
+/// meshoptimizer's `buildTriangleAdjacency`), from the corner counts that compact left in
+/// `first`: `v`'s list is `lists[end(v - 1)..end(v)]`, its triangles from the highest number
+/// down.
 #[inline(never)]
 pub(super) fn link<I: Index, L: Index>(
     triangles: &[[I; 3]],
@@ -81,17 +82,7 @@ pub(super) fn link<I: Index, L: Index>(
     lists: &mut [L],
 ) {
     let tris = triangles.get(..nt).unwrap_or(&[]);
-    for c in first.iter_mut() {
-        *c = L::ZERO;
-    }
-    // Counts (at most nt each, so they fit a link), then each list's start.
-    for tr in tris {
-        for i in tr {
-            if let Some(c) = first.get_mut(i.to_usize()) {
-                *c = L::narrow(c.to_usize() + 1);
-            }
-        }
-    }
+    // Each list's start from the counts (at most nt each, so they fit a link).
     let mut sum = 0;
     for v in 0..first.len() {
         let c = first.get(v).map_or(0, |c| c.to_usize());

@@ -385,7 +385,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         let triangles_in = triangles.len();
 
         // build
-        let (mut nt, degenerate) = compact::compact(triangles, triangles_in);
+        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, first);
         build::link(triangles, nt, first, flags, lists);
         let duplicates = build::dedupe(
             triangles,
@@ -393,7 +393,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             (first, flags, lists.get(..3 * nt).unwrap_or(&[])),
         );
         if duplicates > 0 {
-            nt = compact::compact(triangles, nt).0;
+            nt = compact::compact(triangles, nt, first).0;
             build::link(triangles, nt, first, flags, lists);
         }
         let valid = nt;
@@ -452,7 +452,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 &mut stats,
             );
             passes += 1;
-            nt = compact::compact(triangles, nt).0;
+            nt = compact::compact(triangles, nt, first).0;
             build::link(triangles, nt, first, flags, lists);
             compact::unlock(flags);
             let _ = pass_triangles.push(nt as u32);
