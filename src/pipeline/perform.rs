@@ -48,7 +48,7 @@ fn normal(p: [V3; 3]) -> V3 {
 /// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
 /// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
 /// frame.
-#[inline]
+#[inline(always)]
 fn folded(n1: V3, n2: V3) -> bool {
     let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
     // Written so that NaN refuses too.
@@ -317,19 +317,30 @@ fn check<I: Index, L: Index>(
     }
 
     // 4. Folds: each survivor against its neighbours after the collapse.
-    let unchanged = |t: usize| normal(tri(tris, t).map(|v| frame.at(v)));
+    // b's triangle across b-o1 (or b-o2): b and o1 at their known positions.
+    let unchanged = |t: usize, o: usize, po: V3| {
+        normal(tri(tris, t).map(|v| {
+            if v == b {
+                pb
+            } else if v == o {
+                po
+            } else {
+                frame.at(v)
+            }
+        }))
+    };
     for s in fan_a {
         // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
         // the one on a-o1 dies; across the spoke to o2 likewise.
         let spoke = match fan_a.iter().find(|u| u.y == s.x) {
             Some(u) => folded(s.n, u.n),
-            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1)),
+            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1, o1, s.px)),
             None => false,
         };
         if spoke {
             return Err(Reject::Fold);
         }
-        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
+        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2, o2, s.py)) {
             return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched in the list of an end that has not moved or
