@@ -453,11 +453,14 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             );
             passes += 1;
             nt = compact::compact(triangles, nt, first).0;
-            build::link(triangles, nt, first, flags, lists);
-            compact::unlock(flags);
             let _ = pass_triangles.push(nt as u32);
             if done == 0 {
                 break Stop::NoLegalCollapse;
+            }
+            // No fan lists for a pass that will not run.
+            if nt > target_triangles && passes < config.max_passes {
+                build::link(triangles, nt, first, flags, lists);
+                compact::unlock(flags);
             }
         };
         Ok(Report {
