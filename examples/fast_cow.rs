@@ -63,8 +63,8 @@ fn main() {
     );
     if std::env::var("FAST_COW_DEBUG").is_ok() {
         println!(
-            "passes {:?} rejected [{}] locked {}",
-            r.pass_triangles, r.rejected, r.locked_vertices
+            "passes {:?} rejected [{}] locked {} duplicates {}",
+            r.pass_triangles, r.rejected, r.locked_vertices, r.duplicates_dropped
         );
     }
     // `FAST_COW_REPS=n`: the best of n more runs (host time).

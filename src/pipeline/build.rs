@@ -1,6 +1,6 @@
-//! build: validation (before anything is written), fan lists, duplicate triangles.
+//! build: validation (before anything is written), fan lists.
 
-use super::{bump_end, list, set_end, slot, tri, Frame};
+use super::{bump_end, set_end, Frame};
 use crate::error::Capacity;
 use crate::index::Index;
 use crate::Error;
@@ -98,34 +98,4 @@ pub(super) fn link<I: Index, L: Index>(
             }
         }
     }
-}
-
-/// Marks every triangle with the vertex set of a lower-numbered one (either winding: a
-/// repeated copy, or the back of a double-sided triangle) by writing it degenerate; returns
-/// how many. Highest first, so the lower-numbered triangles read are not yet written.
-#[inline(never)]
-pub(super) fn dedupe<I: Index, L: Index>(
-    triangles: &mut [[I; 3]],
-    nt: usize,
-    (first, flags, lists): (&[L], &[u8], &[L]),
-) -> usize {
-    let mut count = 0;
-    for t in (0..nt).rev() {
-        let tr = tri(triangles, t);
-        let dup = list(first, flags, lists, tr[0]).iter().any(|u| {
-            let u = u.to_usize();
-            u < t && {
-                let s = tri(triangles, u);
-                slot(s, tr[1]).is_some() && slot(s, tr[2]).is_some()
-            }
-        });
-        if dup {
-            if let Some(x) = triangles.get_mut(t) {
-                x[1] = x[0];
-                x[2] = x[0];
-            }
-            count += 1;
-        }
-    }
-    count
 }

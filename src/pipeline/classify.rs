@@ -1,61 +1,116 @@
 //! classify: each vertex's kind from its fan (meshoptimizer's `classifyVertices`, without
 //! seams): manifold (one closed disk), border (one open fan; `border_next` is the vertex
 //! across its open out-edge), locked (anything else: an edge with more than two triangles or
-//! two wound the same way, or a pinched fan), gone (no triangle).
+//! two wound the same way, or a pinched fan), gone (no triangle); and duplicate triangles
+//! dropped on the way.
 
-use super::{fan, flag, list, others, set_link, NONE};
+use super::{dead, flag, list, others, set_link, slot, tri, NONE};
 use crate::index::Index;
 
-/// Writes every vertex's kind and border successor; returns the number of locked vertices.
+/// Writes every vertex's kind and border successor, and drops duplicate triangles: every
+/// triangle with the vertex set of a lower-numbered one (either winding: a repeated copy, or
+/// the back of a double-sided triangle) is written degenerate, seen from any of its vertices
+/// (a duplicate is in all three fans with its original) and left out of the kinds. Returns
+/// the numbers of locked vertices and of duplicates.
 #[inline(never)]
 pub(super) fn classify<I: Index, L: Index>(
-    triangles: &[[I; 3]],
+    triangles: &mut [[I; 3]],
     nt: usize,
     (first, lists): (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-) -> usize {
-    let tris = triangles.get(..nt).unwrap_or(&[]);
-    let mut locked = 0;
+) -> (usize, usize) {
+    let (mut locked, mut duplicates) = (0, 0);
     for v in 0..flags.len() {
         set_link(border_next, v, NONE);
         let l = list(first, flags, lists, v);
-        let kind = if l.is_empty() {
+        // The fan as (after, before) pairs, lowest triangle first, each vertex set once (as
+        // the ordered pair of the other two vertices); a larger fan is locked.
+        let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
+        let mut sets = [(0u32, 0u32); MAX_FAN];
+        let mut full = false;
+        for &t in l.iter().rev() {
+            let t = t.to_usize();
+            let tr = tri(triangles, t);
+            if t >= nt || dead(tr) {
+                continue;
+            }
+            let Some(k) = slot(tr, v) else { continue };
+            let (x, y) = others(tr, k);
+            let (x, y) = (x as u32, y as u32);
+            let set = (x.min(y), x.max(y));
+            let seen = sets.get(..pairs.len()).unwrap_or(&[]);
+            if seen.contains(&set) {
+                if drop(triangles, t) {
+                    duplicates += 1;
+                }
+                continue;
+            }
+            if let Some(s) = sets.get_mut(pairs.len()) {
+                *s = set;
+            }
+            if pairs.push((x, y)).is_err() {
+                full = true;
+                break;
+            }
+        }
+        let kind = if full {
+            duplicates += dedupe_all(triangles, nt, l);
+            flag::LOCKED
+        } else if pairs.is_empty() {
             flag::GONE
         } else {
-            // The fan as (after, before) pairs; a larger fan is locked.
-            let mut pairs = [(0u32, 0u32); MAX_FAN];
-            let mut count = 0usize;
-            for (_, tr, k) in fan(tris, (first, lists), flags, v) {
-                match pairs.get_mut(count) {
-                    Some(p) => {
-                        let (x, y) = others(tr, k);
-                        *p = (x as u32, y as u32);
-                    }
-                    None => {
-                        count = MAX_FAN + 1;
-                        break;
-                    }
-                }
-                count += 1;
-            }
-            let (kind, end) = match pairs.get(..count) {
-                Some(pairs) => kind_of(pairs),
-                None => (flag::LOCKED, NONE),
-            };
+            let (kind, end) = kind_of(&pairs);
             if kind == flag::BORDER {
                 set_link(border_next, v, end);
             }
-            if kind == flag::LOCKED {
-                locked += 1;
-            }
             kind
         };
+        if kind == flag::LOCKED {
+            locked += 1;
+        }
         if let Some(f) = flags.get_mut(v) {
             *f = (*f & flag::HIGH) | kind;
         }
     }
-    locked
+    (locked, duplicates)
+}
+
+/// Writes triangle `t` degenerate; whether it was there.
+#[inline]
+fn drop<I: Index>(triangles: &mut [[I; 3]], t: usize) -> bool {
+    match triangles.get_mut(t) {
+        Some(x) => {
+            x[1] = x[0];
+            x[2] = x[0];
+            true
+        }
+        None => false,
+    }
+}
+
+/// Duplicates in a fan too large for the pair buffer, against the whole list; returns how many
+/// were dropped.
+fn dedupe_all<I: Index, L: Index>(triangles: &mut [[I; 3]], nt: usize, l: &[L]) -> usize {
+    let mut count = 0;
+    for &t in l {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let dup = l.iter().any(|u| {
+            let u = u.to_usize();
+            u < t && {
+                let s = tri(triangles, u);
+                !dead(s) && tr.iter().all(|&w| slot(s, w).is_some())
+            }
+        });
+        if dup && drop(triangles, t) {
+            count += 1;
+        }
+    }
+    count
 }
 
 /// Fans larger than this are locked.

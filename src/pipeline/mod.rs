@@ -14,8 +14,9 @@
 //! vertex), so the positions are only read and may stay in flash.
 //!
 //! ```text
-//! build     validate, drop degenerate and duplicate triangles, fan lists
-//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex
+//! build     validate, drop degenerate triangles, fan lists
+//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex;
+//!           drop duplicate triangles
 //! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics
 //! loop {
 //!   pick      each vertex's cheapest collapse its kind allows, from its quadric
@@ -387,25 +388,20 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         // build
         let (mut nt, degenerate) = compact::compact(triangles, triangles_in, first);
         build::link(triangles, nt, first, flags, lists);
-        let duplicates = build::dedupe(
-            triangles,
-            nt,
-            (first, flags, lists.get(..3 * nt).unwrap_or(&[])),
-        );
-        if duplicates > 0 {
-            nt = compact::compact(triangles, nt, first).0;
-            build::link(triangles, nt, first, flags, lists);
-        }
-        let valid = nt;
 
-        // classify
-        let locked = classify::classify(
+        // classify (and duplicates)
+        let (locked, duplicates) = classify::classify(
             triangles,
             nt,
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
         );
+        if duplicates > 0 {
+            nt = compact::compact(triangles, nt, first).0;
+            build::link(triangles, nt, first, flags, lists);
+        }
+        let valid = nt;
 
         // fill
         fill::face_quadrics(&frame, triangles, nt, quadrics);
