@@ -354,36 +354,34 @@ fn check<I: Index, L: Index>(
             (s.x(), s.y(), link(target, s.x()))
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
-        let lists = [from, also].map(|v| {
+        'search: for v in [from, also] {
             if v == NONE {
-                &[][..]
-            } else {
-                list(adj.0, flags, adj.1, v)
+                break;
             }
-        });
-        'search: for &u in lists.iter().flat_map(|l| l.iter()) {
-            let u = u.to_usize();
-            if u == s.t() {
-                continue;
-            }
-            let tr = tri(tris, u);
-            if slot(tr, other).is_some() && !dead(tr) {
-                let p = tr.map(|v| {
-                    if v == s.x() {
-                        s.px
-                    } else if v == s.y() {
-                        s.py
-                    } else if v == a {
-                        pb
-                    } else {
-                        frame.at(v)
-                    }
-                });
-                if folded(s.n, normal(p)) {
-                    return Err(Reject::Fold);
+            for &u in list(adj.0, flags, adj.1, v) {
+                let u = u.to_usize();
+                if u == s.t() {
+                    continue;
                 }
-                if manifold {
-                    break 'search;
+                let tr = tri(tris, u);
+                if slot(tr, other).is_some() && !dead(tr) {
+                    let p = tr.map(|v| {
+                        if v == s.x() {
+                            s.px
+                        } else if v == s.y() {
+                            s.py
+                        } else if v == a {
+                            pb
+                        } else {
+                            frame.at(v)
+                        }
+                    });
+                    if folded(s.n, normal(p)) {
+                        return Err(Reject::Fold);
+                    }
+                    if manifold {
+                        break 'search;
+                    }
                 }
             }
         }
