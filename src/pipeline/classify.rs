@@ -24,48 +24,13 @@ pub(super) fn classify<I: Index, L: Index>(
     for v in 0..flags.len() {
         set_link(border_next, v, NONE);
         let l = list(first, flags, lists, v);
-        // The fan as (after, before) pairs, lowest triangle first, each vertex set once (as
-        // the ordered pair of the other two vertices); a larger fan is locked.
-        let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
-        let mut sets = [(0u32, 0u32); MAX_FAN];
-        let mut full = false;
-        for &t in l.iter().rev() {
-            let t = t.to_usize();
-            let tr = tri(triangles, t);
-            if t >= nt || dead(tr) {
-                continue;
-            }
-            let Some(k) = slot(tr, v) else { continue };
-            let (x, y) = others(tr, k);
-            let (x, y) = (x as u32, y as u32);
-            let set = (x.min(y), x.max(y));
-            let seen = sets.get(..pairs.len()).unwrap_or(&[]);
-            if seen.contains(&set) {
-                if drop(triangles, t) {
-                    duplicates += 1;
-                }
-                continue;
-            }
-            if let Some(s) = sets.get_mut(pairs.len()) {
-                *s = set;
-            }
-            if pairs.push((x, y)).is_err() {
-                full = true;
-                break;
-            }
-        }
-        let kind = if full {
-            duplicates += dedupe_all(triangles, nt, l);
-            flag::LOCKED
-        } else if pairs.is_empty() {
-            flag::GONE
-        } else {
-            let (kind, end) = kind_of(&pairs);
-            if kind == flag::BORDER {
-                set_link(border_next, v, end);
-            }
-            kind
+        let (kind, end) = match fast(triangles, nt, l, v) {
+            Some(r) => r,
+            None => slow(triangles, nt, l, v, &mut duplicates),
         };
+        if kind == flag::BORDER {
+            set_link(border_next, v, end);
+        }
         if kind == flag::LOCKED {
             locked += 1;
         }
@@ -74,6 +39,80 @@ pub(super) fn classify<I: Index, L: Index>(
         }
     }
     (locked, duplicates)
+}
+
+/// The kind of `v` from its fan as listed, when no triangle of the fan can be a duplicate:
+/// two triangles with one vertex set repeat a before-vertex (same winding) or match each
+/// other's spokes (opposite winding), and `kind_of` reports either. `None` then, or for a
+/// fan larger than the buffer.
+#[inline]
+fn fast<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    nt: usize,
+    l: &[L],
+    v: usize,
+) -> Option<(u8, usize)> {
+    let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
+    for &t in l {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let Some(k) = slot(tr, v) else { continue };
+        let (x, y) = others(tr, k);
+        pairs.push((x as u32, y as u32)).ok()?;
+    }
+    if pairs.is_empty() {
+        return Some((flag::GONE, NONE));
+    }
+    let (kind, end, suspect) = kind_of(&pairs);
+    (!suspect).then_some((kind, end))
+}
+
+/// The kind of `v` with its fan's duplicates dropped: lowest triangle first, each vertex set
+/// once (as the ordered pair of the other two vertices); a larger fan is locked (its
+/// duplicates found against its whole list).
+fn slow<I: Index, L: Index>(
+    triangles: &mut [[I; 3]],
+    nt: usize,
+    l: &[L],
+    v: usize,
+    duplicates: &mut usize,
+) -> (u8, usize) {
+    let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
+    let mut sets = [(0u32, 0u32); MAX_FAN];
+    for &t in l.iter().rev() {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let Some(k) = slot(tr, v) else { continue };
+        let (x, y) = others(tr, k);
+        let (x, y) = (x as u32, y as u32);
+        let set = (x.min(y), x.max(y));
+        let seen = sets.get(..pairs.len()).unwrap_or(&[]);
+        if seen.contains(&set) {
+            if drop(triangles, t) {
+                *duplicates += 1;
+            }
+            continue;
+        }
+        if let Some(s) = sets.get_mut(pairs.len()) {
+            *s = set;
+        }
+        if pairs.push((x, y)).is_err() {
+            *duplicates += dedupe_all(triangles, nt, l);
+            return (flag::LOCKED, NONE);
+        }
+    }
+    if pairs.is_empty() {
+        (flag::GONE, NONE)
+    } else {
+        let (kind, end, _) = kind_of(&pairs);
+        (kind, end)
+    }
 }
 
 /// Writes triangle `t` degenerate; whether it was there.
@@ -126,12 +165,12 @@ const SLOTS: usize = 2 * MAX_FAN;
 /// twice or leaves two triangles without one), as many unmatched after- as before-vertices
 /// (at most one: the open ends), and following the matches from the open end (or anywhere)
 /// must visit every triangle. No scratch memory.
-fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize) {
+fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
     let n = pairs.len();
     let hash = |v: u32| (v.wrapping_mul(0x9e37_79b1) >> 26) as usize;
     let mut keys = [u32::MAX; SLOTS];
     let mut vals = [0u8; SLOTS];
-    let mut bad = false;
+    let (mut bad, mut repeated) = (false, false);
     for (j, &(_, y)) in pairs.iter().enumerate() {
         let mut h = hash(y);
         for _ in 0..SLOTS {
@@ -144,7 +183,7 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize) {
                     break;
                 }
                 Some(&k) if k == y => {
-                    bad = true;
+                    repeated = true;
                     break;
                 }
                 _ => h = (h + 1) % SLOTS,
@@ -179,11 +218,19 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize) {
             }
         }
     }
+    bad |= repeated;
+    // Two triangles on each other's spokes: (v, x, y) and (v, y, x).
+    let twins = next
+        .iter()
+        .take(n)
+        .enumerate()
+        .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i));
     let all = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
     let open = all & !seen;
     let open_in = open.count_ones();
+    let suspect = repeated || twins;
     if bad || open_out != open_in || open_out > 1 {
-        return (flag::LOCKED, NONE);
+        return (flag::LOCKED, NONE, suspect);
     }
     let start = if open == 0 {
         0
@@ -199,10 +246,10 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize) {
         }
     }
     if steps != n {
-        (flag::LOCKED, NONE)
+        (flag::LOCKED, NONE, suspect)
     } else if open_out == 1 {
-        (flag::BORDER, end)
+        (flag::BORDER, end, suspect)
     } else {
-        (flag::MANIFOLD, NONE)
+        (flag::MANIFOLD, NONE, suspect)
     }
 }
