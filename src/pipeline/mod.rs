@@ -90,7 +90,7 @@ pub(crate) mod flag {
 /// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
 /// * `V`, `T`: the largest mesh it takes (vertices, triangles).
 ///
-/// Per vertex: a quadric (10 `f32`, 40 B), four links (fan list start, border successor,
+/// Per vertex: a quadric (10 `f32`, 40 B), four links (fan list end, border successor,
 /// candidate target, sort slot), a candidate cost (`f32`) and a flag byte; per triangle three
 /// fan list entries (one per corner); plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
 /// `V ≈ T/2` that is about 32.5 bytes per triangle ([`FastWorkspace::BYTES`]).
