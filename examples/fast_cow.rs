@@ -61,6 +61,12 @@ fn main() {
         "{path}: {} -> {} triangles, {} collapses, {} passes, {:?} in {dt:?}",
         r.triangles_in, r.triangles_out, r.collapses, r.passes, r.stop
     );
+    if std::env::var("FAST_COW_DEBUG").is_ok() {
+        println!(
+            "passes {:?} rejected [{}] locked {} duplicates {}",
+            r.pass_triangles, r.rejected, r.locked_vertices, r.duplicates_dropped
+        );
+    }
     // `FAST_COW_REPS=n`: the best of n more runs (host time).
     if let Some(n) = std::env::var("FAST_COW_REPS")
         .ok()

@@ -1,6 +1,6 @@
-//! build: validation (before anything is written), corner lists, duplicate triangles.
+//! build: validation (before anything is written), fan lists.
 
-use super::{link as get_link, slot, tri, Frame, NONE};
+use super::{bump_end, set_end, Frame};
 use crate::error::Capacity;
 use crate::index::Index;
 use crate::Error;
@@ -69,64 +69,33 @@ pub(super) fn validate<'p, I: Index>(
     })
 }
 
-/// Corner lists of the first `nt` triangles: `head[v]` the first triangle holding `v`,
-/// `next[t][k]` the next triangle holding `t`'s vertex in slot `k`. Each list runs from the
-/// highest triangle number down.
+/// Fan lists of the first `nt` triangles (a counting sort of their corners by vertex, as
+/// meshoptimizer's `buildTriangleAdjacency`), from the corner counts that compact left in
+/// `first`: `v`'s list is `lists[end(v - 1)..end(v)]`, its triangles from the highest number
+/// down.
 #[inline(never)]
 pub(super) fn link<I: Index, L: Index>(
     triangles: &[[I; 3]],
     nt: usize,
-    head: &mut [L],
-    next: &mut [[L; 3]],
+    first: &mut [L],
+    flags: &mut [u8],
+    lists: &mut [L],
 ) {
-    for h in head.iter_mut() {
-        *h = L::NIL;
+    let tris = triangles.get(..nt).unwrap_or(&[]);
+    // Each list's start from the counts (at most nt each, so they fit a link).
+    let mut sum = 0;
+    for v in 0..first.len() {
+        let c = first.get(v).map_or(0, |c| c.to_usize());
+        set_end(first, flags, v, sum);
+        sum += c;
     }
-    for (t, (tr, n)) in triangles.iter().zip(next.iter_mut()).take(nt).enumerate() {
-        for (i, nk) in tr.iter().zip(n.iter_mut()) {
-            let v = i.to_usize();
-            if let Some(h) = head.get_mut(v) {
-                *nk = *h;
-                *h = L::narrow(t);
+    // Filled from the start up, highest triangle first: each end ends where it belongs.
+    for (t, tr) in tris.iter().enumerate().rev() {
+        for i in tr {
+            let s = bump_end(first, flags, i.to_usize());
+            if let Some(x) = lists.get_mut(s) {
+                *x = L::narrow(t);
             }
         }
     }
-}
-
-/// Marks every triangle with the vertex set of a lower-numbered one (either winding: a
-/// repeated copy, or the back of a double-sided triangle) by writing it degenerate; returns
-/// how many. Highest first: a list walk from triangle `t` visits only lower numbers, which
-/// are not yet written.
-#[inline(never)]
-pub(super) fn dedupe<I: Index, L: Index>(
-    triangles: &mut [[I; 3]],
-    nt: usize,
-    next: &[[L; 3]],
-) -> usize {
-    let mut count = 0;
-    for t in (0..nt).rev() {
-        let tr = tri(triangles, t);
-        let v = tr[0];
-        let mut u = next.get(t).map_or(NONE, |n| get_link(n, 0));
-        let mut guard = nt;
-        let mut dup = false;
-        while u != NONE && guard > 0 {
-            guard -= 1;
-            let s = tri(triangles, u);
-            if slot(s, tr[1]).is_some() && slot(s, tr[2]).is_some() {
-                dup = true;
-                break;
-            }
-            let Some(k) = slot(s, v) else { break };
-            u = next.get(u).map_or(NONE, |n| get_link(n, k));
-        }
-        if dup {
-            if let Some(x) = triangles.get_mut(t) {
-                x[1] = x[0];
-                x[2] = x[0];
-            }
-            count += 1;
-        }
-    }
-    count
 }

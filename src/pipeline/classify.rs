@@ -1,53 +1,32 @@
 //! classify: each vertex's kind from its fan (meshoptimizer's `classifyVertices`, without
 //! seams): manifold (one closed disk), border (one open fan; `border_next` is the vertex
 //! across its open out-edge), locked (anything else: an edge with more than two triangles or
-//! two wound the same way, or a pinched fan), gone (no triangle).
+//! two wound the same way, or a pinched fan), gone (no triangle); and duplicate triangles
+//! dropped on the way.
 
-use super::{fan, flag, link, others, set_link, NONE};
+use super::{dead, flag, list, others, set_link, slot, tri, NONE};
 use crate::index::Index;
 
-/// Writes every vertex's kind and border successor; returns the number of locked vertices. `scratch`: two links per vertex,
-/// contents on entry and exit meaningless.
+/// Writes every vertex's kind and border successor, and drops duplicate triangles: every
+/// triangle with the vertex set of a lower-numbered one (either winding: a repeated copy, or
+/// the back of a double-sided triangle) is written degenerate, seen from any of its vertices
+/// (a duplicate is in all three fans with its original) and left out of the kinds. Returns
+/// the numbers of locked vertices and of duplicates.
 #[inline(never)]
 pub(super) fn classify<I: Index, L: Index>(
-    triangles: &[[I; 3]],
+    triangles: &mut [[I; 3]],
     nt: usize,
-    head: &[L],
-    next: &[[L; 3]],
+    (first, lists): (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    (counts, across): (&mut [L], &mut [L]),
-) -> usize {
-    let tris = triangles.get(..nt).unwrap_or(&[]);
-    for c in counts.iter_mut() {
-        *c = L::ZERO;
-    }
-    let mut locked = 0;
-    for (v, f) in flags.iter_mut().enumerate() {
+) -> (usize, usize) {
+    let (mut locked, mut duplicates) = (0, 0);
+    for v in 0..flags.len() {
         set_link(border_next, v, NONE);
-        if link(head, v) == NONE {
-            *f = flag::GONE;
-            continue;
-        }
-        // The fan as (after, before) pairs; a larger fan is locked.
-        let mut pairs = [(0u32, 0u32); MAX_FAN];
-        let mut count = 0usize;
-        for (_, tr, k) in fan(tris, next, head, v) {
-            match pairs.get_mut(count) {
-                Some(p) => {
-                    let (x, y) = others(tr, k);
-                    *p = (x as u32, y as u32);
-                }
-                None => {
-                    count = MAX_FAN + 1;
-                    break;
-                }
-            }
-            count += 1;
-        }
-        let (kind, end) = match pairs.get(..count) {
-            Some(pairs) => kind_of(pairs, counts, across),
-            None => (flag::LOCKED, NONE),
+        let l = list(first, flags, lists, v);
+        let (kind, end) = match fast(triangles, nt, l, v) {
+            Some(r) => r,
+            None => slow(triangles, nt, l, v, &mut duplicates),
         };
         if kind == flag::BORDER {
             set_link(border_next, v, end);
@@ -55,79 +34,222 @@ pub(super) fn classify<I: Index, L: Index>(
         if kind == flag::LOCKED {
             locked += 1;
         }
-        *f = kind;
+        if let Some(f) = flags.get_mut(v) {
+            *f = (*f & flag::HIGH) | kind;
+        }
     }
-    locked
+    (locked, duplicates)
+}
+
+/// The kind of `v` from its fan as listed, when no triangle of the fan can be a duplicate:
+/// two triangles with one vertex set repeat a before-vertex (same winding) or match each
+/// other's spokes (opposite winding), and `kind_of` reports either. `None` then, or for a
+/// fan larger than the buffer.
+#[inline]
+fn fast<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    nt: usize,
+    l: &[L],
+    v: usize,
+) -> Option<(u8, usize)> {
+    let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
+    for &t in l {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let Some(k) = slot(tr, v) else { continue };
+        let (x, y) = others(tr, k);
+        pairs.push((x as u32, y as u32)).ok()?;
+    }
+    if pairs.is_empty() {
+        return Some((flag::GONE, NONE));
+    }
+    let (kind, end, suspect) = kind_of(&pairs);
+    (!suspect).then_some((kind, end))
+}
+
+/// The kind of `v` with its fan's duplicates dropped: lowest triangle first, each vertex set
+/// once (as the ordered pair of the other two vertices); a larger fan is locked (its
+/// duplicates found against its whole list).
+fn slow<I: Index, L: Index>(
+    triangles: &mut [[I; 3]],
+    nt: usize,
+    l: &[L],
+    v: usize,
+    duplicates: &mut usize,
+) -> (u8, usize) {
+    let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
+    let mut sets = [(0u32, 0u32); MAX_FAN];
+    for &t in l.iter().rev() {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let Some(k) = slot(tr, v) else { continue };
+        let (x, y) = others(tr, k);
+        let (x, y) = (x as u32, y as u32);
+        let set = (x.min(y), x.max(y));
+        let seen = sets.get(..pairs.len()).unwrap_or(&[]);
+        if seen.contains(&set) {
+            if drop(triangles, t) {
+                *duplicates += 1;
+            }
+            continue;
+        }
+        if let Some(s) = sets.get_mut(pairs.len()) {
+            *s = set;
+        }
+        if pairs.push((x, y)).is_err() {
+            *duplicates += dedupe_all(triangles, nt, l);
+            return (flag::LOCKED, NONE);
+        }
+    }
+    if pairs.is_empty() {
+        (flag::GONE, NONE)
+    } else {
+        let (kind, end, _) = kind_of(&pairs);
+        (kind, end)
+    }
+}
+
+/// Writes triangle `t` degenerate; whether it was there.
+#[inline]
+fn drop<I: Index>(triangles: &mut [[I; 3]], t: usize) -> bool {
+    match triangles.get_mut(t) {
+        Some(x) => {
+            x[1] = x[0];
+            x[2] = x[0];
+            true
+        }
+        None => false,
+    }
+}
+
+/// Duplicates in a fan too large for the pair buffer, against the whole list; returns how many
+/// were dropped.
+fn dedupe_all<I: Index, L: Index>(triangles: &mut [[I; 3]], nt: usize, l: &[L]) -> usize {
+    let mut count = 0;
+    for &t in l {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let dup = l.iter().any(|u| {
+            let u = u.to_usize();
+            u < t && {
+                let s = tri(triangles, u);
+                !dead(s) && tr.iter().all(|&w| slot(s, w).is_some())
+            }
+        });
+        if dup && drop(triangles, t) {
+            count += 1;
+        }
+    }
+    count
 }
 
 /// Fans larger than this are locked.
 const MAX_FAN: usize = 32;
 
-/// Per neighbour in `counts`: triangles with it after v (low byte) and before v (times 256).
-const IN: usize = 256;
-
-#[inline]
-fn bump<L: Index>(s: &mut [L], v: usize, by: usize) {
-    if let Some(c) = s.get_mut(v) {
-        *c = L::narrow(c.to_usize() + by);
-    }
-}
+/// Slots of the small hash table of a fan's before-vertices (twice the largest fan).
+const SLOTS: usize = 2 * MAX_FAN;
 
 /// The kind of a vertex from its fan's (after, before) pairs, and for a border vertex the
-/// vertex across its open out-edge. Linear: each neighbour's counts of triangles with it after
-/// and before v in `counts`, and in `across` the pair with it before v (left zero / stale).
-fn kind_of<L: Index>(pairs: &[(u32, u32)], counts: &mut [L], across: &mut [L]) -> (u8, usize) {
-    for (i, &(x, y)) in pairs.iter().enumerate() {
-        let (x, y) = (x as usize, y as usize);
-        bump(counts, x, 1);
-        bump(counts, y, IN);
-        set_link(across, y, i);
-    }
-    let (mut open_out, mut open_in, mut start, mut end, mut bad) = (0, 0, 0, NONE, false);
-    for (i, &(x, y)) in pairs.iter().enumerate() {
-        let (x, y) = (x as usize, y as usize);
-        let (cx, cy) = (link(counts, x), link(counts, y));
-        // x: once after v, at most once before; y: once before, at most once after.
-        if cx % IN != 1 || cx / IN > 1 || cy / IN != 1 || cy % IN > 1 {
-            bad = true;
-        }
-        if cx / IN == 0 {
-            open_out += 1;
-            end = x;
-        }
-        if cy % IN == 0 {
-            open_in += 1;
-            start = i;
-        }
-    }
-    let mut steps = 0usize;
-    if !bad && open_out == open_in && open_out <= 1 {
-        // One fan? Walk it across its spokes from the open end (or anywhere): the triangle
-        // across spoke v-x has x before v.
-        let mut cur = start;
-        while steps <= pairs.len() {
-            steps += 1;
-            let Some(&(x, _)) = pairs.get(cur) else { break };
-            let x = x as usize;
-            if link(counts, x) / IN == 0 {
-                break;
+/// vertex across its open out-edge. The triangle across spoke v-x is the one with x before v,
+/// found in a small hash table of the before-vertices. Manifold or border needs each
+/// before-vertex once and each match taken once (a repeated after-vertex either takes a match
+/// twice or leaves two triangles without one), as many unmatched after- as before-vertices
+/// (at most one: the open ends), and following the matches from the open end (or anywhere)
+/// must visit every triangle. No scratch memory.
+fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
+    let n = pairs.len();
+    let hash = |v: u32| (v.wrapping_mul(0x9e37_79b1) >> 26) as usize;
+    let mut keys = [u32::MAX; SLOTS];
+    let mut vals = [0u8; SLOTS];
+    let (mut bad, mut repeated) = (false, false);
+    for (j, &(_, y)) in pairs.iter().enumerate() {
+        let mut h = hash(y);
+        for _ in 0..SLOTS {
+            match keys.get(h) {
+                Some(&k) if k == u32::MAX => {
+                    if let (Some(k), Some(v)) = (keys.get_mut(h), vals.get_mut(h)) {
+                        *k = y;
+                        *v = j as u8;
+                    }
+                    break;
+                }
+                Some(&k) if k == y => {
+                    repeated = true;
+                    break;
+                }
+                _ => h = (h + 1) % SLOTS,
             }
-            let j = link(across, x);
-            if j == start {
-                break;
-            }
-            cur = j;
         }
     }
-    for &(x, y) in pairs {
-        set_link(counts, x as usize, 0);
-        set_link(counts, y as usize, 0);
+    let mut next = [u8::MAX; MAX_FAN];
+    let (mut seen, mut open_out, mut end) = (0u32, 0, NONE);
+    for (&(x, _), nx) in pairs.iter().zip(next.iter_mut()) {
+        let mut h = hash(x);
+        let mut found = None;
+        for _ in 0..SLOTS {
+            match keys.get(h) {
+                Some(&k) if k == x => {
+                    found = vals.get(h).copied();
+                    break;
+                }
+                Some(&k) if k != u32::MAX => h = (h + 1) % SLOTS,
+                _ => break,
+            }
+        }
+        match found {
+            Some(j) => {
+                let bit = 1u32.checked_shl(j as u32).unwrap_or(0);
+                bad |= seen & bit != 0;
+                seen |= bit;
+                *nx = j;
+            }
+            None => {
+                open_out += 1;
+                end = x as usize;
+            }
+        }
     }
-    if bad || open_out != open_in || open_out > 1 || steps != pairs.len() {
-        (flag::LOCKED, NONE)
-    } else if open_out == 1 {
-        (flag::BORDER, end)
+    bad |= repeated;
+    // Two triangles on each other's spokes: (v, x, y) and (v, y, x).
+    let twins = next
+        .iter()
+        .take(n)
+        .enumerate()
+        .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i));
+    let all = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    let open = all & !seen;
+    let open_in = open.count_ones();
+    let suspect = repeated || twins;
+    if bad || open_out != open_in || open_out > 1 {
+        return (flag::LOCKED, NONE, suspect);
+    }
+    let start = if open == 0 {
+        0
     } else {
-        (flag::MANIFOLD, NONE)
+        31 - open.leading_zeros() as usize
+    };
+    let (mut cur, mut steps) = (start, 0usize);
+    while steps <= n {
+        steps += 1;
+        match next.get(cur) {
+            Some(&j) if (j as usize) < n && j as usize != start => cur = j as usize,
+            _ => break,
+        }
+    }
+    if steps != n {
+        (flag::LOCKED, NONE, suspect)
+    } else if open_out == 1 {
+        (flag::BORDER, end, suspect)
+    } else {
+        (flag::MANIFOLD, NONE, suspect)
     }
 }

@@ -1,24 +1,36 @@
 //! compact: the live triangles to the front of the buffer (meshoptimizer's
 //! `remapIndexBuffer`; the collapses already wrote their targets), and the pass's locks off.
 
-use super::{dead, flag, tri};
+use super::{dead, flag};
 use crate::index::Index;
 
-/// Moves the triangles of the first `nt` without a repeated index to the front, in order;
-/// returns how many there are and how many were dropped.
+/// Moves the triangles of the first `nt` without a repeated index to the front, in order,
+/// counting their corners per vertex in `counts` (the fan lists' first pass); returns how
+/// many there are and how many were dropped.
 #[inline(never)]
-pub(super) fn compact<I: Index>(triangles: &mut [[I; 3]], nt: usize) -> (usize, usize) {
+pub(super) fn compact<I: Index, L: Index>(
+    triangles: &mut [[I; 3]],
+    nt: usize,
+    counts: &mut [L],
+) -> (usize, usize) {
+    for c in counts.iter_mut() {
+        *c = L::ZERO;
+    }
     let mut w = 0;
     for r in 0..nt {
-        let tr = tri(triangles, r);
+        let Some(&x) = triangles.get(r) else { break };
+        let tr = [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()];
         if dead(tr) {
             continue;
         }
+        for v in tr {
+            if let Some(c) = counts.get_mut(v) {
+                *c = L::narrow(c.to_usize() + 1);
+            }
+        }
         if w != r {
-            if let Some(&x) = triangles.get(r) {
-                if let Some(y) = triangles.get_mut(w) {
-                    *y = x;
-                }
+            if let Some(y) = triangles.get_mut(w) {
+                *y = x;
             }
         }
         w += 1;
@@ -30,6 +42,6 @@ pub(super) fn compact<I: Index>(triangles: &mut [[I; 3]], nt: usize) -> (usize, 
 #[inline(never)]
 pub(super) fn unlock(flags: &mut [u8]) {
     for f in flags.iter_mut() {
-        *f &= flag::KIND;
+        *f &= flag::KIND | flag::HIGH;
     }
 }

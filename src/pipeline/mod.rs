@@ -14,14 +14,15 @@
 //! vertex), so the positions are only read and may stay in flash.
 //!
 //! ```text
-//! build     validate, drop degenerate and duplicate triangles, corner lists
-//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex
+//! build     validate, drop degenerate triangles, fan lists
+//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex;
+//!           drop duplicate triangles
 //! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics
 //! loop {
 //!   pick      each vertex's cheapest collapse its kind allows, from its quadric
 //!   sort      counting sort on the cost's top 12 bits
 //!   perform   in order, to the pass's error goal: skip locked ends, check, collapse, lock both
-//!   compact   drop dead triangles, rebuild the corner lists
+//!   compact   drop dead triangles, rebuild the fan lists
 //! }
 //! ```
 //!
@@ -82,6 +83,10 @@ pub(crate) mod flag {
     pub const PASS: u8 = 4;
     /// Scratch mark (the link condition).
     pub const MARK: u8 = 8;
+    /// The bits of a fan list's start above the link type's width (see [`super::start`]).
+    pub const HIGH: u8 = 0xf0;
+    /// Shift of [`HIGH`].
+    pub const HIGH_SHIFT: u32 = 4;
 }
 
 /// The fast mode's working memory, sized at compile time (it can be a `static`).
@@ -89,19 +94,19 @@ pub(crate) mod flag {
 /// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
 /// * `V`, `T`: the largest mesh it takes (vertices, triangles).
 ///
-/// Per vertex: a quadric (10 `f32`, 40 B), four links (corner-list head, border successor,
+/// Per vertex: a quadric (10 `f32`, 40 B), four links (fan list end, border successor,
 /// candidate target, sort slot), a candidate cost (`f32`) and a flag byte; per triangle three
-/// corner links; plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
+/// fan list entries (one per corner); plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
 /// `V ≈ T/2` that is about 32.5 bytes per triangle ([`FastWorkspace::BYTES`]).
 pub struct FastWorkspace<L: Index, const V: usize, const T: usize> {
     quadrics: [VertexQuadric; V],
-    head: [L; V],
+    first: [L; V],
     border_next: [L; V],
     target: [L; V],
     cost: [f32; V],
     order: [L; V],
     flags: [u8; V],
-    next: [[L; 3]; T],
+    lists: [[L; 3]; T],
     histogram: [L; BINS],
 }
 
@@ -195,13 +200,71 @@ pub(crate) fn flags_of(f: &[u8], v: usize) -> u8 {
     f.get(v).copied().unwrap_or(flag::GONE)
 }
 
-/// The triangles around one vertex: its corner list, one corner per triangle that holds it.
+/// Bits of the link type `L`.
+#[inline]
+const fn bits<L>() -> u32 {
+    (core::mem::size_of::<L>() * 8) as u32
+}
+
+/// Where `v`'s fan list ends in the fan lists (or, while they are built, the next free
+/// entry): its low bits in `first[v]`, the bits above the link type's width in `v`'s flag
+/// byte (3·T entries need two more bits than a `u16` link has, and the flag byte has four
+/// spare).
+#[inline]
+pub(crate) fn end<L: Index>(first: &[L], flags: &[u8], v: usize) -> usize {
+    let lo = first.get(v).map_or(0, |l| l.to_usize());
+    let hi = (flags_of(flags, v) >> flag::HIGH_SHIFT) as usize;
+    lo | hi.checked_shl(bits::<L>()).unwrap_or(0)
+}
+
+/// Sets `v`'s list end (below `16 << bits(L)`).
+#[inline]
+pub(crate) fn set_end<L: Index>(first: &mut [L], flags: &mut [u8], v: usize, s: usize) {
+    let hi = s.checked_shr(bits::<L>()).unwrap_or(0);
+    let lo = s ^ hi.checked_shl(bits::<L>()).unwrap_or(0);
+    if let Some(l) = first.get_mut(v) {
+        *l = L::narrow(lo);
+    }
+    if let Some(f) = flags.get_mut(v) {
+        *f = (*f & !flag::HIGH) | ((hi as u8) << flag::HIGH_SHIFT);
+    }
+}
+
+/// Adds one to `v`'s list end, returning the old value.
+#[inline]
+pub(crate) fn bump_end<L: Index>(first: &mut [L], flags: &mut [u8], v: usize) -> usize {
+    let (Some(l), Some(f)) = (first.get_mut(v), flags.get_mut(v)) else {
+        return NONE;
+    };
+    let lo = l.to_usize();
+    let hi = (*f >> flag::HIGH_SHIFT) as usize;
+    let old = lo | hi.checked_shl(bits::<L>()).unwrap_or(0);
+    match L::from_usize(lo + 1) {
+        Some(n) if lo + 1 < L::COUNT => *l = n,
+        _ if lo + 1 == L::COUNT => *l = L::NIL,
+        _ => {
+            *l = L::ZERO;
+            *f = f.wrapping_add(1 << flag::HIGH_SHIFT);
+        }
+    }
+    old
+}
+
+/// The triangle numbers around `v` (its fan list, highest first).
+#[inline]
+pub(crate) fn list<'m, L: Index>(first: &[L], flags: &[u8], lists: &'m [L], v: usize) -> &'m [L] {
+    let s = match v.checked_sub(1) {
+        Some(u) => end(first, flags, u),
+        None => 0,
+    };
+    lists.get(s..end(first, flags, v)).unwrap_or(&[])
+}
+
+/// The triangles around one vertex, from its fan list.
 pub(crate) struct Fan<'m, L: Index, I: Index> {
     tris: &'m [[I; 3]],
-    next: &'m [[L; 3]],
+    list: core::slice::Iter<'m, L>,
     v: usize,
-    t: usize,
-    guard: usize,
 }
 
 impl<L: Index, I: Index> Iterator for Fan<'_, L, I> {
@@ -210,35 +273,25 @@ impl<L: Index, I: Index> Iterator for Fan<'_, L, I> {
 
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
-        if self.guard == 0 {
-            return None;
-        }
-        self.guard -= 1;
-        let t = self.t;
+        let t = self.list.next()?.to_usize();
         let tr = tri(self.tris, t);
         let k = slot(tr, self.v)?;
-        self.t = match self.next.get(t).and_then(|n| n.get(k)) {
-            Some(&l) if l != L::NIL => l.to_usize(),
-            _ => NONE,
-        };
         Some((t, tr, k))
     }
 }
 
-/// The fan of `v`, from its list head.
+/// The fan of `v`.
 #[inline]
 pub(crate) fn fan<'m, L: Index, I: Index>(
     tris: &'m [[I; 3]],
-    next: &'m [[L; 3]],
-    head: &[L],
+    (first, lists): (&[L], &'m [L]),
+    flags: &[u8],
     v: usize,
 ) -> Fan<'m, L, I> {
     Fan {
         tris,
-        next,
+        list: list(first, flags, lists, v).iter(),
         v,
-        t: link(head, v),
-        guard: tris.len(),
     }
 }
 
@@ -265,13 +318,13 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     pub const fn new() -> Self {
         FastWorkspace {
             quadrics: [[0.0; 10]; V],
-            head: [L::ZERO; V],
+            first: [L::ZERO; V],
             border_next: [L::ZERO; V],
             target: [L::ZERO; V],
             cost: [0.0; V],
             order: [L::ZERO; V],
             flags: [0; V],
-            next: [[L::ZERO; 3]; T],
+            lists: [[L::ZERO; 3]; T],
             histogram: [L::ZERO; BINS],
         }
     }
@@ -304,18 +357,19 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         };
         let FastWorkspace {
             quadrics,
-            head,
+            first,
             border_next,
             target,
             cost,
             order,
             flags,
-            next,
+            lists,
             histogram,
         } = self;
+        let lists = lists.as_flattened_mut();
         let (
             Some(quadrics),
-            Some(head),
+            Some(first),
             Some(border_next),
             Some(target),
             Some(cost),
@@ -323,7 +377,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             Some(flags),
         ) = (
             quadrics.get_mut(..nv),
-            head.get_mut(..nv),
+            first.get_mut(..nv),
             border_next.get_mut(..nv),
             target.get_mut(..nv),
             cost.get_mut(..nv),
@@ -336,25 +390,22 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         let triangles_in = triangles.len();
 
         // build
-        let (mut nt, degenerate) = compact::compact(triangles, triangles_in);
-        build::link(triangles, nt, head, next);
-        let duplicates = build::dedupe(triangles, nt, next);
-        if duplicates > 0 {
-            nt = compact::compact(triangles, nt).0;
-            build::link(triangles, nt, head, next);
-        }
-        let valid = nt;
+        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, first);
+        build::link(triangles, nt, first, flags, lists);
 
-        // classify
-        let locked = classify::classify(
+        // classify (and duplicates)
+        let (locked, duplicates) = classify::classify(
             triangles,
             nt,
-            head,
-            next,
+            (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
-            (&mut *target, &mut *order),
         );
+        if duplicates > 0 {
+            nt = compact::compact(triangles, nt, first).0;
+            build::link(triangles, nt, first, flags, lists);
+        }
+        let valid = nt;
 
         // fill
         fill::face_quadrics(&frame, triangles, nt, quadrics);
@@ -375,8 +426,18 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 break Stop::MaxPasses;
             }
             let tris = triangles.get(..nt).unwrap_or(&[]);
-            pick::pick(&frame, tris, flags, border_next, quadrics, target, cost);
-            let m = sort::sort(flags, target, cost, order, histogram);
+            let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
+            pick::pick(
+                &frame,
+                tris,
+                adj,
+                flags,
+                border_next,
+                quadrics,
+                (&mut *target, &mut *cost),
+                histogram,
+            );
+            let m = sort::sort(target, cost, order, histogram);
             if m == 0 {
                 break Stop::NoLegalCollapse;
             }
@@ -386,18 +447,16 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             let done = perform::perform(
                 &frame,
                 tris,
-                (&*head, &*next),
+                (&*first, lists.get(..3 * nt).unwrap_or(&[])),
                 flags,
                 border_next,
                 quadrics,
-                (&*target, &*cost, order.get(..m).unwrap_or(&[])),
+                (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
                 (goal, limit),
                 &mut stats,
             );
             passes += 1;
-            nt = compact::compact(triangles, nt).0;
-            build::link(triangles, nt, head, next);
-            compact::unlock(flags);
+            nt = compact::compact(triangles, nt, first).0;
             let _ = pass_triangles.push(nt as u32);
             if done == 0 {
                 break if stats.over_limit > refused {
@@ -405,6 +464,11 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 } else {
                     Stop::NoLegalCollapse
                 };
+            }
+            // No fan lists for a pass that will not run.
+            if nt > target_triangles && passes < config.max_passes {
+                build::link(triangles, nt, first, flags, lists);
+                compact::unlock(flags);
             }
         };
         let collapse_error = if config.error_limit.is_finite() {

@@ -24,7 +24,9 @@
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
 //! degenerate: compact drops them), adds a's quadric to b's, and locks both ends.
 
-use super::{dead, fan, flag, flags_of, link, others, set_link, slot, tri, Frame, Stats, NONE};
+use super::{
+    dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
+};
 use crate::index::Index;
 use crate::legality::Reject;
 use crate::math::{self, V3};
@@ -45,17 +47,11 @@ fn normal(p: [V3; 3]) -> V3 {
     math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
 }
 
-/// The positions of `tr` after `a` moves onto `b` (at `pb`).
-#[inline]
-fn after(frame: &Frame<'_>, tr: [usize; 3], a: usize, pb: V3) -> [V3; 3] {
-    tr.map(|v| if v == a { pb } else { frame.at(v) })
-}
-
 /// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
 /// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
 /// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
 /// frame.
-#[inline]
+#[inline(always)]
 fn folded(n1: V3, n2: V3) -> bool {
     let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
     // Written so that NaN refuses too.
@@ -115,11 +111,11 @@ fn error(quadrics: &[VertexQuadric], a: usize, c: f32) -> f32 {
 pub(super) fn perform<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &mut [[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
-    (target, cost, order): (&[L], &[f32], &[L]),
+    (target, cost, order): (&mut [L], &[f32], &[L]),
     (goal, limit): (usize, f32),
     stats: &mut Stats,
 ) -> usize {
@@ -151,12 +147,14 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        if let Err(r) = check(frame, tris, (head, next), flags, a, b) {
+        if let Err(r) = check(frame, tris, adj, flags, target, a, b) {
             stats.rejected.count(r);
             edge_goal += 1;
             continue;
         }
-        removed += collapse(tris, (head, next), flags, border_next, quadrics, a, b);
+        removed += collapse(tris, adj, flags, border_next, quadrics, a, b);
+        // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
+        set_link(target, b, a);
         done += 1;
         if c > worst {
             worst = c;
@@ -169,14 +167,16 @@ pub(super) fn perform<I: Index, L: Index>(
     done
 }
 
-/// A surviving triangle of a's fan: its number, its other vertices (after and before a) and
-/// its normal after the collapse.
+/// A surviving triangle of a's fan: its number, its other vertices (after and before a), their
+/// positions and its normal after the collapse.
 #[derive(Clone, Copy)]
 struct Survivor {
     t: u32,
     x: u32,
     y: u32,
     n: V3,
+    px: V3,
+    py: V3,
 }
 
 impl Survivor {
@@ -202,8 +202,9 @@ const MAX_FAN: usize = 32;
 fn check<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
+    target: &[L],
     a: usize,
     b: usize,
 ) -> Result<(), Reject> {
@@ -220,14 +221,10 @@ fn check<I: Index, L: Index>(
     // 1 and 2. One walk of a's fan: the vertices opposite a-b (o1 in (a, b, o1), o2 in
     // (a, o2, b)), and each survivor's flip and area.
     let (pa, pb) = (frame.at(a), frame.at(b));
-    let mut fan_a = [Survivor {
-        t: 0,
-        x: 0,
-        y: 0,
-        n: [0.0; 3],
-    }; MAX_FAN];
-    let (mut ns, mut o1, mut o2, mut n_ab, mut na) = (0, NONE, NONE, 0, 0);
-    for (t, tr, k) in fan(tris, next, head, a) {
+    // Not zeroed: a fan rarely fills it.
+    let mut fan_a = heapless::Vec::<Survivor, MAX_FAN>::new();
+    let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
+    for (t, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
         }
@@ -257,20 +254,19 @@ fn check<I: Index, L: Index>(
         if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
             return Err(Reject::NormalTurn);
         }
-        match fan_a.get_mut(ns) {
-            Some(slot) => {
-                *slot = Survivor {
-                    t: t as u32,
-                    x: x as u32,
-                    y: y as u32,
-                    n: n1,
-                }
-            }
-            None => return Err(Reject::Locked),
+        let s = Survivor {
+            t: t as u32,
+            x: x as u32,
+            y: y as u32,
+            n: n1,
+            px,
+            py,
+        };
+        if fan_a.push(s).is_err() {
+            return Err(Reject::Locked);
         }
-        ns += 1;
     }
-    let fan_a = fan_a.get(..ns).unwrap_or(&[]);
+    let fan_a = fan_a.as_slice();
     let want = if ka == flag::BORDER { 1 } else { 2 };
     let want = if const { on(RULE_BORDER) } {
         want
@@ -295,7 +291,7 @@ fn check<I: Index, L: Index>(
     let mut verdict = Ok(());
     let (mut nb, mut on_o1, mut on_o2, mut opposite) = (0, 0, 0, false);
     let (mut across1, mut across2) = (NONE, NONE);
-    for (t, tr, k) in fan(tris, next, head, b) {
+    for (t, tr, k) in fan(tris, adj, flags, b) {
         if dead(tr) {
             continue;
         }
@@ -346,37 +342,71 @@ fn check<I: Index, L: Index>(
     }
 
     // 4. Folds: each survivor against its neighbours after the collapse.
-    let unchanged = |t: usize| normal(tri(tris, t).map(|v| frame.at(v)));
+    // b's triangle across b-o1 (or b-o2): b and o1 at their known positions.
+    let unchanged = |t: usize, o: usize, po: V3| {
+        normal(tri(tris, t).map(|v| {
+            if v == b {
+                pb
+            } else if v == o {
+                po
+            } else {
+                frame.at(v)
+            }
+        }))
+    };
     for s in fan_a {
         // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
         // the one on a-o1 dies; across the spoke to o2 likewise.
         let spoke = match fan_a.iter().find(|u| u.y == s.x) {
             Some(u) => folded(s.n, u.n),
-            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1)),
+            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1, o1, s.px)),
             None => false,
         };
         if spoke {
             return Err(Reject::Fold);
         }
-        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2)) {
+        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2, o2, s.py)) {
             return Err(Reject::Fold);
         }
-        // Across the outer edge x-y: searched from an end whose list is current.
-        let (from, other) = if flags_of(flags, s.x()) & flag::PASS == 0 {
-            (s.x(), s.y())
+        // Across the outer edge x-y: searched in the list of an end that has not moved or
+        // been moved onto in this pass, else in x's list and the list of the vertex that
+        // moved onto x (all of x's triangles now).
+        let (from, other, also) = if flags_of(flags, s.x()) & flag::PASS == 0 {
+            (s.x(), s.y(), NONE)
         } else if flags_of(flags, s.y()) & flag::PASS == 0 {
-            (s.y(), s.x())
+            (s.y(), s.x(), NONE)
         } else {
-            return Err(Reject::Fold);
+            (s.x(), s.y(), link(target, s.x()))
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
-        for (u, tr, _) in fan(tris, next, head, from) {
-            if u != s.t() && !dead(tr) && slot(tr, other).is_some() {
-                if folded(s.n, normal(after(frame, tr, a, pb))) {
-                    return Err(Reject::Fold);
+        'search: for v in [from, also] {
+            if v == NONE {
+                break;
+            }
+            for &u in list(adj.0, flags, adj.1, v) {
+                let u = u.to_usize();
+                if u == s.t() {
+                    continue;
                 }
-                if manifold {
-                    break;
+                let tr = tri(tris, u);
+                if slot(tr, other).is_some() && !dead(tr) {
+                    let p = tr.map(|v| {
+                        if v == s.x() {
+                            s.px
+                        } else if v == s.y() {
+                            s.py
+                        } else if v == a {
+                            pb
+                        } else {
+                            frame.at(v)
+                        }
+                    });
+                    if folded(s.n, normal(p)) {
+                        return Err(Reject::Fold);
+                    }
+                    if manifold {
+                        break 'search;
+                    }
                 }
             }
         }
@@ -400,7 +430,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
     tris: &mut [[I; 3]],
-    (head, next): (&[L], &[[L; 3]]),
+    adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
@@ -412,10 +442,10 @@ fn collapse<I: Index, L: Index>(
             // ... p → a → b ...: p's open edge now ends at b. p is the neighbour before a
             // that no triangle of a has after it.
             let mut p = NONE;
-            for (_, tr, k) in fan(tris, next, head, a) {
+            for (_, tr, k) in fan(tris, adj, flags, a) {
                 let (_, y) = others(tr, k);
                 if !dead(tr)
-                    && !fan(tris, next, head, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
+                    && !fan(tris, adj, flags, a).any(|(_, s, j)| !dead(s) && others(s, j).0 == y)
                 {
                     p = y;
                 }
@@ -430,11 +460,9 @@ fn collapse<I: Index, L: Index>(
         }
     }
     let mut dying = 0;
-    let mut t = link(head, a);
-    let mut guard = tris.len();
     let nb = I::narrow(b);
-    while t != NONE && guard > 0 {
-        guard -= 1;
+    for &t in list(adj.0, flags, adj.1, a) {
+        let t = t.to_usize();
         let tr = tri(tris, t);
         let Some(k) = slot(tr, a) else { break };
         if !dead(tr) && slot(tr, b).is_some() {
@@ -443,7 +471,6 @@ fn collapse<I: Index, L: Index>(
         if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
             *c = nb;
         }
-        t = next.get(t).map_or(NONE, |n| link(n, k));
     }
     if let Some(&qa) = quadrics.get(a) {
         if let Some(q) = quadrics.get_mut(b) {
@@ -451,7 +478,7 @@ fn collapse<I: Index, L: Index>(
         }
     }
     if let Some(f) = flags.get_mut(a) {
-        *f = flag::GONE | flag::PASS;
+        *f = (*f & flag::HIGH) | flag::GONE | flag::PASS;
     }
     if let Some(f) = flags.get_mut(b) {
         *f |= flag::PASS;

@@ -4,76 +4,73 @@
 //! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
 //! along its border edge (either direction); a locked vertex never moves.
 
-use super::{flag, flags_of, link, set_link, tri, Frame};
+use super::sort::key;
+use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
 use crate::index::Index;
-use crate::math::V3;
 use crate::quadric::{self, VertexQuadric};
 
-/// Offers `a → b` (b at `pb`) at its price, keeping the cheaper (ties: the lower target).
-#[inline]
-fn offer<L: Index>(
-    quadrics: &[VertexQuadric],
-    target: &mut [L],
-    cost: &mut [f32],
-    a: usize,
-    b: usize,
-    pb: V3,
-) {
-    let Some(q) = quadrics.get(a) else { return };
-    let e = quadric::error(q, pb);
-    let Some(c) = cost.get_mut(a) else { return };
-    if e < *c || (e == *c && b < link(target, a)) {
-        *c = e;
-        set_link(target, a, b);
-    }
-}
-
-/// Prices every allowed collapse of the live triangles' edges.
+/// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
+/// the vertex after it in each triangle (the triangle across offers the other direction), a
+/// border vertex along its open edges only, either way. One vertex at a time, so its quadric
+/// and its best candidate stay in registers; ties go to the lower target. Counts each
+/// candidate's sort key in `histogram` (the counting sort's first pass).
+#[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(super) fn pick<I: Index, L: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
     flags: &[u8],
     border_next: &[L],
     quadrics: &[VertexQuadric],
-    target: &mut [L],
-    cost: &mut [f32],
+    (target, cost): (&mut [L], &mut [f32]),
+    histogram: &mut [L; BINS],
 ) {
-    for (t, c) in target.iter_mut().zip(cost.iter_mut()) {
-        *t = L::NIL;
-        *c = f32::INFINITY;
+    for h in histogram.iter_mut() {
+        *h = L::ZERO;
     }
-    for t in 0..triangles.len() {
-        let tr = tri(triangles, t);
-        let k = tr.map(|v| flags_of(flags, v) & flag::KIND);
-        if k == [flag::LOCKED; 3] {
-            continue;
-        }
-        let p = tr.map(|v| frame.at(v));
-        for (e0, e1) in [(0, 1), (1, 2), (2, 0)] {
-            let (Some(&i0), Some(&i1), Some(&k0), Some(&k1), Some(&p0), Some(&p1)) = (
-                tr.get(e0),
-                tr.get(e1),
-                k.get(e0),
-                k.get(e1),
-                p.get(e0),
-                p.get(e1),
-            ) else {
-                continue;
+    let free = |k: u8| {
+        k == flag::MANIFOLD
+            || (!const { super::perform::on("border") } && k == flag::BORDER)
+            || (!const { super::perform::on("locked") } && k == flag::LOCKED)
+    };
+    for (a, (ta, ca)) in target.iter_mut().zip(cost.iter_mut()).enumerate() {
+        let ka = flags_of(flags, a) & flag::KIND;
+        let (mut best, mut to) = (f32::INFINITY, NONE);
+        let border = !free(ka) && ka == flag::BORDER;
+        if free(ka) || border {
+            let q = quadrics.get(a).copied().unwrap_or([0.0; 10]);
+            let mut offer = |b: usize| {
+                let e = quadric::error(&q, frame.at(b));
+                if e < best || (e == best && b < to) {
+                    best = e;
+                    to = b;
+                }
             };
-            let free = |k: u8| {
-                k == flag::MANIFOLD
-                    || (!const { super::perform::on("border") } && k == flag::BORDER)
-                    || (!const { super::perform::on("locked") } && k == flag::LOCKED)
-            };
-            if free(k0) {
-                // The other direction comes from the triangle across.
-                offer(quadrics, target, cost, i0, i1, p1);
-            } else if k0 == flag::BORDER && k1 == flag::BORDER && link(border_next, i0) == i1 {
-                // An open edge has no triangle across: both directions here.
-                offer(quadrics, target, cost, i0, i1, p1);
-                offer(quadrics, target, cost, i1, i0, p0);
+            let next = link(border_next, a);
+            for (_, tr, k) in fan(triangles, adj, flags, a) {
+                let (x, y) = others(tr, k);
+                if !border {
+                    offer(x);
+                    continue;
+                }
+                // An open edge has no triangle across: both directions from its one triangle.
+                if x == next && flags_of(flags, x) & flag::KIND == flag::BORDER {
+                    offer(x);
+                }
+                if flags_of(flags, y) & flag::KIND == flag::BORDER && link(border_next, y) == a {
+                    offer(y);
+                }
             }
         }
+        *ca = best;
+        *ta = if to == NONE {
+            L::NIL
+        } else {
+            if let Some(h) = histogram.get_mut(key(best)) {
+                *h = L::narrow(h.to_usize() + 1);
+            }
+            L::narrow(to)
+        };
     }
 }

@@ -2,7 +2,7 @@
 //! (meshoptimizer's `sortEdgeCollapses`: 8 bits of exponent and 4 of mantissa), stable, so
 //! equal keys stay in vertex order.
 
-use super::{flag, link, BINS, NONE};
+use super::BINS;
 use crate::index::Index;
 
 /// `2⁻⁴⁸`'s 12-bit key: costs below it share bin 0.
@@ -20,37 +20,23 @@ pub(super) fn key(cost: f32) -> usize {
     }
 }
 
-/// Writes the vertices with a candidate (and still there) into `order` by cost; returns how
-/// many.
+/// Writes the vertices with a candidate into `order` by cost, from the key counts that pick
+/// left in `histogram`; returns how many.
 #[inline(never)]
 pub(super) fn sort<L: Index>(
-    flags: &[u8],
     target: &[L],
     cost: &[f32],
     order: &mut [L],
     histogram: &mut [L; BINS],
 ) -> usize {
-    for h in histogram.iter_mut() {
-        *h = L::ZERO;
-    }
-    let mut m = 0usize;
-    for (v, c) in cost.iter().enumerate() {
-        if link(target, v) == NONE || flags.get(v).is_none_or(|f| f & flag::KIND == flag::GONE) {
-            continue;
-        }
-        if let Some(h) = histogram.get_mut(key(*c)) {
-            *h = L::narrow(h.to_usize() + 1);
-        }
-        m += 1;
-    }
     let mut sum = 0usize;
     for h in histogram.iter_mut() {
         let n = h.to_usize();
         *h = L::narrow(sum);
         sum += n;
     }
-    for (v, c) in cost.iter().enumerate() {
-        if link(target, v) == NONE || flags.get(v).is_none_or(|f| f & flag::KIND == flag::GONE) {
+    for (v, (t, c)) in target.iter().zip(cost).enumerate() {
+        if *t == L::NIL {
             continue;
         }
         if let Some(h) = histogram.get_mut(key(*c)) {
@@ -61,5 +47,5 @@ pub(super) fn sort<L: Index>(
             *h = L::narrow(at + 1);
         }
     }
-    m
+    sum
 }
