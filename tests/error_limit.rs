@@ -176,7 +176,9 @@ fn the_limit_holds_in_the_fast_mode() {
         output(&m.positions, tris, r)
     };
     let config = Config::new().with_target(Target::Triangles(8));
-    let limit = 0.05;
+    // The fast mode refuses more of the spike than the greedy engines: its largest collapse
+    // without a limit is under 0.05, so the limit here is lower.
+    let limit = 0.02;
     let (_, r) = fast(&config);
     assert_eq!(r.collapse_error, 0.0, "tracked only with a limit");
     let (_, r) = fast(&config.with_error_limit(1e6));

@@ -23,33 +23,6 @@ use tinydecimate::{
     Positions, Report, Schedule, Stop, Workspace,
 };
 
-/// A closed octahedron of radius `r` about `c`, appended to `m`.
-fn octahedron(m: &mut MeshData, c: [f32; 3], r: f32) {
-    let b = m.positions.len() as u32;
-    for d in [
-        [r, 0.0, 0.0],
-        [-r, 0.0, 0.0],
-        [0.0, r, 0.0],
-        [0.0, -r, 0.0],
-        [0.0, 0.0, r],
-        [0.0, 0.0, -r],
-    ] {
-        m.positions.push([c[0] + d[0], c[1] + d[1], c[2] + d[2]]);
-    }
-    for [x, y, z] in [
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ] {
-        m.triangles.push([b + x, b + y, b + z]);
-    }
-}
-
 /// A wavy 24 x 24 sheet and, beside it, ten small octahedra (8 triangles each, radius 0.01 to
 /// 0.028 of the sheet's unit width). Returns the mesh and each small part's vertex range.
 fn sheet_and_bolts() -> (MeshData, Vec<std::ops::Range<u32>>) {

@@ -214,35 +214,12 @@ fn small_closed_meshes_keep_their_topology() {
     // turned over (the link condition passes: the common neighbours are the two opposite
     // vertices); the duplicate rule refuses it, and so does the fold rule (a copy turned over
     // faces the other way). An octahedron and an icosahedron towards nothing.
-    let tetra = MeshData {
-        positions: vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ],
-        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    let tetra = tetrahedron();
+    let mut octa = MeshData {
+        positions: Vec::new(),
+        triangles: Vec::new(),
     };
-    let octa = MeshData {
-        positions: vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ],
-        triangles: vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ],
-    };
+    octahedron(&mut octa, [0.0; 3], 1.0);
     for (what, m) in [
         ("tetrahedron", tetra),
         ("octahedron", octa),
@@ -257,4 +234,35 @@ fn small_closed_meshes_keep_their_topology() {
         assert!(v.is_valid(), "{what}: {r:?}\n{}", v.describe(10));
         assert_eq!(r.stop, Stop::NoLegalCollapse, "{what}");
     }
+}
+
+/// The rules that no validity check can see fire where they are meant to: the flip test
+/// (`normal_turn`) and the zero-area test (`sliver`) on real meshes, the duplicate rule on the
+/// tetrahedron (checked before the fold rule, which would refuse the same collapse). With any
+/// of them switched off (`PIPELINE_RULE_OFF=flip|area|duplicate`) its count is zero and this
+/// fails, as the validity tests fail for the others.
+#[test]
+fn each_rule_fires_where_it_should() {
+    let count = |r: &Report, name: &str| {
+        r.rejected
+            .iter()
+            .find(|(rule, _)| rule.name == name)
+            .map_or(0, |(_, n)| n)
+    };
+    let (mut turn, mut sliver) = (0, 0);
+    for name in [
+        "cow.obj",
+        "fandisk.obj",
+        "tray_bottom.obj",
+        "pr2_sensor_mount.obj",
+    ] {
+        let (_, r) = run(&load_obj(name), 0.1);
+        turn += count(&r, "normal_turn");
+        sliver += count(&r, "sliver");
+    }
+    assert!(turn > 0, "the flip test never refused");
+    assert!(sliver > 0, "the zero-area test never refused");
+    let tetra = tetrahedron();
+    let (_, r) = run(&tetra, 0.0);
+    assert!(count(&r, "duplicate") > 0, "{r:?}");
 }

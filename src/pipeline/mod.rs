@@ -28,7 +28,8 @@
 //!
 //! Differences from meshoptimizer, each for a promise this crate makes: a vertex keeps one
 //! candidate (its cheapest allowed collapse) instead of one per edge, so the sort buffer is one
-//! link per vertex; the checks are not only its flip test
+//! link per vertex, and when the checks refuse it the vertex's next cheapest target is tried
+//! at once (priced from the same quadric); the checks are not only its flip test
 //! (`hasTriangleFlips`, on unnormalised cross products, no square root) but also the link
 //! condition by marks (Cheng, Pan and Shi 1998 §3.2(1)), no duplicate triangle, no fold
 //! across any edge of a changed triangle, no zero-area triangle; border vertices only slide

@@ -3,8 +3,9 @@
 //! A candidate is skipped when either end is already an end of a collapse in this pass (so a
 //! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
 //! at its goal or at its error goal: 1.5 times the cost of the candidate that would reach the
-//! goal, once a sixth of the goal is done. Each candidate is checked on the current mesh, the
-//! rules in order of cost, each where it can fire:
+//! goal, once a sixth of the goal is done. A refused candidate is followed at once by a's
+//! next cheapest target, if it is within the error goal. Each candidate is checked on the
+//! current mesh, the rules in order of cost, each where it can fire:
 //!
 //! 1. the edge: two triangles on a-b (one for a border vertex: its border edge);
 //! 2. meshoptimizer's flip test (`hasTriangleFlip`) on each surviving triangle of a's fan:
@@ -105,6 +106,47 @@ fn error(quadrics: &[VertexQuadric], a: usize, c: f32) -> f32 {
     }
 }
 
+/// a's cheapest target other than `b` that its kind allows (pick's rules) and no collapse of
+/// this pass has touched, and its price.
+#[inline(never)]
+fn alternative<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    tris: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    border_next: &[L],
+    quadrics: &[VertexQuadric],
+    a: usize,
+    b: usize,
+) -> Option<(usize, f32)> {
+    let q = quadrics.get(a)?;
+    let border = flags_of(flags, a) & flag::KIND == flag::BORDER;
+    let mut best: Option<(usize, f32)> = None;
+    for (_, tr, k) in fan(tris, adj, flags, a) {
+        if dead(tr) {
+            continue;
+        }
+        let (x, y) = others(tr, k);
+        for w in [x, y] {
+            let fw = flags_of(flags, w);
+            if w == b || fw & flag::PASS != 0 || fw & flag::KIND == flag::GONE {
+                continue;
+            }
+            if border
+                && !(fw & flag::KIND == flag::BORDER
+                    && (link(border_next, a) == w || link(border_next, w) == a))
+            {
+                continue;
+            }
+            let e = quadric::error(q, frame.at(w));
+            if best.is_none_or(|(v, c)| e < c || (e == c && w < v)) {
+                best = Some((w, e));
+            }
+        }
+    }
+    best
+}
+
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
@@ -147,11 +189,29 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        if let Err(r) = check(frame, tris, adj, flags, target, a, b) {
-            stats.rejected.count(r);
-            edge_goal += 1;
-            continue;
-        }
+        let b = match check(frame, tris, adj, flags, target, a, b) {
+            Ok(()) => b,
+            Err(r) => {
+                stats.rejected.count(r);
+                edge_goal += 1;
+                // a's next cheapest target, at once: a vertex keeps one candidate, so one
+                // whose cheapest collapse stays illegal would otherwise never move.
+                let Some((x, cx)) =
+                    alternative(frame, tris, adj, flags, border_next, quadrics, a, b)
+                else {
+                    continue;
+                };
+                let ex = error(quadrics, a, cx);
+                if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
+                    continue;
+                }
+                if let Err(r) = check(frame, tris, adj, flags, target, a, x) {
+                    stats.rejected.count(r);
+                    continue;
+                }
+                x
+            }
+        };
         removed += collapse(tris, adj, flags, border_next, quadrics, a, b);
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
         set_link(target, b, a);

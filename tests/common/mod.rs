@@ -373,3 +373,43 @@ pub fn jitter(mut m: MeshData, seed: u64, amount: f32) -> MeshData {
     }
     m
 }
+
+/// A closed octahedron of radius `r` about `c`, appended to `m`.
+pub fn octahedron(m: &mut MeshData, c: [f32; 3], r: f32) {
+    let b = m.positions.len() as u32;
+    for d in [
+        [r, 0.0, 0.0],
+        [-r, 0.0, 0.0],
+        [0.0, r, 0.0],
+        [0.0, -r, 0.0],
+        [0.0, 0.0, r],
+        [0.0, 0.0, -r],
+    ] {
+        m.positions.push([c[0] + d[0], c[1] + d[1], c[2] + d[2]]);
+    }
+    for [x, y, z] in [
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ] {
+        m.triangles.push([b + x, b + y, b + z]);
+    }
+}
+
+/// The tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1), outward.
+pub fn tetrahedron() -> MeshData {
+    MeshData {
+        positions: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
+    }
+}
