@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Flash of one instantiation of tinydecimate, measured as a user would: the minimal firmware in
 # tests/flash (positions a static in flash, triangles a static RAM buffer, a static workspace)
-# is built without and with the call `Workspace<u16, 512, 1024>::simplify(.., &Config::new())`,
+# is built without and with the call `Workspace<u16, 512, 1024>::simplify(.., &Config::new())`
+# (and with the fast mode's `FastWorkspace<u16, 512, 1024>::simplify` instead),
 # opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
 # of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
 #
@@ -57,7 +58,8 @@ export CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt
 images="$CARGO_TARGET_DIR/images"
 mkdir -p "$images"
 # Variants: name, cargo features (comma-separated, may be empty), what the row shows.
-variants=("without||-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
+variants=("without||-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
+    "fast|fast|fast mode: FastWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
 if [ $all = 1 ]; then
     variants+=(
         "paper|paper|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::paper()"
@@ -137,7 +139,7 @@ if [ $all = 1 ]; then
     echo "what each addition costs over the single instantiation (Config::new(), u16):"
     for t in "${targets[@]}"; do
         one=${size[$t/call]}
-        for v in "${variants[@]:2}"; do
+        for v in "${variants[@]:3}"; do
             IFS='|' read -r name _ what <<<"$v"
             d=$((size[$t/$name] - one))
             printf '  %-22s %-82s %+7d B (%s)\n' "$t" "$what" "$d" "$(kb "$d")"

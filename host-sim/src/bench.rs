@@ -461,6 +461,23 @@ pub struct ModeSummary {
     pub scratch_bytes_per_triangle: (f64, f64),
     /// Per ratio, the worst error ratios (ours only; empty for meshoptimizer).
     pub worst: Vec<Worst>,
+    /// Over every run of this mode, against meshoptimizer at the same count (ours only).
+    pub overall: Option<Overall>,
+}
+
+/// A mode's error against meshoptimizer over every mesh and ratio of the run: geometric means
+/// of the Metro mean and max ratios (the same-count ones where the mode stopped short), and
+/// the worst of each.
+#[derive(Clone, Debug, Serialize)]
+pub struct Overall {
+    /// Geometric mean of the mean-error ratios.
+    pub mean_geomean: f64,
+    /// Geometric mean of the max-error (Hausdorff) ratios.
+    pub max_geomean: f64,
+    /// The worst mean and max ratios, with their meshes and ratios.
+    pub worst: WorstPair,
+    /// The ratios of the worst mean and max rows.
+    pub worst_at: (f32, f32),
 }
 
 /// The summary rows.
@@ -943,7 +960,22 @@ pub fn summarise(rows: &[Row], ratios: &[f32]) -> Summary {
                 });
             }
         }
+        let all: Vec<&Row> = mine.clone();
+        let overall = if method.is_ours() {
+            WorstPair::of(&all).map(|w| Overall {
+                mean_geomean: geomean(all.iter().map(|x| x.fair_mean_vs_meshopt())),
+                max_geomean: geomean(all.iter().map(|x| x.fair_max_vs_meshopt())),
+                worst_at: (
+                    worst_by(&all, Row::fair_mean_vs_meshopt).map_or(0.0, |x| x.ratio),
+                    worst_by(&all, Row::fair_max_vs_meshopt).map_or(0.0, |x| x.ratio),
+                ),
+                worst: w,
+            })
+        } else {
+            None
+        };
         modes.push(ModeSummary {
+            overall,
             method,
             runs: mine.len(),
             valid: mine.iter().filter(|x| x.valid).count(),
@@ -1018,7 +1050,8 @@ mod tests {
         );
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 8);
+        assert_eq!(Method::Fast.config(), Some(Config::new()));
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 9);
     }
 
     #[test]
@@ -1108,10 +1141,12 @@ mod tests {
                 .lines()
                 .filter(|l| l.contains(" %") && l.contains(&format!("| {} |", method.label())))
                 .count();
-            // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table and
-            // one per run that stopped short in the stopped-short table.
+            // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table,
+            // one in the whole-run error table and one per run that stopped short in the
+            // stopped-short table.
             let extra = if method.is_ours() {
                 QUICK_RATIOS.len()
+                    + 1
                     + r.rows
                         .iter()
                         .filter(|x| x.method == method && !x.target_reached)
@@ -1129,6 +1164,7 @@ mod tests {
         for m in &r.summary.modes {
             assert!(m.time_vs_meshopt_geomean.is_finite(), "{m:?}");
             assert_eq!(m.worst.len(), if m.method.is_ours() { 2 } else { 0 });
+            assert_eq!(m.overall.is_some(), m.method.is_ours(), "{m:?}");
         }
         let json: serde_json::Value =
             serde_json::from_str(&serde_json::to_string(&r).unwrap()).unwrap();

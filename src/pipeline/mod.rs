@@ -42,10 +42,12 @@
 //! weights (the quadric's trace): a weighted mean squared distance, a distance in the input's
 //! units once its root is taken.
 //!
-//! A prototype: neither the crate's default nor the CLI's yet. Not in it: welded seams, parts,
-//! the error bound and `step(budget)`. A vertex with more than 32 triangles is locked, and a collapse whose moving
-//! vertex would keep more is refused, so the checks run on fixed fan buffers.
-//! `examples/fast_cow.rs` runs it on one mesh, for callgrind and timing.
+//! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` runs it
+//! (seams welded by position before the call). Not in it: wedges (welded seams), parts, the
+//! error bound and `step(budget)`. A vertex with more than 32 triangles is locked, and a
+//! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
+//! buffers. `examples/fast_cow.rs` runs it on one mesh, for callgrind and timing;
+//! docs/speed.md#fast-mode has its instructions and the decisions behind its passes.
 
 mod build;
 mod classify;
