@@ -113,8 +113,7 @@ fn alternative<I: Index, L: Index>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
-    flags: &[u8],
-    border_next: &[L],
+    (flags, border_next): (&[u8], &[L]),
     quadrics: &[VertexQuadric],
     a: usize,
     b: usize,
@@ -197,7 +196,7 @@ pub(super) fn perform<I: Index, L: Index>(
                 // a's next cheapest target, at once: a vertex keeps one candidate, so one
                 // whose cheapest collapse stays illegal would otherwise never move.
                 let Some((x, cx)) =
-                    alternative(frame, tris, adj, flags, border_next, quadrics, a, b)
+                    alternative(frame, tris, adj, (&*flags, &*border_next), quadrics, a, b)
                 else {
                     continue;
                 };
