@@ -242,30 +242,7 @@ mod on {
     fn parts_vanish_whole() {
         let mut m = grid(24, 24, 0.15);
         for i in 0..10 {
-            let (b, r) = (m.positions.len() as u32, 0.01 + 0.002 * i as f32);
-            let c = [0.1 * i as f32, 1.2, 0.05];
-            for d in [
-                [r, 0.0, 0.0],
-                [-r, 0.0, 0.0],
-                [0.0, r, 0.0],
-                [0.0, -r, 0.0],
-                [0.0, 0.0, r],
-                [0.0, 0.0, -r],
-            ] {
-                m.positions.push([c[0] + d[0], c[1] + d[1], c[2] + d[2]]);
-            }
-            for [x, y, z] in [
-                [0, 2, 4],
-                [2, 1, 4],
-                [1, 3, 4],
-                [3, 0, 4],
-                [2, 0, 5],
-                [1, 2, 5],
-                [3, 1, 5],
-                [0, 3, 5],
-            ] {
-                m.triangles.push([b + x, b + y, b + z]);
-            }
+            octahedron(&mut m, [0.1 * i as f32, 1.2, 0.05], 0.01 + 0.002 * i as f32);
         }
         let config = batched().with_ratio(0.05);
         let run = |budget: u32| {

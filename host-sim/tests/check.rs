@@ -3,20 +3,8 @@
 //! the Metro error only with `--measure`; its report keeps one line per figure on glTF input.
 //! Each test runs the built binary.
 
-use std::path::{Path, PathBuf};
-
 mod common;
-use common::{run, text};
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures")
-        .join(name)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{fixture, run, s, text};
 
 /// Every output `simplify` calls VALID with its defaults passes `check` with its defaults:
 /// multi-part models (parts pruned), seam-split assets (seams welded), a scan with holes and

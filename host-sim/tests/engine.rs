@@ -3,20 +3,8 @@
 //! vanish whole), the error limit stops it as it stops the exact engine, and what it cannot
 //! run is refused with the option named. Each test runs the built binary.
 
-use std::path::{Path, PathBuf};
-
 mod common;
-use common::{run, text};
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures")
-        .join(name)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{fixture, run, s, text};
 
 /// A clean scan, a seam-split asset (welded by position), a raw CAD export and a multi-part
 /// model at 10 %: `simplify` says VALID, `check` agrees, and the JSON names the engine.
