@@ -3,7 +3,8 @@
 //! meshoptimizer's `sqrt(area)` weight, added at its three vertices; and for each border edge
 //! a plane through the edge perpendicular to its triangle, weighted by the edge's length
 //! times 10, plus the triangle's plane at the same weight, added at both ends, so that
-//! borders keep their shape.
+//! borders keep their shape. Every quadric is in its vertex's frame (module `pipeline`), where
+//! each of these planes passes through the origin.
 
 use super::{flag, flags_of, link, tri, Frame};
 use crate::index::Index;
@@ -26,7 +27,9 @@ fn add_to(q: &mut [VertexQuadric], v: usize, x: &VertexQuadric) {
     }
 }
 
-/// The plane quadric of triangle `p` with weight `sqrt(area) · w`, zero without area.
+/// The plane quadric of triangle `p` with weight `sqrt(area) · w`, zero without area, in the
+/// frame of any of its vertices: the plane passes through each, so its offset there is zero
+/// (exactly, not to rounding).
 #[inline]
 fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
     let c = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
@@ -37,7 +40,7 @@ fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
     let inv = math::rsqrt(l2);
     let n = math::scale(c, inv);
     let area = 0.5 * l2 * inv;
-    plane(n, -math::dot(n, p[0]), math::sqrt(area) * w)
+    plane(n, 0.0, math::sqrt(area) * w)
 }
 
 /// Zeroes the quadrics and adds every triangle's plane at its vertices.
@@ -93,10 +96,7 @@ pub(super) fn border_quadrics<I: Index, L: Index>(
             }
             let n = math::scale(perp, math::rsqrt(pl2));
             let w = math::sqrt(l2) * BORDER_WEIGHT;
-            let q = quadric::add(
-                &plane(n, -math::dot(n, p0), w),
-                &triangle([p0, p1, p2], BORDER_WEIGHT),
-            );
+            let q = quadric::add(&plane(n, 0.0, w), &triangle([p0, p1, p2], BORDER_WEIGHT));
             add_to(quadrics, i0, &q);
             add_to(quadrics, i1, &q);
         }

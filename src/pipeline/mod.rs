@@ -17,7 +17,8 @@
 //! build     validate, drop degenerate triangles, fan lists
 //! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex;
 //!           drop duplicate triangles
-//! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics
+//! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics,
+//!           each in its vertex's frame
 //! loop {
 //!   pick      each vertex's cheapest collapse its kind allows, from its quadric
 //!   sort      counting sort on the cost's top 12 bits
@@ -25,6 +26,12 @@
 //!   compact   drop dead triangles, rebuild the fan lists
 //! }
 //! ```
+//!
+//! Each vertex's quadric is kept in a frame centred on that vertex (moved to the kept vertex
+//! on a collapse, `quadric::translate`), as `StoredQuadric` keeps its own: a plane through the
+//! vertex then has offset zero exactly, and a collapse within a flat patch prices at zero
+//! instead of at the rounding of terms of order one, so CAD models lose their flat regions'
+//! triangles first and without error.
 //!
 //! Differences from meshoptimizer, each for a promise this crate makes: a vertex keeps one
 //! candidate (its cheapest allowed collapse) instead of one per edge, so the sort buffer is one

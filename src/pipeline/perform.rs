@@ -23,7 +23,8 @@
 //! unit frame, above the limit's square) is never collapsed.
 //!
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
-//! degenerate: compact drops them), adds a's quadric to b's, and locks both ends.
+//! degenerate: compact drops them), adds a's quadric, moved to b's frame, to b's, and locks
+//! both ends.
 
 use super::{
     dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
@@ -120,6 +121,7 @@ fn alternative<I: Index, L: Index>(
 ) -> Option<(usize, f32)> {
     let q = quadrics.get(a)?;
     let border = flags_of(flags, a) & flag::KIND == flag::BORDER;
+    let pa = frame.at(a);
     let mut best: Option<(usize, f32)> = None;
     for (_, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
@@ -137,7 +139,7 @@ fn alternative<I: Index, L: Index>(
             {
                 continue;
             }
-            let e = quadric::error(q, frame.at(w));
+            let e = quadric::error(q, math::sub(frame.at(w), pa));
             if best.is_none_or(|(v, c)| e < c || (e == c && w < v)) {
                 best = Some((w, e));
             }
@@ -211,7 +213,7 @@ pub(super) fn perform<I: Index, L: Index>(
                 x
             }
         };
-        removed += collapse(tris, adj, flags, border_next, quadrics, a, b);
+        removed += collapse(frame, tris, adj, flags, border_next, quadrics, a, b);
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
         set_link(target, b, a);
         done += 1;
@@ -488,6 +490,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 /// both ends locked for the pass. Returns the triangles that died.
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
+    frame: &Frame<'_>,
     tris: &mut [[I; 3]],
     adj: (&[L], &[L]),
     flags: &mut [u8],
@@ -533,7 +536,10 @@ fn collapse<I: Index, L: Index>(
     }
     if let Some(&qa) = quadrics.get(a) {
         if let Some(q) = quadrics.get_mut(b) {
-            *q = quadric::add(q, &qa);
+            *q = quadric::add(
+                q,
+                &quadric::translate(&qa, math::sub(frame.at(b), frame.at(a))),
+            );
         }
     }
     if let Some(f) = flags.get_mut(a) {

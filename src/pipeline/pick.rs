@@ -1,5 +1,5 @@
-//! pick: each vertex's cheapest collapse its kind allows, priced from its quadric at the
-//! target (meshoptimizer's `pickEdgeCollapses` and `rankEdgeCollapses`, reduced to one
+//! pick: each vertex's cheapest collapse its kind allows, priced from its quadric (in its own
+//! frame) at the target (meshoptimizer's `pickEdgeCollapses` and `rankEdgeCollapses`, reduced to one
 //! candidate per source vertex). Kinds (meshoptimizer's `kCanCollapse` without seams): a
 //! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
 //! along its border edge (either direction); a locked vertex never moves.
@@ -7,6 +7,7 @@
 use super::sort::key;
 use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
 use crate::index::Index;
+use crate::math;
 use crate::quadric::{self, VertexQuadric};
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
@@ -40,8 +41,9 @@ pub(super) fn pick<I: Index, L: Index>(
         let border = !free(ka) && ka == flag::BORDER;
         if free(ka) || border {
             let q = quadrics.get(a).copied().unwrap_or([0.0; 10]);
+            let pa = frame.at(a);
             let mut offer = |b: usize| {
-                let e = quadric::error(&q, frame.at(b));
+                let e = quadric::error(&q, math::sub(frame.at(b), pa));
                 if e < best || (e == best && b < to) {
                     best = e;
                     to = b;
