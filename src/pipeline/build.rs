@@ -71,25 +71,58 @@ pub(super) fn validate<'p, I: Index>(
 
 /// Fan lists of the first `nt` triangles (a counting sort of their corners by vertex, as
 /// meshoptimizer's `buildTriangleAdjacency`), from the corner counts that compact left in
-/// `first`: `v`'s list is `lists[end(v - 1)..end(v)]`, its triangles from the highest number
-/// down.
+/// `scratch` (the cost array, free until the next pick, as `u32` bit patterns; it then holds
+/// each list's write position): `v`'s list is `lists[end(v - 1)..end(v)]`, its triangles from
+/// the highest number down.
 #[inline(never)]
 pub(super) fn link<I: Index, L: Index>(
     triangles: &[[I; 3]],
     nt: usize,
-    first: &mut [L],
-    flags: &mut [u8],
+    (first, flags): (&mut [L], &mut [u8]),
+    scratch: &mut [f32],
     lists: &mut [L],
 ) {
     let tris = triangles.get(..nt).unwrap_or(&[]);
-    // Each list's start from the counts (at most nt each, so they fit a link).
-    let mut sum = 0;
-    for v in 0..first.len() {
-        let c = first.get(v).map_or(0, |c| c.to_usize());
-        set_end(first, flags, v, sum);
-        sum += c;
+    if u32::try_from(3 * nt).is_err() {
+        return link_wide(tris, first, flags, scratch, lists);
     }
-    // Filled from the start up, highest triangle first: each end ends where it belongs.
+    // Each list's start as its write position, its end in `first` (below 3·nt: fits a u32).
+    let mut sum = 0u32;
+    for (v, c) in scratch.iter_mut().enumerate() {
+        let count = c.to_bits();
+        *c = f32::from_bits(sum);
+        sum = sum.wrapping_add(count);
+        set_end(first, flags, v, sum as usize);
+    }
+    // Filled from the start up, highest triangle first.
+    for (t, tr) in tris.iter().enumerate().rev() {
+        for i in tr {
+            if let Some(c) = scratch.get_mut(i.to_usize()) {
+                let s = c.to_bits();
+                *c = f32::from_bits(s.wrapping_add(1));
+                if let Some(x) = lists.get_mut(s as usize) {
+                    *x = L::narrow(t);
+                }
+            }
+        }
+    }
+}
+
+/// [`link`] for more than `u32::MAX` list entries: the write positions in `first` and the
+/// flag bytes, which end as the lists' ends.
+#[cold]
+fn link_wide<I: Index, L: Index>(
+    tris: &[[I; 3]],
+    first: &mut [L],
+    flags: &mut [u8],
+    counts: &[f32],
+    lists: &mut [L],
+) {
+    let mut sum = 0;
+    for (v, c) in counts.iter().enumerate() {
+        set_end(first, flags, v, sum);
+        sum += c.to_bits() as usize;
+    }
     for (t, tr) in tris.iter().enumerate().rev() {
         for i in tr {
             let s = bump_end(first, flags, i.to_usize());

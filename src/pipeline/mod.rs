@@ -400,8 +400,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         let triangles_in = triangles.len();
 
         // build
-        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, first);
-        build::link(triangles, nt, first, flags, lists);
+        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, cost);
+        build::link(triangles, nt, (first, flags), cost, lists);
 
         // classify (and duplicates)
         let (locked, duplicates) = classify::classify(
@@ -412,8 +412,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             border_next,
         );
         if duplicates > 0 {
-            nt = compact::compact(triangles, nt, first).0;
-            build::link(triangles, nt, first, flags, lists);
+            nt = compact::compact(triangles, nt, cost).0;
+            build::link(triangles, nt, (first, flags), cost, lists);
         }
         let valid = nt;
 
@@ -466,7 +466,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 &mut stats,
             );
             passes += 1;
-            nt = compact::compact(triangles, nt, first).0;
+            nt = compact::compact(triangles, nt, cost).0;
             let _ = pass_triangles.push(nt as u32);
             if done == 0 {
                 break if stats.over_limit > refused {
@@ -477,7 +477,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             }
             // No fan lists for a pass that will not run.
             if nt > target_triangles && passes < config.max_passes {
-                build::link(triangles, nt, first, flags, lists);
+                build::link(triangles, nt, (first, flags), cost, lists);
                 compact::unlock(flags);
             }
         };

@@ -213,7 +213,7 @@ pub(super) fn perform<I: Index, L: Index>(
                 x
             }
         };
-        removed += collapse(frame, tris, adj, flags, border_next, quadrics, a, b);
+        removed += collapse(frame, tris, adj, flags, border_next, quadrics, (a, b));
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
         set_link(target, b, a);
         done += 1;
@@ -496,8 +496,7 @@ fn collapse<I: Index, L: Index>(
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
-    a: usize,
-    b: usize,
+    (a, b): (usize, usize),
 ) -> usize {
     if flags_of(flags, a) & flag::KIND == flag::BORDER {
         if link(border_next, a) == b {
