@@ -190,8 +190,8 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        let b = match check(frame, tris, adj, flags, target, a, b) {
-            Ok(()) => b,
+        let (b, dying) = match check(frame, tris, adj, flags, target, a, b) {
+            Ok(n) => (b, n),
             Err(r) => {
                 stats.rejected.count(r);
                 edge_goal += 1;
@@ -206,14 +206,18 @@ pub(super) fn perform<I: Index, L: Index>(
                 if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
                     continue;
                 }
-                if let Err(r) = check(frame, tris, adj, flags, target, a, x) {
-                    stats.rejected.count(r);
-                    continue;
+                match check(frame, tris, adj, flags, target, a, x) {
+                    Ok(n) => (x, n),
+                    Err(r) => {
+                        stats.rejected.count(r);
+                        continue;
+                    }
                 }
-                x
             }
         };
-        removed += collapse(frame, tris, adj, flags, border_next, quadrics, (a, b));
+        collapse(frame, tris, adj, flags, border_next, quadrics, (a, b));
+        // The live triangles on a-b, which check counted, die.
+        removed += dying;
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
         set_link(target, b, a);
         done += 1;
@@ -258,7 +262,8 @@ impl Survivor {
 /// Fans with more survivors than this are not collapsed (counted as locked).
 const MAX_FAN: usize = 32;
 
-/// Every rule for `a → b` on the current mesh (module documentation, in that order).
+/// Every rule for `a → b` on the current mesh (module documentation, in that order); `Ok` gives
+/// the triangles the collapse removes (the live ones on a-b).
 #[inline(never)]
 fn check<I: Index, L: Index>(
     frame: &Frame<'_>,
@@ -268,7 +273,7 @@ fn check<I: Index, L: Index>(
     target: &[L],
     a: usize,
     b: usize,
-) -> Result<(), Reject> {
+) -> Result<usize, Reject> {
     let (ka, kb) = (
         flags_of(flags, a) & flag::KIND,
         flags_of(flags, b) & flag::KIND,
@@ -399,7 +404,7 @@ fn check<I: Index, L: Index>(
         return Err(Reject::Duplicate);
     }
     if !const { on(RULE_FOLD) } {
-        return Ok(());
+        return Ok(n_ab);
     }
 
     // 4. Folds: each survivor against its neighbours after the collapse.
@@ -472,7 +477,7 @@ fn check<I: Index, L: Index>(
             }
         }
     }
-    Ok(())
+    Ok(n_ab)
 }
 
 #[inline]
@@ -487,7 +492,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 }
 
 /// `a → b`: a's corners rewritten to b, a's quadric added to b's, border successors kept,
-/// both ends locked for the pass. Returns the triangles that died.
+/// both ends locked for the pass.
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
     frame: &Frame<'_>,
@@ -497,7 +502,7 @@ fn collapse<I: Index, L: Index>(
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
     (a, b): (usize, usize),
-) -> usize {
+) {
     if flags_of(flags, a) & flag::KIND == flag::BORDER {
         if link(border_next, a) == b {
             // ... p → a → b ...: p's open edge now ends at b. p is the neighbour before a
@@ -520,15 +525,12 @@ fn collapse<I: Index, L: Index>(
             set_link(border_next, b, q);
         }
     }
-    let mut dying = 0;
     let nb = I::narrow(b);
     for &t in list(adj.0, flags, adj.1, a) {
         let t = t.to_usize();
-        let tr = tri(tris, t);
-        let Some(k) = slot(tr, a) else { break };
-        if !dead(tr) && slot(tr, b).is_some() {
-            dying += 1;
-        }
+        let Some(k) = slot(tri(tris, t), a) else {
+            break;
+        };
         if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
             *c = nb;
         }
@@ -547,5 +549,4 @@ fn collapse<I: Index, L: Index>(
     if let Some(f) = flags.get_mut(b) {
         *f |= flag::PASS;
     }
-    dying
 }
