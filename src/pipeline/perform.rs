@@ -246,10 +246,6 @@ struct Survivor {
 
 impl Survivor {
     #[inline]
-    fn t(&self) -> usize {
-        self.t as usize
-    }
-    #[inline]
     fn x(&self) -> usize {
         self.x as usize
     }
@@ -445,34 +441,42 @@ fn check<I: Index, L: Index>(
             (s.x(), s.y(), link(target, s.x()))
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
+        // Compared as u32: every vertex and triangle number fits.
+        let (ot, oa) = (other as u32, a as u32);
         'search: for v in [from, also] {
             if v == NONE {
                 break;
             }
             for &u in list(adj.0, flags, adj.1, v) {
                 let u = u.to_usize();
-                if u == s.t() {
+                let Some(tr) = tris.get(u) else { continue };
+                let tr = [
+                    tr[0].to_usize() as u32,
+                    tr[1].to_usize() as u32,
+                    tr[2].to_usize() as u32,
+                ];
+                if u as u32 == s.t || (tr[0] != ot && tr[1] != ot && tr[2] != ot) {
                     continue;
                 }
-                let tr = tri(tris, u);
-                if slot(tr, other).is_some() && !dead(tr) {
-                    let p = tr.map(|v| {
-                        if v == s.x() {
-                            s.px
-                        } else if v == s.y() {
-                            s.py
-                        } else if v == a {
-                            pb
-                        } else {
-                            frame.at(v)
-                        }
-                    });
-                    if folded(s.n, normal(p)) {
-                        return Err(Reject::Fold);
+                if tr[0] == tr[1] || tr[1] == tr[2] || tr[0] == tr[2] {
+                    continue;
+                }
+                let p = tr.map(|v| {
+                    if v == s.x {
+                        s.px
+                    } else if v == s.y {
+                        s.py
+                    } else if v == oa {
+                        pb
+                    } else {
+                        frame.at(v as usize)
                     }
-                    if manifold {
-                        break 'search;
-                    }
+                });
+                if folded(s.n, normal(p)) {
+                    return Err(Reject::Fold);
+                }
+                if manifold {
+                    break 'search;
                 }
             }
         }
