@@ -358,7 +358,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     ) -> Result<Report, Error> {
         config.validate()?;
         let (cv, ct) = (V.min(L::COUNT), T.min(L::COUNT));
-        let frame = build::validate(positions, triangles, cv, ct)?;
+        let frame = build::validate(positions, triangles, (cv, ct), &mut self.flags)?;
         let nv = positions.len();
         let short = Error::Capacity {
             what: Capacity::Vertices,
