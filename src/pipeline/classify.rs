@@ -199,16 +199,16 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
             .any(|(j, &(_, y))| pairs.iter().take(j).any(|&(_, z)| z == y));
     bad |= repeated;
     // Two triangles on each other's spokes: (v, x, y) and (v, y, x).
-    let twins = next
-        .iter()
-        .take(n)
-        .enumerate()
-        .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i));
+    let twins = || {
+        next.iter()
+            .take(n)
+            .enumerate()
+            .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i))
+    };
     let open = all & !seen;
     let open_in = open.count_ones();
-    let suspect = repeated || twins;
     if bad || open_out != open_in || open_out > 1 {
-        return (flag::LOCKED, NONE, suspect);
+        return (flag::LOCKED, NONE, repeated || twins());
     }
     let start = if open == 0 {
         0
@@ -223,11 +223,14 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
             _ => break,
         }
     }
+    // One chain or one cycle of three or more through every triangle holds no pair of twins.
     if steps != n {
-        (flag::LOCKED, NONE, suspect)
+        (flag::LOCKED, NONE, repeated || twins())
     } else if open_out == 1 {
-        (flag::BORDER, end, suspect)
+        (flag::BORDER, end, repeated)
+    } else if n >= 3 {
+        (flag::MANIFOLD, NONE, repeated)
     } else {
-        (flag::MANIFOLD, NONE, suspect)
+        (flag::MANIFOLD, NONE, repeated || twins())
     }
 }
