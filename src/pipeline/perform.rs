@@ -49,13 +49,18 @@ fn normal(p: [V3; 3]) -> V3 {
     math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
 }
 
+/// A normal and its squared length.
+#[inline(always)]
+fn squared(n: V3) -> (V3, f32) {
+    (n, math::dot(n, n))
+}
+
 /// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
 /// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
 /// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
-/// frame.
+/// frame. Each normal comes with its squared length (a survivor's is known from rule 2).
 #[inline(always)]
-fn folded(n1: V3, n2: V3) -> bool {
-    let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
+fn folded((n1, u2): (V3, f32), (n2, v2): (V3, f32)) -> bool {
     // Written so that NaN refuses too.
     let directed = v2 > TINY;
     let d = math::dot(n1, n2);
@@ -233,13 +238,13 @@ pub(super) fn perform<I: Index, L: Index>(
 }
 
 /// A surviving triangle of a's fan: its number, its other vertices (after and before a), their
-/// positions and its normal after the collapse.
+/// positions and its normal after the collapse with its squared length.
 #[derive(Clone, Copy)]
 struct Survivor {
     t: u32,
     x: u32,
     y: u32,
-    n: V3,
+    n: (V3, f32),
     px: V3,
     py: V3,
 }
@@ -320,7 +325,7 @@ fn check<I: Index, L: Index>(
             t: t as u32,
             x: x as u32,
             y: y as u32,
-            n: n1,
+            n: (n1, abd),
             px,
             py,
         };
@@ -421,13 +426,15 @@ fn check<I: Index, L: Index>(
         // the one on a-o1 dies; across the spoke to o2 likewise.
         let spoke = match fan_a.iter().find(|u| u.y == s.x) {
             Some(u) => folded(s.n, u.n),
-            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1, o1, s.px)),
+            None if s.x() == o1 && across1 != NONE => {
+                folded(s.n, squared(unchanged(across1, o1, s.px)))
+            }
             None => false,
         };
         if spoke {
             return Err(Reject::Fold);
         }
-        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2, o2, s.py)) {
+        if s.y() == o2 && across2 != NONE && folded(s.n, squared(unchanged(across2, o2, s.py))) {
             return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched in the list of an end that has not moved or
@@ -472,7 +479,7 @@ fn check<I: Index, L: Index>(
                         frame.at(v as usize)
                     }
                 });
-                if folded(s.n, normal(p)) {
+                if folded(s.n, squared(normal(p))) {
                     return Err(Reject::Fold);
                 }
                 if manifold {
