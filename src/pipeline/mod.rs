@@ -284,7 +284,9 @@ impl<L: Index, I: Index> Iterator for Fan<'_, L, I> {
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
         let t = self.list.next()?.to_usize();
-        let tr = tri(self.tris, t);
+        // A number out of range ends the fan, as a triangle without the vertex does.
+        let x = self.tris.get(t)?;
+        let tr = [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()];
         let k = slot(tr, self.v)?;
         Some((t, tr, k))
     }
