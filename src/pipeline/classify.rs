@@ -55,8 +55,11 @@ fn fast<I: Index, L: Index>(
     let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
     for &t in l {
         let t = t.to_usize();
-        let tr = tri(triangles, t);
-        if t >= nt || dead(tr) {
+        let Some(x) = triangles.get(t).filter(|_| t < nt) else {
+            continue;
+        };
+        let tr = [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()];
+        if dead(tr) {
             continue;
         }
         let Some(k) = slot(tr, v) else { continue };

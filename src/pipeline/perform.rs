@@ -539,7 +539,7 @@ fn collapse<I: Index, L: Index>(
     let nb = I::narrow(b);
     for &t in list(adj.0, flags, adj.1, a) {
         let t = t.to_usize();
-        let Some(k) = slot(tri(tris, t), a) else {
+        let Some(k) = tris.get(t).and_then(|x| slot(x.map(|v| v.to_usize()), a)) else {
             break;
         };
         if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
