@@ -55,8 +55,11 @@ fn fast<I: Index, L: Index>(
     let mut pairs = heapless::Vec::<(u32, u32), MAX_FAN>::new();
     for &t in l {
         let t = t.to_usize();
-        let tr = tri(triangles, t);
-        if t >= nt || dead(tr) {
+        let Some(x) = triangles.get(t).filter(|_| t < nt) else {
+            continue;
+        };
+        let tr = [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()];
+        if dead(tr) {
             continue;
         }
         let Some(k) = slot(tr, v) else { continue };
@@ -155,54 +158,25 @@ fn dedupe_all<I: Index, L: Index>(triangles: &mut [[I; 3]], nt: usize, l: &[L]) 
 /// Fans larger than this are locked.
 const MAX_FAN: usize = 32;
 
-/// Slots of the small hash table of a fan's before-vertices (twice the largest fan).
-const SLOTS: usize = 2 * MAX_FAN;
-
 /// The kind of a vertex from its fan's (after, before) pairs, and for a border vertex the
-/// vertex across its open out-edge. The triangle across spoke v-x is the one with x before v,
-/// found in a small hash table of the before-vertices. Manifold or border needs each
-/// before-vertex once and each match taken once (a repeated after-vertex either takes a match
-/// twice or leaves two triangles without one), as many unmatched after- as before-vertices
-/// (at most one: the open ends), and following the matches from the open end (or anywhere)
-/// must visit every triangle. No scratch memory.
+/// vertex across its open out-edge. The triangle across spoke v-x is the first one with x
+/// before v, found by a linear search (a fan has a handful of triangles: cheaper than a hash
+/// table to clear). Manifold or border needs each before-vertex once and each match taken
+/// once (a repeated after-vertex either takes a match twice or leaves two triangles without
+/// one), as many unmatched after- as before-vertices (at most one: the open ends), and
+/// following the matches from the open end (or anywhere) must visit every triangle. No
+/// scratch memory.
 fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
     let n = pairs.len();
-    let hash = |v: u32| (v.wrapping_mul(0x9e37_79b1) >> 26) as usize;
-    let mut keys = [u32::MAX; SLOTS];
-    let mut vals = [0u8; SLOTS];
-    let (mut bad, mut repeated) = (false, false);
-    for (j, &(_, y)) in pairs.iter().enumerate() {
-        let mut h = hash(y);
-        for _ in 0..SLOTS {
-            match keys.get(h) {
-                Some(&k) if k == u32::MAX => {
-                    if let (Some(k), Some(v)) = (keys.get_mut(h), vals.get_mut(h)) {
-                        *k = y;
-                        *v = j as u8;
-                    }
-                    break;
-                }
-                Some(&k) if k == y => {
-                    repeated = true;
-                    break;
-                }
-                _ => h = (h + 1) % SLOTS,
-            }
-        }
-    }
+    let mut bad = false;
     let mut next = [u8::MAX; MAX_FAN];
     let (mut seen, mut open_out, mut end) = (0u32, 0, NONE);
     for (&(x, _), nx) in pairs.iter().zip(next.iter_mut()) {
-        let mut h = hash(x);
         let mut found = None;
-        for _ in 0..SLOTS {
-            match keys.get(h) {
-                Some(&k) if k == x => {
-                    found = vals.get(h).copied();
-                    break;
-                }
-                Some(&k) if k != u32::MAX => h = (h + 1) % SLOTS,
-                _ => break,
+        for (j, &(_, y)) in pairs.iter().enumerate() {
+            if y == x {
+                found = Some(j);
+                break;
             }
         }
         match found {
@@ -210,7 +184,7 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
                 let bit = 1u32.checked_shl(j as u32).unwrap_or(0);
                 bad |= seen & bit != 0;
                 seen |= bit;
-                *nx = j;
+                *nx = j as u8;
             }
             None => {
                 open_out += 1;
@@ -218,19 +192,26 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
             }
         }
     }
+    let all = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    // A repeated before-vertex: a search finds only its first triangle, so with every triangle
+    // found there is none, and only a fan with an unmatched triangle needs the pairwise test.
+    let repeated = seen != all
+        && pairs
+            .iter()
+            .enumerate()
+            .any(|(j, &(_, y))| pairs.iter().take(j).any(|&(_, z)| z == y));
     bad |= repeated;
     // Two triangles on each other's spokes: (v, x, y) and (v, y, x).
-    let twins = next
-        .iter()
-        .take(n)
-        .enumerate()
-        .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i));
-    let all = if n >= 32 { u32::MAX } else { (1u32 << n) - 1 };
+    let twins = || {
+        next.iter()
+            .take(n)
+            .enumerate()
+            .any(|(i, &j)| next.get(j as usize).is_some_and(|&k| k as usize == i))
+    };
     let open = all & !seen;
     let open_in = open.count_ones();
-    let suspect = repeated || twins;
     if bad || open_out != open_in || open_out > 1 {
-        return (flag::LOCKED, NONE, suspect);
+        return (flag::LOCKED, NONE, repeated || twins());
     }
     let start = if open == 0 {
         0
@@ -245,11 +226,14 @@ fn kind_of(pairs: &[(u32, u32)]) -> (u8, usize, bool) {
             _ => break,
         }
     }
+    // One chain or one cycle of three or more through every triangle holds no pair of twins.
     if steps != n {
-        (flag::LOCKED, NONE, suspect)
+        (flag::LOCKED, NONE, repeated || twins())
     } else if open_out == 1 {
-        (flag::BORDER, end, suspect)
+        (flag::BORDER, end, repeated)
+    } else if n >= 3 {
+        (flag::MANIFOLD, NONE, repeated)
     } else {
-        (flag::MANIFOLD, NONE, suspect)
+        (flag::MANIFOLD, NONE, repeated || twins())
     }
 }

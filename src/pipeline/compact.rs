@@ -5,16 +5,17 @@ use super::{dead, flag};
 use crate::index::Index;
 
 /// Moves the triangles of the first `nt` without a repeated index to the front, in order,
-/// counting their corners per vertex in `counts` (the fan lists' first pass); returns how
+/// counting their corners per vertex in `counts` (the fan lists' first pass, as `u32` bit
+/// patterns in the candidates' cost array, free between a pass and the next pick); returns how
 /// many there are and how many were dropped.
 #[inline(never)]
-pub(super) fn compact<I: Index, L: Index>(
+pub(super) fn compact<I: Index>(
     triangles: &mut [[I; 3]],
     nt: usize,
-    counts: &mut [L],
+    counts: &mut [f32],
 ) -> (usize, usize) {
     for c in counts.iter_mut() {
-        *c = L::ZERO;
+        *c = f32::from_bits(0);
     }
     let mut w = 0;
     for r in 0..nt {
@@ -25,7 +26,8 @@ pub(super) fn compact<I: Index, L: Index>(
         }
         for v in tr {
             if let Some(c) = counts.get_mut(v) {
-                *c = L::narrow(c.to_usize() + 1);
+                // At most `nt` corners per vertex: no wrap.
+                *c = f32::from_bits(c.to_bits().wrapping_add(1));
             }
         }
         if w != r {

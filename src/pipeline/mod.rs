@@ -284,7 +284,9 @@ impl<L: Index, I: Index> Iterator for Fan<'_, L, I> {
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
         let t = self.list.next()?.to_usize();
-        let tr = tri(self.tris, t);
+        // A number out of range ends the fan, as a triangle without the vertex does.
+        let x = self.tris.get(t)?;
+        let tr = [x[0].to_usize(), x[1].to_usize(), x[2].to_usize()];
         let k = slot(tr, self.v)?;
         Some((t, tr, k))
     }
@@ -358,7 +360,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     ) -> Result<Report, Error> {
         config.validate()?;
         let (cv, ct) = (V.min(L::COUNT), T.min(L::COUNT));
-        let frame = build::validate(positions, triangles, cv, ct)?;
+        let frame = build::validate(positions, triangles, (cv, ct), &mut self.flags)?;
         let nv = positions.len();
         let short = Error::Capacity {
             what: Capacity::Vertices,
@@ -400,8 +402,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         let triangles_in = triangles.len();
 
         // build
-        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, first);
-        build::link(triangles, nt, first, flags, lists);
+        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, cost);
+        build::link(triangles, nt, (first, flags), cost, lists);
 
         // classify (and duplicates)
         let (locked, duplicates) = classify::classify(
@@ -412,8 +414,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             border_next,
         );
         if duplicates > 0 {
-            nt = compact::compact(triangles, nt, first).0;
-            build::link(triangles, nt, first, flags, lists);
+            nt = compact::compact(triangles, nt, cost).0;
+            build::link(triangles, nt, (first, flags), cost, lists);
         }
         let valid = nt;
 
@@ -466,7 +468,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 &mut stats,
             );
             passes += 1;
-            nt = compact::compact(triangles, nt, first).0;
+            nt = compact::compact(triangles, nt, cost).0;
             let _ = pass_triangles.push(nt as u32);
             if done == 0 {
                 break if stats.over_limit > refused {
@@ -477,7 +479,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             }
             // No fan lists for a pass that will not run.
             if nt > target_triangles && passes < config.max_passes {
-                build::link(triangles, nt, first, flags, lists);
+                build::link(triangles, nt, (first, flags), cost, lists);
                 compact::unlock(flags);
             }
         };

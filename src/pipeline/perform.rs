@@ -49,13 +49,18 @@ fn normal(p: [V3; 3]) -> V3 {
     math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
 }
 
+/// A normal and its squared length.
+#[inline(always)]
+fn squared(n: V3) -> (V3, f32) {
+    (n, math::dot(n, n))
+}
+
 /// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
 /// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
 /// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
-/// frame.
+/// frame. Each normal comes with its squared length (a survivor's is known from rule 2).
 #[inline(always)]
-fn folded(n1: V3, n2: V3) -> bool {
-    let (u2, v2) = (math::dot(n1, n1), math::dot(n2, n2));
+fn folded((n1, u2): (V3, f32), (n2, v2): (V3, f32)) -> bool {
     // Written so that NaN refuses too.
     let directed = v2 > TINY;
     let d = math::dot(n1, n2);
@@ -190,8 +195,8 @@ pub(super) fn perform<I: Index, L: Index>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
-        let b = match check(frame, tris, adj, flags, target, a, b) {
-            Ok(()) => b,
+        let (b, dying) = match check(frame, tris, adj, flags, target, a, b) {
+            Ok(n) => (b, n),
             Err(r) => {
                 stats.rejected.count(r);
                 edge_goal += 1;
@@ -206,14 +211,18 @@ pub(super) fn perform<I: Index, L: Index>(
                 if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
                     continue;
                 }
-                if let Err(r) = check(frame, tris, adj, flags, target, a, x) {
-                    stats.rejected.count(r);
-                    continue;
+                match check(frame, tris, adj, flags, target, a, x) {
+                    Ok(n) => (x, n),
+                    Err(r) => {
+                        stats.rejected.count(r);
+                        continue;
+                    }
                 }
-                x
             }
         };
-        removed += collapse(frame, tris, adj, flags, border_next, quadrics, a, b);
+        collapse(frame, tris, adj, flags, border_next, quadrics, (a, b));
+        // The live triangles on a-b, which check counted, die.
+        removed += dying;
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
         set_link(target, b, a);
         done += 1;
@@ -229,22 +238,18 @@ pub(super) fn perform<I: Index, L: Index>(
 }
 
 /// A surviving triangle of a's fan: its number, its other vertices (after and before a), their
-/// positions and its normal after the collapse.
+/// positions and its normal after the collapse with its squared length.
 #[derive(Clone, Copy)]
 struct Survivor {
     t: u32,
     x: u32,
     y: u32,
-    n: V3,
+    n: (V3, f32),
     px: V3,
     py: V3,
 }
 
 impl Survivor {
-    #[inline]
-    fn t(&self) -> usize {
-        self.t as usize
-    }
     #[inline]
     fn x(&self) -> usize {
         self.x as usize
@@ -258,7 +263,8 @@ impl Survivor {
 /// Fans with more survivors than this are not collapsed (counted as locked).
 const MAX_FAN: usize = 32;
 
-/// Every rule for `a → b` on the current mesh (module documentation, in that order).
+/// Every rule for `a → b` on the current mesh (module documentation, in that order); `Ok` gives
+/// the triangles the collapse removes (the live ones on a-b).
 #[inline(never)]
 fn check<I: Index, L: Index>(
     frame: &Frame<'_>,
@@ -268,7 +274,7 @@ fn check<I: Index, L: Index>(
     target: &[L],
     a: usize,
     b: usize,
-) -> Result<(), Reject> {
+) -> Result<usize, Reject> {
     let (ka, kb) = (
         flags_of(flags, a) & flag::KIND,
         flags_of(flags, b) & flag::KIND,
@@ -319,7 +325,7 @@ fn check<I: Index, L: Index>(
             t: t as u32,
             x: x as u32,
             y: y as u32,
-            n: n1,
+            n: (n1, abd),
             px,
             py,
         };
@@ -399,7 +405,7 @@ fn check<I: Index, L: Index>(
         return Err(Reject::Duplicate);
     }
     if !const { on(RULE_FOLD) } {
-        return Ok(());
+        return Ok(n_ab);
     }
 
     // 4. Folds: each survivor against its neighbours after the collapse.
@@ -420,13 +426,15 @@ fn check<I: Index, L: Index>(
         // the one on a-o1 dies; across the spoke to o2 likewise.
         let spoke = match fan_a.iter().find(|u| u.y == s.x) {
             Some(u) => folded(s.n, u.n),
-            None if s.x() == o1 && across1 != NONE => folded(s.n, unchanged(across1, o1, s.px)),
+            None if s.x() == o1 && across1 != NONE => {
+                folded(s.n, squared(unchanged(across1, o1, s.px)))
+            }
             None => false,
         };
         if spoke {
             return Err(Reject::Fold);
         }
-        if s.y() == o2 && across2 != NONE && folded(s.n, unchanged(across2, o2, s.py)) {
+        if s.y() == o2 && across2 != NONE && folded(s.n, squared(unchanged(across2, o2, s.py))) {
             return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched in the list of an end that has not moved or
@@ -440,39 +448,47 @@ fn check<I: Index, L: Index>(
             (s.x(), s.y(), link(target, s.x()))
         };
         let manifold = flags_of(flags, from) & flag::KIND != flag::LOCKED;
+        // Compared as u32: every vertex and triangle number fits.
+        let (ot, oa) = (other as u32, a as u32);
         'search: for v in [from, also] {
             if v == NONE {
                 break;
             }
             for &u in list(adj.0, flags, adj.1, v) {
                 let u = u.to_usize();
-                if u == s.t() {
+                let Some(tr) = tris.get(u) else { continue };
+                let tr = [
+                    tr[0].to_usize() as u32,
+                    tr[1].to_usize() as u32,
+                    tr[2].to_usize() as u32,
+                ];
+                if u as u32 == s.t || (tr[0] != ot && tr[1] != ot && tr[2] != ot) {
                     continue;
                 }
-                let tr = tri(tris, u);
-                if slot(tr, other).is_some() && !dead(tr) {
-                    let p = tr.map(|v| {
-                        if v == s.x() {
-                            s.px
-                        } else if v == s.y() {
-                            s.py
-                        } else if v == a {
-                            pb
-                        } else {
-                            frame.at(v)
-                        }
-                    });
-                    if folded(s.n, normal(p)) {
-                        return Err(Reject::Fold);
+                if tr[0] == tr[1] || tr[1] == tr[2] || tr[0] == tr[2] {
+                    continue;
+                }
+                let p = tr.map(|v| {
+                    if v == s.x {
+                        s.px
+                    } else if v == s.y {
+                        s.py
+                    } else if v == oa {
+                        pb
+                    } else {
+                        frame.at(v as usize)
                     }
-                    if manifold {
-                        break 'search;
-                    }
+                });
+                if folded(s.n, squared(normal(p))) {
+                    return Err(Reject::Fold);
+                }
+                if manifold {
+                    break 'search;
                 }
             }
         }
     }
-    Ok(())
+    Ok(n_ab)
 }
 
 #[inline]
@@ -487,7 +503,7 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
 }
 
 /// `a → b`: a's corners rewritten to b, a's quadric added to b's, border successors kept,
-/// both ends locked for the pass. Returns the triangles that died.
+/// both ends locked for the pass.
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
     frame: &Frame<'_>,
@@ -496,9 +512,8 @@ fn collapse<I: Index, L: Index>(
     flags: &mut [u8],
     border_next: &mut [L],
     quadrics: &mut [VertexQuadric],
-    a: usize,
-    b: usize,
-) -> usize {
+    (a, b): (usize, usize),
+) {
     if flags_of(flags, a) & flag::KIND == flag::BORDER {
         if link(border_next, a) == b {
             // ... p → a → b ...: p's open edge now ends at b. p is the neighbour before a
@@ -521,15 +536,12 @@ fn collapse<I: Index, L: Index>(
             set_link(border_next, b, q);
         }
     }
-    let mut dying = 0;
     let nb = I::narrow(b);
     for &t in list(adj.0, flags, adj.1, a) {
         let t = t.to_usize();
-        let tr = tri(tris, t);
-        let Some(k) = slot(tr, a) else { break };
-        if !dead(tr) && slot(tr, b).is_some() {
-            dying += 1;
-        }
+        let Some(k) = tris.get(t).and_then(|x| slot(x.map(|v| v.to_usize()), a)) else {
+            break;
+        };
         if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
             *c = nb;
         }
@@ -548,5 +560,4 @@ fn collapse<I: Index, L: Index>(
     if let Some(f) = flags.get_mut(b) {
         *f |= flag::PASS;
     }
-    dying
 }
