@@ -137,13 +137,19 @@ const MICROBIT_SKIPS: &[&str] = &[
     "grid12-energy-u16",
     "sphere2-energy-u16",
     "box4-energy-u32",
+    "grid12-fast-u16",
+    "box6-fast-u16",
+    "grid8-dirty-fast-u32",
+    "plate-cut-fast-u16",
+    "cow-fast-u16",
     "pm-grid8",
     "pm-cow-quantised",
 ];
 /// No RAM for stored quadrics on the micro:bit and the lm3s6965evb (firmware
 /// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases (they borrow it) or the
-/// energy's samples either, and no stack for vertex decimation (`board::VERTEX_DECIMATION`);
-/// the cow's cases need the 4 MB boards or the 400 KB RISC-V.
+/// energy's samples either, no stack for vertex decimation (`board::VERTEX_DECIMATION`) and
+/// no fast mode (`board::FAST_VERTICES` = 0); the cow's cases need the 4 MB boards or the
+/// 400 KB RISC-V.
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
     "tray-new-u16",
@@ -164,14 +170,20 @@ const LM3S_SKIPS: &[&str] = &[
     "grid12-energy-u16",
     "sphere2-energy-u16",
     "box4-energy-u32",
+    "grid12-fast-u16",
+    "box6-fast-u16",
+    "grid8-dirty-fast-u32",
+    "plate-cut-fast-u16",
+    "cow-fast-u16",
     "pm-cow-quantised",
 ];
 
-/// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream).
-const RISCV_400K_SKIPS: &[&str] = &[];
+/// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream) but
+/// the cow's fast case: its fast workspace holds 2 000 vertices (`board::FAST_VERTICES`).
+const RISCV_400K_SKIPS: &[&str] = &["cow-fast-u16"];
 /// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
 /// no RAM for stored quadrics, bounds or the energy's samples, and the plate and the cow are
-/// too big, and vertex decimation overflows its stack.
+/// too big, vertex decimation overflows its stack, and there is no fast mode.
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
@@ -193,6 +205,11 @@ const RISCV_32K_SKIPS: &[&str] = &[
     "grid12-energy-u16",
     "sphere2-energy-u16",
     "box4-energy-u32",
+    "grid12-fast-u16",
+    "box6-fast-u16",
+    "grid8-dirty-fast-u32",
+    "plate-cut-fast-u16",
+    "cow-fast-u16",
     "pm-cow-quantised",
 ];
 
@@ -349,7 +366,7 @@ mod tests {
     #[test]
     fn expected_skips_match_the_board_capacities() {
         // (board, MAX_VERTICES, MAX_TRIANGLES, bytes per link, QUADRIC_VERTICES,
-        // VERTEX_DECIMATION)
+        // VERTEX_DECIMATION); the fast workspace's from `capacity_tests::FAST`.
         let caps = [
             ("microbit", 224, 432, 2, 0, false),
             ("lm3s6965evb", 1_250, 2_400, 2, 0, false),
@@ -362,6 +379,10 @@ mod tests {
         let cases = golden::load_cases(&golden::default_dir()).unwrap();
         let streams = crate::golden::stream::load(&golden::default_dir()).unwrap();
         for (board, v, t, link, qv, vd) in caps {
+            let (_, fv, ft) = *super::capacity_tests::FAST
+                .iter()
+                .find(|(b, _, _)| *b == board)
+                .expect("every board in capacity_tests::FAST");
             let too_big: Vec<&str> = cases
                 .iter()
                 .filter(|c| {
@@ -371,6 +392,8 @@ mod tests {
                         || c.triangles.len() > fit
                         || (c.per_vertex_storage() && (c.positions.len() > qv || qv == 0))
                         || (c.method == Some(golden::case::MethodName::VertexDecimation) && !vd)
+                        || (c.method == Some(golden::case::MethodName::Fast)
+                            && (c.positions.len() > fv || c.triangles.len() > ft))
                         || (c.config.max_error.is_finite() && qv == 0)
                         || (c.config.max_error.is_finite()
                             && c.triangles.len() * 3 * c.index_type.bytes()
@@ -514,6 +537,42 @@ impl StreamCapacity {
 #[cfg(test)]
 mod capacity_tests {
     use super::StreamCapacity;
+
+    /// The fast workspace per board (firmware `board::FAST_VERTICES`, `FAST_TRIANGLES`; 0: no
+    /// fast mode).
+    pub(super) const FAST: &[(&str, usize, usize)] = &[
+        ("microbit", 0, 0),
+        ("lm3s6965evb", 0, 0),
+        ("mps2-an386", 32_000, 64_000),
+        ("mps2-an500", 32_000, 64_000),
+        ("mps2-an505", 32_000, 64_000),
+        ("riscv32imc-virt-400k", 2_000, 4_000),
+        ("riscv32imac-virt-32k", 0, 0),
+    ];
+
+    /// [`FAST`] is a copy of the firmware's constants: it must agree with
+    /// host-sim/firmware/src/board.rs for every board there.
+    #[test]
+    fn fast_capacity_agrees_with_the_firmware() {
+        let src = include_str!("../firmware/src/board.rs");
+        let mut boards = 0;
+        for block in src.split("mod sel {").skip(1) {
+            let block = &block[..block.find("\n}").unwrap_or(block.len())];
+            let (v, t) = (
+                constant(block, "FAST_VERTICES"),
+                constant(block, "FAST_TRIANGLES"),
+            );
+            for name in block
+                .lines()
+                .filter(|l| l.contains("pub const NAME: &str ="))
+                .map(|l| l.split('"').nth(1).unwrap())
+            {
+                boards += 1;
+                assert!(FAST.contains(&(name, v, t)), "{name}: {v} / {t}");
+            }
+        }
+        assert_eq!(boards, FAST.len(), "boards in board.rs");
+    }
 
     /// The value of `pub const NAME...: ... = VALUE;` in one board's block of board.rs.
     fn constant(block: &str, name: &str) -> usize {

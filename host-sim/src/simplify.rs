@@ -404,24 +404,12 @@ pub fn simplify_fast(
     let mut tris = mesh.triangles.clone();
     let mut order = vec![0u32; if weld { mesh.positions.len() } else { 0 }];
     let mut wedges = vec![[0u32; 3]; if weld { tris.len() } else { 0 }];
-    let small = mesh.positions.len() < 65_535 && tris.len() < 65_535;
     let start = Instant::now();
     if weld && shares_positions(&mesh.positions) {
         tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
             .map_err(library_error)?;
     }
-    let report = if small {
-        FAST_SMALL
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .simplify(&mesh.positions, &mut tris, config)
-    } else {
-        FAST_LARGE
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .simplify(&mesh.positions, &mut tris, config)
-    }
-    .map_err(library_error)?;
+    let report = fast_workspace_run(&mesh.positions, &mut tris, config).map_err(library_error)?;
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     Ok((
@@ -432,6 +420,27 @@ pub fn simplify_fast(
         report,
         elapsed,
     ))
+}
+
+/// The library call `FastWorkspace::simplify` on `triangles` as they are (any index type), on
+/// the workspace of the smallest link type that fits: the host's fast run, shared by
+/// [`simplify_fast`] and the golden reference of a fast case (`host-sim demo`, `qemu`).
+pub fn fast_workspace_run<I: tinydecimate::Index>(
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    if positions.len() < 65_535 && triangles.len() < 65_535 {
+        FAST_SMALL
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify(positions, triangles, config)
+    } else {
+        FAST_LARGE
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify(positions, triangles, config)
+    }
 }
 
 /// Bytes a fast-mode workspace sized exactly for `v` vertices and `t` triangles takes

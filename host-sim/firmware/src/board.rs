@@ -24,6 +24,11 @@ mod sel {
     /// No stack for vertex decimation (a removal's fixed buffers overflow the Cortex-M3's
     /// 5.8 KB and the 32 KB RISC-V's 7 KB): its cases are skipped here and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
+    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
+    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
+    /// are skipped here.
+    pub const FAST_VERTICES: usize = 0;
+    pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
     /// Progressive streams (`pm-*` cases): 44 vertex splits (704 B) and an 80 B chunk buffer
     /// (chunks of up to 71 B), taken from the stack's slack; triangles, their links, the list
@@ -44,6 +49,11 @@ mod sel {
     /// Vertex decimation needs more stack than the ~5.8 KB left here (a removal's fixed
     /// buffers): its cases are skipped and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
+    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
+    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
+    /// are skipped here.
+    pub const FAST_VERTICES: usize = 0;
+    pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer.
     pub const PM_VERTICES: usize = 100;
@@ -77,6 +87,11 @@ mod sel {
     /// the stack's ~110 KB.
     pub const QUADRIC_VERTICES: usize = 1_024;
     pub const VERTEX_DECIMATION: bool = true;
+    /// The fast mode's workspace, `u16` links (53 B per vertex, 6 B per triangle, 2 KB of
+    /// histogram: 2 082 048 B), shares the exact engine's RAM ([`Engine`]): as large a mesh
+    /// as fits it, 2 vertices per triangle.
+    pub const FAST_VERTICES: usize = 32_000;
+    pub const FAST_TRIANGLES: usize = 64_000;
     pub type Link = u32;
     /// Progressive streams: 3 000 vertex splits (48 000 B: the cow's 2 844 fit) and a 4 KB
     /// chunk buffer. With the quadrics that leaves ~20 KB of stack (the firmware needs ~4 KB).
@@ -100,6 +115,11 @@ mod sel {
     /// boards: every stored-quadric and bounded golden case fits.
     pub const QUADRIC_VERTICES: usize = 1_024;
     pub const VERTEX_DECIMATION: bool = true;
+    /// The fast mode's workspace, `u16` links (53 B per vertex, 6 B per triangle, 2 KB of
+    /// histogram: 132 048 B), shares the exact engine's RAM ([`Engine`]): as large a mesh
+    /// as fits it, 2 vertices per triangle (the cow does not).
+    pub const FAST_VERTICES: usize = 2_000;
+    pub const FAST_TRIANGLES: usize = 4_000;
     pub type Link = u16;
     /// Progressive streams: 3 000 vertex splits (48 000 B) and a 4 KB chunk buffer.
     pub const PM_VERTICES: usize = 3_000;
@@ -120,6 +140,11 @@ mod sel {
     /// Vertex decimation overflows the ~7 KB of stack left here (a removal's fixed buffers):
     /// its cases are skipped and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
+    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
+    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
+    /// are skipped here.
+    pub const FAST_VERTICES: usize = 0;
+    pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer, as on the
     /// lm3s6965evb.
@@ -146,6 +171,24 @@ pub const fn bound_bytes(v: usize, t: usize, index_bytes: usize) -> usize {
     t * 3 * index_bytes + (2 * t + v) * core::mem::size_of::<Link>()
 }
 
+/// The largest mesh (vertices, triangles of `it`) a case of `entry` takes on this board: the
+/// buffers', and for the fast mode its workspace's.
+pub const fn capacity(it: IndexType, entry: meshfmt::Entry) -> (usize, usize) {
+    let t = triangle_capacity(it);
+    match entry {
+        meshfmt::Entry::Fast => (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t)),
+        _ => (MAX_VERTICES, t),
+    }
+}
+
+const fn min(a: usize, b: usize) -> usize {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
 /// Bytes of the triangle buffer: `MAX_TRIANGLES` triangles of the widest index type this board
 /// takes (`u16` boards read `u32` files too, with half as many triangles).
 pub const TRIANGLE_BYTES: usize = MAX_TRIANGLES * 3 * core::mem::size_of::<Link>();
@@ -166,6 +209,37 @@ pub struct TriangleBytes(pub [u8; TRIANGLE_BYTES]);
 
 #[cfg(feature = "lib")]
 pub type Workspace = tinydecimate::Workspace<Link, MAX_VERTICES, MAX_TRIANGLES>;
+
+/// Whether the board runs the fast mode (`MethodCode::Fast`). Without it the firmware skips
+/// every fast case and leaves its code out of the image.
+pub const FAST: bool = FAST_VERTICES > 0;
+
+/// The fast mode's workspace (`u16` links on every board: it holds at most 32 000 vertices).
+#[cfg(feature = "lib")]
+pub type FastWorkspace = tinydecimate::pipeline::FastWorkspace<u16, FAST_VERTICES, FAST_TRIANGLES>;
+
+/// The working memory of a run, one static for both engines: a run is one case, so it needs
+/// the exact engine's workspace or the fast mode's, never both, and the RAM is the larger of
+/// the two rather than their sum (on the 4 MB boards their sum does not fit). `Exact` is
+/// variant 0 and both workspaces are all zero, so the static is all zero and sits in `.bss`;
+/// a fast case turns it into `Fast` before its run (`main.rs`, `fast_workspace`). The tag is a
+/// `u32` so that no padding lies between it and the 4-aligned workspace: the switch is then a
+/// store of the tag and a memset of the workspace in place (with a `u8` tag the compiler built
+/// the new value on the stack and copied it, a frame of the workspace's size).
+#[cfg(feature = "lib")]
+#[repr(C, u32)]
+// Both variants are large on purpose: the enum is how they share the RAM (no heap to box one).
+#[allow(clippy::large_enum_variant)]
+pub enum Engine {
+    /// `Workspace`, the exact engine (every method but the fast mode).
+    Exact(Workspace),
+    /// `FastWorkspace`, the fast mode.
+    Fast(FastWorkspace),
+}
+
+// The fast mode adds no RAM: its workspace fits in the exact engine's.
+#[cfg(feature = "lib")]
+const _: () = assert!(FastWorkspace::BYTES <= Workspace::BYTES);
 
 /// What a progressive stream needs beyond the triangle and position buffers (which it reuses:
 /// the triangle bytes hold a list head per vertex, then the triangles and their links): a split

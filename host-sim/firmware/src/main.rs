@@ -120,30 +120,36 @@ fn run_case(
     triangles: &mut [u8],
     result: &mut ResultHeader,
 ) -> Result<(), IoError> {
-    if let Some(h) = read_case(case_path, positions, triangles, result)? {
-        simplify(
-            syst,
-            &h,
-            &mut positions[..h.vertices as usize],
-            &mut triangles[..h.triangles_len()],
-            result,
-        );
-    }
-    result.capacity_vertices = board::MAX_VERTICES as u32;
-    result.capacity_triangles = board::triangle_capacity(result.index_type) as u32;
+    let entry = match read_case(case_path, positions, triangles, result)? {
+        Ok(h) => {
+            simplify(
+                syst,
+                &h,
+                &mut positions[..h.vertices as usize],
+                &mut triangles[..h.triangles_len()],
+                result,
+            );
+            h.entry()
+        }
+        Err(entry) => entry,
+    };
+    let (v, t) = board::capacity(result.index_type, entry);
+    result.capacity_vertices = v as u32;
+    result.capacity_triangles = t as u32;
     let out_bytes = result.triangles_len();
     write_result(out_path, result, &triangles[..out_bytes])
 }
 
-/// Reads the case file into the buffers. `Ok(None)`: the case is rejected (not a case file,
-/// or too big for this board) and `result` says so.
+/// Reads the case file into the buffers. `Ok(Err(entry))`: the case is rejected (not a case
+/// file, or too big for this board) and `result` says so; `entry` is the one it asked for
+/// (`Simplify` when the file is not a case), whose capacity the result reports.
 #[inline(never)]
 fn read_case(
     case_path: &str,
     positions: &mut [[f32; 3]],
     triangles: &mut [u8],
     result: &mut ResultHeader,
-) -> Result<Option<CaseHeader>, IoError> {
+) -> Result<Result<CaseHeader, meshfmt::Entry>, IoError> {
     let mut file = hostio::open(case_path)?;
     let mut head = [0u8; CASE_HEADER_LEN];
     hostio::read_exact(&mut file, &mut head)?;
@@ -156,7 +162,7 @@ fn read_case(
                 defmt::Debug2Format(&e)
             );
             *result = ResultHeader::empty(IndexType::U16, Status::BadCase, board::BOARD);
-            return Ok(None);
+            return Ok(Err(meshfmt::Entry::Simplify));
         }
     };
     let nv = h.vertices as usize;
@@ -169,26 +175,32 @@ fn read_case(
         h.index_type.bytes() * 8
     );
     // A board without quadric storage skips every case that borrows it (an empty one too), a
-    // board without the stack for vertex decimation every vertex-decimation case:
-    // `run_library` leaves their code out of the image.
+    // board without the stack for vertex decimation every vertex-decimation case, a board
+    // without the fast mode every fast case: `run_library` leaves their code out of the image.
     let entry = h.entry();
-    if nv > board::MAX_VERTICES
-        || nt > board::triangle_capacity(h.index_type)
+    let (cv, ct) = board::capacity(h.index_type, entry);
+    if nv > cv
+        || nt > ct
+        || (entry == meshfmt::Entry::Fast && !board::FAST)
         || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
         || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
         || (entry == meshfmt::Entry::Bounded
             && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
                 || !board::HAS_QUADRICS))
     {
-        defmt::warn!("the mesh does not fit this board");
+        if entry == meshfmt::Entry::Fast && !board::FAST {
+            defmt::warn!("no fast mode on this board");
+        } else {
+            defmt::warn!("the mesh does not fit this board");
+        }
         *result = ResultHeader::empty(h.index_type, Status::TooBig, board::BOARD);
         result.error_a = h.vertices;
         result.error_b = h.triangles;
-        return Ok(None);
+        return Ok(Err(entry));
     }
     hostio::read_exact(&mut file, bytemuck::cast_slice_mut(&mut positions[..nv]))?;
     hostio::read_exact(&mut file, &mut triangles[..h.triangles_len()])?;
-    Ok(Some(h))
+    Ok(Ok(h))
 }
 
 /// Writes the result file: header, then the triangles (already in the file's byte order).
@@ -359,35 +371,47 @@ fn simplify(
 ) {
     // `Workspace::new` is const, so the workspace is initialised at compile time. (Building it
     // at run time, `StaticCell::uninit().write(Workspace::new())`, assembles it on the stack
-    // first: a 1.6 MB frame on the 4 MB boards.)
-    static WORKSPACE: ConstStaticCell<board::Workspace> =
-        ConstStaticCell::new(board::Workspace::new());
-    let ws = WORKSPACE.take();
+    // first: a 1.6 MB frame on the 4 MB boards.) The fast mode's workspace shares its RAM
+    // (`board::Engine`).
+    static ENGINE: ConstStaticCell<board::Engine> =
+        ConstStaticCell::new(board::Engine::Exact(board::Workspace::new()));
+    let engine = ENGINE.take();
     let quadrics = QUADRICS.take();
     let config = meshfmt::lib::config(h);
     let entry = h.entry();
 
     let sp = measure::paint();
+    // Not counted: the exact engine's workspace is ready at boot, the fast one is zeroed here.
+    if entry == meshfmt::Entry::Fast && board::FAST {
+        fast_workspace(engine);
+    }
     measure::start(syst);
-    let outcome = match h.index_type {
-        IndexType::U16 => match bytemuck::try_cast_slice_mut::<u8, [u16; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, entry, quadrics),
-            Err(_) => {
-                *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
-                return;
-            }
-        },
-        IndexType::U32 => match bytemuck::try_cast_slice_mut::<u8, [u32; 3]>(tri) {
-            Ok(t) => run_library(ws, pos, t, &config, entry, quadrics),
-            Err(_) => {
-                *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
-                return;
-            }
-        },
+    let outcome =
+        match engine {
+            board::Engine::Exact(ws) => match h.index_type {
+                IndexType::U16 => triangles_as::<u16>(tri)
+                    .map(|t| run_library(ws, pos, t, &config, entry, quadrics)),
+                IndexType::U32 => triangles_as::<u32>(tri)
+                    .map(|t| run_library(ws, pos, t, &config, entry, quadrics)),
+            },
+            board::Engine::Fast(ws) => match h.index_type {
+                IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_fast(ws, pos, t, &config)),
+                IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_fast(ws, pos, t, &config)),
+            },
+        };
+    let Some(outcome) = outcome else {
+        *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
+        return;
     };
     let ticks = measure::stop(syst);
     let low = measure::lowest_touched();
     write_header(h, &outcome, pos, ticks, sp, low, r);
+}
+
+/// The triangle bytes as triangles of `I` (`None`: misaligned or not a whole number of them).
+#[cfg(feature = "lib")]
+fn triangles_as<I: bytemuck::Pod>(tri: &mut [u8]) -> Option<&mut [[I; 3]]> {
+    bytemuck::try_cast_slice_mut::<u8, [I; 3]>(tri).ok()
 }
 
 /// The result header of a library call and its log lines. Never inlined: its temporaries
@@ -412,7 +436,11 @@ fn write_header(
     r.ticks = ticks;
     r.stack_bytes = sp.saturating_sub(low) as u32;
     r.stack_high_water = measure::depth(low) as u32;
-    r.workspace_bytes = board::Workspace::BYTES as u32;
+    r.workspace_bytes = if entry == meshfmt::Entry::Fast {
+        board::FastWorkspace::BYTES as u32
+    } else {
+        board::Workspace::BYTES as u32
+    };
     match outcome {
         Ok(report) => defmt::info!("{}", report),
         Err(e) => defmt::warn!("simplify failed: {}", e),
@@ -448,31 +476,79 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     // A board leaves out the entry points it cannot run (`read_case` skips their cases): the
     // ones that borrow the quadric storage where there is none, vertex decimation where the
     // stack is too small. With all of them the micro:bit's and the lm3s6965evb's images
-    // overflow their 256 KB of flash.
+    // overflow their 256 KB of flash. A fast case runs on the fast workspace (`run_fast`),
+    // never here.
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
+        Entry::Fast => true,
         _ => !board::HAS_QUADRICS,
     };
     if left_out {
-        return Err(tinydecimate::Error::Capacity {
-            what: tinydecimate::Capacity::Quadrics,
-            needed: positions.len(),
-            available: 0,
-        });
+        return Err(left_out_error(positions.len()));
     }
     match entry {
         Entry::Simplify => ws.simplify(positions, triangles, config),
         Entry::Bounded => run_bounded(ws, positions, triangles, config, quadrics),
-        Entry::StoredSubset => {
-            run_stored(ws, positions, triangles, config, Placement::Subset, quadrics)
-        }
-        Entry::StoredOptimal => {
-            run_stored(ws, positions, triangles, config, Placement::Optimal, quadrics)
-        }
+        Entry::StoredSubset => run_stored(
+            ws,
+            positions,
+            triangles,
+            config,
+            Placement::Subset,
+            quadrics,
+        ),
+        Entry::StoredOptimal => run_stored(
+            ws,
+            positions,
+            triangles,
+            config,
+            Placement::Optimal,
+            quadrics,
+        ),
         Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
         Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
+        Entry::Fast => Err(left_out_error(positions.len())),
     }
+}
+
+/// The error of an entry point the image leaves out (not reached: `read_case` skips its cases).
+#[cfg(feature = "lib")]
+fn left_out_error(vertices: usize) -> tinydecimate::Error {
+    tinydecimate::Error::Capacity {
+        what: tinydecimate::Capacity::Quadrics,
+        needed: vertices,
+        available: 0,
+    }
+}
+
+/// Turns the run's working memory into the fast mode's workspace (zeroed), in place. Never
+/// inlined; called on the painted stack but before the counter starts, so a copy through the
+/// stack (which would run into `.bss`) ends in the stack-overflow panic, and the zeroing is
+/// not counted as the library's instructions.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn fast_workspace(engine: &mut board::Engine) {
+    // A constant operand, not a call: the variant is then written straight into the static
+    // from an all-zero constant, which the compiler turns into a memset (a call's result is
+    // built on the stack and copied, a frame twice the workspace's size).
+    const ZEROED: board::FastWorkspace = board::FastWorkspace::new();
+    if !matches!(engine, board::Engine::Fast(_)) {
+        *engine = board::Engine::Fast(ZEROED);
+    }
+}
+
+/// A fast case (`MethodCode::Fast`): `FastWorkspace::simplify`, positions read. Never inlined,
+/// for the same reason as [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_fast<I: tinydecimate::Index>(
+    ws: &mut board::FastWorkspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    ws.simplify(positions, triangles, config)
 }
 
 /// A stored-quadric case (`StoredQuadric`). Never inlined, for the same reason as
@@ -493,7 +569,9 @@ fn run_stored<I: tinydecimate::Index>(
         Placement::Optimal => Positions::Write(positions),
     };
     let cost = StoredQuadric::new(quadrics, placement);
-    Ok(ws.start(p, triangles, config, cost, NoBound, EdgeCollapse)?.run())
+    Ok(ws
+        .start(p, triangles, config, cost, NoBound, EdgeCollapse)?
+        .run())
 }
 
 /// A vertex decimation case (`VertexDecimation`, the built-in cost). Never inlined, for the
@@ -508,7 +586,9 @@ fn run_decimation<I: tinydecimate::Index>(
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use tinydecimate::{Builtin, NoBound, Positions, VertexDecimation};
     let (p, op) = (Positions::Read(positions), VertexDecimation::new());
-    Ok(ws.start(p, triangles, config, Builtin::new(), NoBound, op)?.run())
+    Ok(ws
+        .start(p, triangles, config, Builtin::new(), NoBound, op)?
+        .run())
 }
 
 /// A case of Hoppe's energy (`cost::Energy`, its samples in the quadric storage). Never
@@ -523,8 +603,13 @@ fn run_energy<I: tinydecimate::Index>(
     samples: &mut [[f32; 10]],
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
     use tinydecimate::{EdgeCollapse, NoBound, Positions};
-    let (p, cost) = (Positions::Read(positions), tinydecimate::cost::Energy::new(samples));
-    Ok(ws.start(p, triangles, config, cost, NoBound, EdgeCollapse)?.run())
+    let (p, cost) = (
+        Positions::Read(positions),
+        tinydecimate::cost::Energy::new(samples),
+    );
+    Ok(ws
+        .start(p, triangles, config, cost, NoBound, EdgeCollapse)?
+        .run())
 }
 
 /// A bounded case (`Controls`). Never inlined: its locals would deepen
@@ -560,7 +645,16 @@ fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
         tinydecimate::Controls::new(orig, controls),
     );
     let cost = tinydecimate::Builtin::new();
-    Ok(ws.start(p, triangles, config, cost, bound, tinydecimate::EdgeCollapse)?.run())
+    Ok(ws
+        .start(
+            p,
+            triangles,
+            config,
+            cost,
+            bound,
+            tinydecimate::EdgeCollapse,
+        )?
+        .run())
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).

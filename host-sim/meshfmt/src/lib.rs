@@ -20,7 +20,7 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy |
+//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy, 6 = the fast mode |
 //! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
@@ -137,8 +137,9 @@ pub enum ScheduleCode {
 }
 
 /// Method code: the cost and operator a case runs (header byte 30). Codes 0-3 name a cost of
-/// the edge collapse, 4 and 5 a plug-in; the byte was first the cost alone, so the codes are
-/// the ones it had.
+/// the edge collapse, 4 and 5 a plug-in, 6 the fast mode's own pipeline; the byte was first the
+/// cost alone, so the codes are the ones it had. A new code keeps the case version: a reader
+/// that predates it refuses the case ([`FormatError::Code`]) rather than run another method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MethodCode {
     /// `CostKind::Quadric`.
@@ -155,6 +156,9 @@ pub enum MethodCode {
     /// Hoppe's energy (`cost::Energy::new`, edge collapse, positions read): one `[f32; 10]` of
     /// samples per vertex.
     Energy = 5,
+    /// The fast mode (`pipeline::FastWorkspace::simplify`, positions read): its own workspace;
+    /// of the configuration only the target, `max_passes` and `error_limit` count.
+    Fast = 6,
 }
 
 /// The library entry point a case runs: its method and whether it is bounded, decided once
@@ -173,6 +177,8 @@ pub enum Entry {
     VertexDecimation,
     /// `cost::Energy::new`, no bound, edge collapse, positions read.
     Energy,
+    /// `pipeline::FastWorkspace::simplify`, positions read.
+    Fast,
 }
 
 impl Entry {
@@ -360,6 +366,7 @@ impl CaseHeader {
             3 => MethodCode::StoredOptimal,
             4 => MethodCode::VertexDecimation,
             5 => MethodCode::Energy,
+            6 => MethodCode::Fast,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -401,6 +408,7 @@ impl CaseHeader {
             MethodCode::StoredOptimal => Entry::StoredOptimal,
             MethodCode::VertexDecimation => Entry::VertexDecimation,
             MethodCode::Energy => Entry::Energy,
+            MethodCode::Fast => Entry::Fast,
         }
     }
 
@@ -711,7 +719,8 @@ pub mod lib {
                 | MethodCode::StoredSubset
                 | MethodCode::StoredOptimal
                 | MethodCode::VertexDecimation
-                | MethodCode::Energy => CostKind::Quadric,
+                | MethodCode::Energy
+                | MethodCode::Fast => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c.features = h.feature_mode != FeatureCode::Off;
@@ -1068,6 +1077,7 @@ mod tests {
             (MethodCode::StoredOptimal, 3, Entry::StoredOptimal),
             (MethodCode::VertexDecimation, 4, Entry::VertexDecimation),
             (MethodCode::Energy, 5, Entry::Energy),
+            (MethodCode::Fast, 6, Entry::Fast),
         ];
         for (method, code, entry) in cases {
             let mut h = case();
@@ -1088,7 +1098,7 @@ mod tests {
             assert_eq!(h.entry(), Entry::Bounded);
         }
         let mut b = case().to_bytes();
-        b[30] = 6;
+        b[30] = 7;
         assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
     }
 

@@ -1,7 +1,11 @@
 //! `host-sim demo [MESH]`: the first impression. Simplifies one mesh (default
 //! `tests/fixtures/cow.obj`, 5804 triangles) with the library on the host and on an emulated
 //! Cortex-M4F (QEMU `mps2-an386`, 4 MB), prints both reports side by side and whether the two
-//! outputs are byte-identical (exit 1 if not).
+//! outputs are byte-identical (exit 1 if not). Then the same mesh and target with the fast mode
+//! (`pipeline::FastWorkspace`, case method `Fast`) on both: its rows say "fast mode", with its
+//! emulated instructions per collapse, and its outputs must be byte-identical too (exit 1 if
+//! not). A board without the fast mode, or whose fast workspace the mesh does not fit, says so
+//! in its row instead.
 //!
 //! On a fresh machine it first makes sure the tools are there ([`qemu::preflight`]): a missing
 //! Rust target is installed with `rustup target add`; a missing `qemu-system-arm` is installed
@@ -17,6 +21,7 @@ use meshfmt::{IndexType, Status};
 use tinydecimate::Config;
 
 use crate::backend::Backend;
+use crate::golden::case::MethodName;
 use crate::golden::{self, Case, Golden, Outcome, Verdict};
 use crate::qemu;
 
@@ -144,7 +149,7 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     // 1. The case: the mesh, its index type and the configuration.
     let mut case = demo_case(a)?;
     // 2. The device's run (of the part of the mesh that fits it).
-    let (device, run) = run_on_board(a, board, backend, &mut case)?;
+    let (elf, (device, run)) = run_on_board(a, board, backend, &mut case)?;
     if a.verbose {
         crate::outln!("{}", run.describe());
     }
@@ -168,7 +173,36 @@ pub fn run(a: &Args) -> Result<ExitCode> {
         (&host, host_wall),
         (&device, &run),
     );
-    byte_identical(&case, backend, &host, &device)
+    let exact = compare(&case, backend, &host, &device)?;
+    sha_row("output sha256", &exact);
+    // 4. The fast mode: the same mesh, target and board.
+    let fast_case = fast_case(&case);
+    let (fast_device, fast_run) =
+        qemu::run_case(board, &elf, &fast_case, Duration::from_secs(a.timeout))?;
+    if a.verbose {
+        crate::outln!("{}", fast_run.describe());
+    }
+    let t0 = Instant::now();
+    let fast_host = golden::reference(&fast_case)?;
+    let fast_wall = t0.elapsed();
+    let fast = fast_rows(
+        board,
+        backend,
+        &fast_case,
+        (&fast_host, fast_wall),
+        (fast_device.as_ref(), &fast_run),
+    )?;
+    crate::outln!();
+    let ok = verdict("byte-identical", &exact);
+    let fast_ok = match &fast {
+        Some(f) => verdict("byte-identical, fast mode", f),
+        None => true,
+    };
+    Ok(if ok && fast_ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
 }
 
 /// The case `host-sim demo` runs: the mesh (the cow by default), `u32` triangles when asked
@@ -208,14 +242,23 @@ fn demo_case(a: &Args) -> Result<Case> {
     })
 }
 
+/// The fast mode's run of `case`: the same mesh, index type and configuration, method `Fast`.
+fn fast_case(case: &Case) -> Case {
+    Case {
+        name: format!("{}-fast", case.name),
+        method: Some(MethodName::Fast),
+        ..case.clone()
+    }
+}
+
 /// Builds the firmware and runs `case` on `board`; a mesh too big for the board is cut to
-/// the triangles that fit (`case` becomes that part) and run again.
+/// the triangles that fit (`case` becomes that part) and run again. Returns the image too.
 fn run_on_board(
     a: &Args,
     board: &'static qemu::Board,
     backend: Backend,
     case: &mut Case,
-) -> Result<(Option<Outcome>, qemu::Run)> {
+) -> Result<(PathBuf, (Option<Outcome>, qemu::Run))> {
     let timeout = Duration::from_secs(a.timeout);
     eprintln!(
         "building the firmware for {} ({}, {backend}) ...",
@@ -243,7 +286,7 @@ fn run_on_board(
             ran = qemu::run_case(board, &elf, case, timeout)?;
         }
     }
-    Ok(ran)
+    Ok((elf, ran))
 }
 
 /// The host's and the device's runs side by side: report, instructions, time, memory.
@@ -302,22 +345,10 @@ fn side_by_side(
         thousands(h.collapses.into()),
         thousands(d.collapses.into()),
     );
-    let instr = board.instructions(d.ticks);
     row(
         "emulated instructions",
         "-".into(),
-        format!(
-            "{}{}",
-            thousands(instr),
-            if d.collapses > 0 {
-                format!(
-                    " ({} per collapse)",
-                    thousands(instr / u64::from(d.collapses))
-                )
-            } else {
-                String::new()
-            }
-        ),
+        instructions_text(board, d),
     );
     row(
         "time",
@@ -351,45 +382,165 @@ fn side_by_side(
     );
 }
 
-/// One line of the side-by-side table.
-fn row(k: &str, x: String, y: String) {
-    crate::outln!("{k:<22} {x:<46} {y}");
+/// The emulated instructions of a device run, and per collapse when it made any.
+fn instructions_text(board: &qemu::Board, d: &meshfmt::ResultHeader) -> String {
+    let instr = board.instructions(d.ticks);
+    format!(
+        "{}{}",
+        thousands(instr),
+        if d.collapses > 0 {
+            format!(
+                " ({} per collapse)",
+                thousands(instr / u64::from(d.collapses))
+            )
+        } else {
+            String::new()
+        }
+    )
 }
 
-/// Whether the host's and the device's outputs are the same bytes (exit code 1 if not).
-fn byte_identical(
-    case: &Case,
+/// The fast mode's rows: the host's and the device's run of `case` (method `Fast`). Returns
+/// their comparison, or `None` when the device did not run it because the mesh does not fit
+/// its fast workspace or the board has none (the row says which).
+fn fast_rows(
+    board: &qemu::Board,
     backend: Backend,
-    host: &Outcome,
-    device: &Outcome,
-) -> Result<ExitCode> {
-    let index_type = case.index_type;
+    case: &Case,
+    (host, host_wall): (&Outcome, Duration),
+    (device, run): (Option<&Outcome>, &qemu::Run),
+) -> Result<Option<Comparison>> {
+    crate::outln!();
+    let h = &host.header;
+    let Some(device) = device else {
+        row(
+            "fast mode",
+            status_text(h),
+            format!("no result: {}", run.describe()),
+        );
+        return Ok(Some(Comparison {
+            host: Golden::from_outcome(case, backend, host)?,
+            device: None,
+            verdict: Verdict::Failed(format!("the firmware gave no result: {}", run.describe())),
+        }));
+    };
+    let d = &device.header;
+    if d.status == Status::TooBig {
+        let why = if d.capacity_vertices == 0 {
+            format!("{} has no fast mode", board.name)
+        } else {
+            format!(
+                "does not fit the fast workspace ({} V / {} T)",
+                d.capacity_vertices, d.capacity_triangles
+            )
+        };
+        row("fast mode", status_text(h), why);
+        return Ok(None);
+    }
+    row("status, fast mode", status_text(h), status_text(d));
+    row(
+        "triangles out, fast mode",
+        thousands(h.triangles_out.into()),
+        thousands(d.triangles_out.into()),
+    );
+    row(
+        "collapses, fast mode",
+        thousands(h.collapses.into()),
+        thousands(d.collapses.into()),
+    );
+    row(
+        "emulated instructions, fast mode",
+        "-".into(),
+        instructions_text(board, d),
+    );
+    row(
+        "time, fast mode",
+        format!("{:.1} ms wall", host_wall.as_secs_f64() * 1e3),
+        format!("{:.2} s wall under QEMU", run.wall.as_secs_f64()),
+    );
+    row(
+        "workspace RAM, fast mode",
+        format!(
+            "{} B (sized to the mesh)",
+            thousands(
+                crate::simplify::fast_bytes(case.positions.len(), case.triangles.len()) as u64
+            ),
+        ),
+        format!(
+            "{} B ({} V / {} T capacity)",
+            thousands(d.workspace_bytes.into()),
+            d.capacity_vertices,
+            d.capacity_triangles
+        ),
+    );
+    row(
+        "stack high-water, fast mode",
+        "-".into(),
+        format!(
+            "{} B (library: {} B)",
+            thousands(d.stack_high_water.into()),
+            thousands(d.stack_bytes.into())
+        ),
+    );
+    let c = compare(case, backend, host, device)?;
+    sha_row("output sha256, fast mode", &c);
+    Ok(Some(c))
+}
+
+/// One line of the side-by-side table.
+fn row(k: &str, x: String, y: String) {
+    crate::outln!("{k:<32} {x:<46} {y}");
+}
+
+/// The host's and the device's outputs of one case, as golden files, and how they compare.
+struct Comparison {
+    host: Golden,
+    device: Option<Golden>,
+    verdict: Verdict,
+}
+
+/// Compares the host's and the device's outputs of `case`.
+fn compare(case: &Case, backend: Backend, host: &Outcome, device: &Outcome) -> Result<Comparison> {
     let (gh, gd) = (
         Golden::from_outcome(case, backend, host)?,
         Golden::from_outcome(case, backend, device)?,
     );
-    row(
-        "output sha256",
-        golden::sha256_hex(&gh.bin)[..16].to_string(),
-        golden::sha256_hex(&gd.bin)[..16].to_string(),
-    );
-    crate::outln!();
-    match golden::diff(index_type, &gh, &gd) {
+    let verdict = golden::diff(case.index_type, &gh, &gd);
+    Ok(Comparison {
+        host: gh,
+        device: Some(gd),
+        verdict,
+    })
+}
+
+/// The row of the outputs' hashes.
+fn sha_row(k: &str, c: &Comparison) {
+    let sha = |g: &Golden| golden::sha256_hex(&g.bin)[..16].to_string();
+    row(k, sha(&c.host), c.device.as_ref().map_or("-".into(), sha));
+}
+
+/// Prints whether the outputs are the same bytes (`what: yes` or `what: NO` and the
+/// differences); true if they are.
+fn verdict(what: &str, c: &Comparison) -> bool {
+    match &c.verdict {
         Verdict::Identical => {
             crate::outln!(
-                "byte-identical: yes ({} bytes of output triangles, same report)",
-                gh.bin.len()
+                "{what}: yes ({} bytes of output triangles, same report)",
+                c.host.bin.len()
             );
-            Ok(ExitCode::SUCCESS)
+            true
         }
         v => {
-            crate::outln!("byte-identical: NO");
-            if let Verdict::Diff(d) = v {
-                for l in d {
-                    crate::outln!("  {l}");
+            crate::outln!("{what}: NO");
+            match v {
+                Verdict::Diff(d) => {
+                    for l in d {
+                        crate::outln!("  {l}");
+                    }
                 }
+                Verdict::Failed(why) | Verdict::Skipped(why) => crate::outln!("  {why}"),
+                Verdict::Identical => {}
             }
-            Ok(ExitCode::from(1))
+            false
         }
     }
 }
@@ -423,6 +574,49 @@ mod tests {
         assert_eq!(stop_reason(h.stop), "target reached");
         let e = meshfmt::ResultHeader::empty(IndexType::U32, Status::TooBig, meshfmt::Board::Host);
         assert!(status_text(&e).starts_with("TooBig"));
+    }
+
+    /// The demo's fast run is a case of method `Fast` (code 6 in the case file) whose host
+    /// reference is the library's fast mode; its instructions row divides by its collapses.
+    #[test]
+    fn the_fast_run_is_the_fast_mode() {
+        let m = meshfmt::golden::bumpy_grid(10);
+        let case = Case {
+            name: "g".into(),
+            mesh: "grid 10".into(),
+            positions: m.positions,
+            triangles: m.triangles,
+            index_type: IndexType::U16,
+            config: Config::new(),
+            stored: None,
+            method: None,
+        };
+        let fast = fast_case(&case);
+        assert_eq!(fast.header().method, meshfmt::MethodCode::Fast);
+        assert_eq!(fast.encode().unwrap()[30], 6);
+        assert_eq!(fast.positions, case.positions);
+        assert_eq!(fast.triangles, case.triangles);
+        let host = golden::reference(&fast).unwrap();
+        let mut t = case.triangles.clone();
+        let r = crate::simplify::fast_workspace_run(&case.positions, &mut t, &case.config).unwrap();
+        t.truncate(r.triangles_out);
+        assert_eq!(host.triangles, t);
+        assert_eq!(host.header.collapses as usize, r.collapses);
+        let board = qemu::board(qemu::REFERENCE_BOARD).unwrap();
+        let mut d = meshfmt::ResultHeader::empty(IndexType::U16, Status::Ok, meshfmt::Board::Host);
+        d.ticks = 1_000_000;
+        d.collapses = 40;
+        let instr = board.instructions(d.ticks);
+        assert_eq!(
+            instructions_text(board, &d),
+            format!(
+                "{} ({} per collapse)",
+                thousands(instr),
+                thousands(instr / 40)
+            )
+        );
+        d.collapses = 0;
+        assert_eq!(instructions_text(board, &d), thousands(instr));
     }
 
     #[test]

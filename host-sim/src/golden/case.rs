@@ -71,6 +71,9 @@ pub enum MethodName {
     VertexDecimation,
     /// The cost `cost::Energy::new` (Hoppe's energy), edge collapse.
     Energy,
+    /// The fast mode (`pipeline::FastWorkspace::simplify`): meshoptimizer's pipeline, its own
+    /// quadrics and workspace.
+    Fast,
 }
 
 impl MethodName {
@@ -79,6 +82,7 @@ impl MethodName {
         match self {
             MethodName::VertexDecimation => MethodCode::VertexDecimation,
             MethodName::Energy => MethodCode::Energy,
+            MethodName::Fast => MethodCode::Fast,
         }
     }
 }
@@ -134,8 +138,9 @@ pub struct CaseSpec {
     /// cost; boundary planes weighted by the config's boundary weight).
     #[serde(default)]
     pub quadric: Option<QuadricName>,
-    /// Optional: `vertex-decimation` (the operator `VertexDecimation`) or `energy` (the cost
-    /// `cost::Energy`); neither with `quadric` or `max_error`.
+    /// Optional: `vertex-decimation` (the operator `VertexDecimation`), `energy` (the cost
+    /// `cost::Energy`) or `fast` (the fast mode, `pipeline::FastWorkspace`); none with
+    /// `quadric` or `max_error`.
     #[serde(default)]
     pub method: Option<MethodName>,
     /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
@@ -498,5 +503,6 @@ fn run_reference<I: tinydecimate::Index>(
                 EdgeCollapse,
             )?
             .run(),
+        Entry::Fast => crate::simplify::fast_workspace_run(positions, triangles, config)?,
     })
 }

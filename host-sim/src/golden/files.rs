@@ -142,6 +142,9 @@ impl Golden {
             Some(super::case::MethodName::Energy) => {
                 writeln!(w, "method = \"Hoppe's energy, edge collapse\"")?
             }
+            Some(super::case::MethodName::Fast) => {
+                writeln!(w, "method = \"the fast mode (pipeline::FastWorkspace)\"")?
+            }
             None => {}
         }
         if case.config.max_error.is_finite() {
@@ -310,6 +313,8 @@ pub fn judge(
                 " (stored quadrics or energy samples: the firmware's QUADRIC_VERTICES may be lower)"
             } else if case.method == Some(super::case::MethodName::VertexDecimation) {
                 " (vertex decimation: the firmware's VERTEX_DECIMATION, stack for a removal's buffers)"
+            } else if case.method == Some(super::case::MethodName::Fast) {
+                " (the fast mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
             } else if case.config.max_error.is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {
