@@ -335,26 +335,7 @@ fn side_by_side(
         thousands(h.triangles_in.into()),
         thousands(d.triangles_in.into()),
     );
-    row(
-        "triangles out",
-        thousands(h.triangles_out.into()),
-        thousands(d.triangles_out.into()),
-    );
-    row(
-        "collapses",
-        thousands(h.collapses.into()),
-        thousands(d.collapses.into()),
-    );
-    row(
-        "emulated instructions",
-        "-".into(),
-        instructions_text(board, d),
-    );
-    row(
-        "time",
-        format!("{:.1} ms wall", host_wall.as_secs_f64() * 1e3),
-        format!("{:.2} s wall under QEMU", run.wall.as_secs_f64()),
-    );
+    run_rows("", board, (h, d), host_wall, run.wall);
     row(
         "workspace RAM",
         format!(
@@ -383,6 +364,37 @@ fn side_by_side(
 }
 
 /// The emulated instructions of a device run, and per collapse when it made any.
+/// The rows both runs print: triangles out, collapses, emulated instructions and time, each
+/// label followed by `suffix`.
+fn run_rows(
+    suffix: &str,
+    board: &qemu::Board,
+    (h, d): (&meshfmt::ResultHeader, &meshfmt::ResultHeader),
+    host_wall: Duration,
+    device_wall: Duration,
+) {
+    row(
+        &format!("triangles out{suffix}"),
+        thousands(h.triangles_out.into()),
+        thousands(d.triangles_out.into()),
+    );
+    row(
+        &format!("collapses{suffix}"),
+        thousands(h.collapses.into()),
+        thousands(d.collapses.into()),
+    );
+    row(
+        &format!("emulated instructions{suffix}"),
+        "-".into(),
+        instructions_text(board, d),
+    );
+    row(
+        &format!("time{suffix}"),
+        format!("{:.1} ms wall", host_wall.as_secs_f64() * 1e3),
+        format!("{:.2} s wall under QEMU", device_wall.as_secs_f64()),
+    );
+}
+
 fn instructions_text(board: &qemu::Board, d: &meshfmt::ResultHeader) -> String {
     let instr = board.instructions(d.ticks);
     format!(
@@ -437,26 +449,7 @@ fn fast_rows(
         return Ok(None);
     }
     row("status, fast mode", status_text(h), status_text(d));
-    row(
-        "triangles out, fast mode",
-        thousands(h.triangles_out.into()),
-        thousands(d.triangles_out.into()),
-    );
-    row(
-        "collapses, fast mode",
-        thousands(h.collapses.into()),
-        thousands(d.collapses.into()),
-    );
-    row(
-        "emulated instructions, fast mode",
-        "-".into(),
-        instructions_text(board, d),
-    );
-    row(
-        "time, fast mode",
-        format!("{:.1} ms wall", host_wall.as_secs_f64() * 1e3),
-        format!("{:.2} s wall under QEMU", run.wall.as_secs_f64()),
-    );
+    run_rows(", fast mode", board, (h, d), host_wall, run.wall);
     row(
         "workspace RAM, fast mode",
         format!(
