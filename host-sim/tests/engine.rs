@@ -52,23 +52,8 @@ fn the_error_limit_stops_the_fast_engine() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("stanford_bunny.obj");
     let out = d.path().join("b.obj");
-    let report = |limit: &str| {
-        let o = run(&[
-            "simplify",
-            s(&input),
-            s(&out),
-            "--ratio",
-            "0.01",
-            "--engine",
-            "fast",
-            "--error-limit",
-            limit,
-            "--json",
-        ]);
-        assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-        let j: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
-        j["report"].clone()
-    };
+    let report =
+        |limit: &str| fast_json(&input, &out, "0.01", &["--error-limit", limit])["report"].clone();
     let free = report("none");
     assert_eq!(free["stop"], "Target", "{free}");
     let limited = report("0.05%");
@@ -143,25 +128,36 @@ fn what_the_fast_engine_cannot_run_is_refused() {
 /// The fandisk (a CAD model: flat and cylindrical patches) to 50 %: every collapse it needs
 /// lies in a patch, so the result stays within 0.005 % of the diagonal of the input (Metro,
 /// both directions). Quadrics evaluated in a global frame in `f32` lose such errors to
-/// rounding and stray about 0.03 % from the surface; the vertex-centred ones do not.
+/// rounding; the vertex-centred ones do not.
 #[test]
 fn collapses_within_flat_patches_cost_no_error() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("fandisk.obj");
     let out = d.path().join("f.obj");
-    let o = run(&[
-        "simplify",
-        s(&input),
-        s(&out),
-        "--ratio",
-        "0.5",
-        "--engine",
-        "fast",
-        "--measure",
-        "--json",
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
-    let j: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+    let j = fast_json(&input, &out, "0.5", &["--measure"]);
     let h = j["metro"]["hausdorff_pct"].as_f64().unwrap();
     assert!(h < 0.005, "Hausdorff distance {h} % of the diagonal");
+}
+
+/// `simplify INPUT OUT --ratio R --engine fast --json EXTRA...`, which must succeed; its JSON.
+fn fast_json(
+    input: &std::path::Path,
+    out: &std::path::Path,
+    ratio: &str,
+    extra: &[&str],
+) -> serde_json::Value {
+    let mut args = vec![
+        "simplify",
+        s(input),
+        s(out),
+        "--ratio",
+        ratio,
+        "--engine",
+        "fast",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    serde_json::from_str(&text(&o.stdout)).unwrap()
 }
