@@ -29,9 +29,9 @@ pub(super) fn validate<'p, I: Index>(
             available: capacity,
         });
     }
-    // The used vertices marked, then measured once each instead of once per corner; the
-    // first bad index or coordinate in corner order is found by a second pass when there is
-    // one (`x * 0.0` is zero exactly when `x` is finite).
+    // Each used vertex's position is read once (marked in its flag byte), not once per
+    // corner; the first bad index or coordinate in corner order, which the error names, is
+    // searched for only when there is one (`x * 0.0` is zero exactly when `x` is finite).
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     let (mut bad, mut inf) = (true, 0.0f32);
     if let Some(used) = used.get_mut(..positions.len()) {
