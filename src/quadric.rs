@@ -47,6 +47,47 @@ pub(crate) fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
     [q[0], q[1], q[2], b0, q[4], q[5], b1, q[7], b2, form(q, s)]
 }
 
+/// A plane quadric kept in a frame centred on a point that each of its planes passes through
+/// (the fast mode's per-vertex quadric, of the planes of the vertex's own triangles): the
+/// offset terms of [`VertexQuadric`] are then zero, so only `A = Σ w n nᵀ` is kept, upper
+/// triangle row by row (`a², ab, ac, b², bc, c²` for one plane), 24 bytes.
+pub(crate) type PointQuadric = [f32; 6];
+
+/// `w · n nᵀ` for a plane of normal `n` through the frame's centre.
+#[inline]
+pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
+    let [a, b, c] = n;
+    [
+        a * a * w,
+        a * b * w,
+        a * c * w,
+        b * b * w,
+        b * c * w,
+        c * c * w,
+    ]
+}
+
+/// `dᵀ A d`, clamped at zero: the weighted sum of squared distances from `d` to the planes.
+#[inline]
+pub(crate) fn point_error(q: &PointQuadric, d: V3) -> f32 {
+    let [x, y, z] = d;
+    let e = q[0] * x * x
+        + q[3] * y * y
+        + q[5] * z * z
+        + 2.0 * (q[1] * x * y + q[2] * x * z + q[4] * y * z);
+    if e > 0.0 {
+        e
+    } else {
+        0.0
+    }
+}
+
+/// The sum of the planes' weights (`trace A`: each normal is a unit vector).
+#[inline]
+pub(crate) fn point_weight(q: &PointQuadric) -> f32 {
+    q[0] + q[3] + q[5]
+}
+
 /// `vᵀ Q v` for `v = (p, 1)`, unclamped.
 #[inline]
 pub(crate) fn form(q: &VertexQuadric, p: V3) -> f32 {

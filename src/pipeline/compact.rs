@@ -40,10 +40,10 @@ pub(super) fn compact<I: Index>(
     (w, nt - w)
 }
 
-/// Clears the pass's locks and marks.
+/// Clears the pass's locks and marks (not the dirty bits: fill reads them).
 #[inline(never)]
 pub(super) fn unlock(flags: &mut [u8]) {
     for f in flags.iter_mut() {
-        *f &= flag::KIND | flag::HIGH;
+        *f &= flag::KIND | flag::HIGH | flag::DIRTY;
     }
 }

@@ -1,104 +1,135 @@
-//! fill: per-vertex quadrics, once (meshoptimizer's `fillFaceQuadrics` and
-//! `fillEdgeQuadrics`): each triangle's plane quadric (Garland's, Cheng, Pan and Shi 1998 §2.3 eq. 3) with
-//! meshoptimizer's `sqrt(area)` weight, added at its three vertices; and for each border edge
-//! a plane through the edge perpendicular to its triangle, weighted by the edge's length
-//! times 10, plus the triangle's plane at the same weight, added at both ends, so that
-//! borders keep their shape. Every quadric is in its vertex's frame (module `pipeline`), where
-//! each of these planes passes through the origin.
+//! fill: per-vertex quadrics, afresh before every pass from the triangles as they are then
+//! (the memoryless quadric of Lindstrom and Turk 1998, which the default cost also uses; its
+//! planes are Garland's, Cheng, Pan and Shi 1998 §2.3 eq. 3): each triangle's plane quadric,
+//! weighted by its area, added at its three vertices; and for each border edge a plane
+//! through the edge perpendicular to its triangle, weighted by the edge's length times 10,
+//! plus the triangle's plane at 10 times its weight, added at both ends, so that borders keep
+//! their shape (meshoptimizer's `fillFaceQuadrics` and `fillEdgeQuadrics`).
+//!
+//! Every quadric is in its vertex's frame, where each of its planes passes through the
+//! origin: its offset terms are zero, exactly, so a [`PointQuadric`] (the 3×3 part, 24 bytes)
+//! holds it, and a collapse within a flat patch prices at zero, not at rounding.
 
-use super::{flag, flags_of, link, tri, Frame};
+use super::{fan, flag, flags_of, link, others, tri, Frame};
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::quadric::{self, VertexQuadric};
+use crate::quadric::{point_plane, PointQuadric};
 
 /// meshoptimizer's `kEdgeWeightBorder`.
 const BORDER_WEIGHT: f32 = 10.0;
 
-/// `w · (n nᵀ)` for the plane `n·x + d = 0`.
 #[inline]
-fn plane(n: V3, d: f32, w: f32) -> VertexQuadric {
-    quadric::outer(n, d).map(|x| x * w)
-}
-
-#[inline]
-fn add_to(q: &mut [VertexQuadric], v: usize, x: &VertexQuadric) {
+fn add_to(q: &mut [PointQuadric], v: usize, x: &PointQuadric) {
     if let Some(q) = q.get_mut(v) {
-        *q = quadric::add(q, x);
+        for (s, y) in q.iter_mut().zip(x) {
+            *s += y;
+        }
     }
 }
 
-/// The plane quadric of triangle `p` with weight `sqrt(area) · w`, zero without area, in the
-/// frame of any of its vertices: the plane passes through each, so its offset there is zero
-/// (exactly, not to rounding).
+/// The plane quadric of triangle `p`, weighted by its area times `w`, zero without area. With
+/// `c` the cross product of two edges, `area · n nᵀ = c cᵀ / (2|c|)`: one reciprocal square
+/// root, no normalisation.
 #[inline]
-fn triangle(p: [V3; 3], w: f32) -> VertexQuadric {
+fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
     let c = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
     let l2 = math::dot(c, c);
     if !(l2 > math::TINY2 && l2.is_finite()) {
-        return [0.0; 10];
+        return [0.0; 6];
     }
-    let inv = math::rsqrt(l2);
-    let n = math::scale(c, inv);
-    let area = 0.5 * l2 * inv;
-    plane(n, 0.0, math::sqrt(area) * w)
+    point_plane(c, 0.5 * math::rsqrt(l2) * w)
 }
 
-/// Zeroes the quadrics and adds every triangle's plane at its vertices.
+/// Whether `v`'s quadric is filled in this pass: every vertex in the first, then those a
+/// collapse dirtied (a vertex whose triangles no collapse changed keeps its quadric, which a
+/// fill would give again).
+#[inline]
+fn due(flags: &[u8], v: usize, all: bool) -> bool {
+    all || flags_of(flags, v) & flag::DIRTY != 0
+}
+
+/// Zeroes the due quadrics and adds every triangle's plane at its due vertices.
 #[inline(never)]
 pub(super) fn face_quadrics<I: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
-    nt: usize,
-    quadrics: &mut [VertexQuadric],
+    flags: &[u8],
+    quadrics: &mut [PointQuadric],
+    all: bool,
 ) {
-    for q in quadrics.iter_mut() {
-        *q = [0.0; 10];
+    for (v, q) in quadrics.iter_mut().enumerate() {
+        if due(flags, v, all) {
+            *q = [0.0; 6];
+        }
     }
-    for t in 0..nt {
+    for t in 0..triangles.len() {
         let tr = tri(triangles, t);
+        let d = tr.map(|v| due(flags, v, all));
+        if !(d[0] || d[1] || d[2]) {
+            continue;
+        }
         let q = triangle(tr.map(|v| frame.at(v)), 1.0);
-        for v in tr {
-            add_to(quadrics, v, &q);
+        for (v, d) in tr.into_iter().zip(d) {
+            if d {
+                add_to(quadrics, v, &q);
+            }
         }
     }
 }
 
-/// Adds the border edge quadrics: for each open edge `v → border_next[v]`.
+/// Adds the border edge quadrics at the due ends of each open edge `v → border_next[v]`, and
+/// clears the dirty bits.
 #[inline(never)]
 pub(super) fn border_quadrics<I: Index, L: Index>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
-    nt: usize,
-    flags: &[u8],
+    adj: (&[L], &[L]),
+    flags: &mut [u8],
     border_next: &[L],
-    quadrics: &mut [VertexQuadric],
+    quadrics: &mut [PointQuadric],
+    all: bool,
 ) {
-    for t in 0..nt {
-        let tr = tri(triangles, t);
-        for e in 0..3 {
-            let (i0, i1, i2) = match e {
-                0 => (tr[0], tr[1], tr[2]),
-                1 => (tr[1], tr[2], tr[0]),
-                _ => (tr[2], tr[0], tr[1]),
-            };
-            if flags_of(flags, i0) & flag::KIND != flag::BORDER || link(border_next, i0) != i1 {
-                continue;
-            }
-            let (p0, p1, p2) = (frame.at(i0), frame.at(i1), frame.at(i2));
-            let e10 = math::sub(p1, p0);
-            let e20 = math::sub(p2, p0);
-            let l2 = math::dot(e10, e10);
-            let proj = math::dot(e20, e10);
-            let perp = math::sub(math::scale(e20, l2), math::scale(e10, proj));
-            let pl2 = math::dot(perp, perp);
-            if !(l2 > math::TINY2 && pl2 > math::TINY2 && pl2.is_finite()) {
-                continue;
-            }
-            let n = math::scale(perp, math::rsqrt(pl2));
-            let w = math::sqrt(l2) * BORDER_WEIGHT;
-            let q = quadric::add(&plane(n, 0.0, w), &triangle([p0, p1, p2], BORDER_WEIGHT));
+    for i0 in 0..flags.len() {
+        if flags_of(flags, i0) & flag::KIND != flag::BORDER {
+            continue;
+        }
+        let i1 = link(border_next, i0);
+        let (d0, d1) = (due(flags, i0, all), due(flags, i1, all));
+        if !(d0 || d1) {
+            continue;
+        }
+        // The open edge's triangle: the one of i0's fan with i1 after i0.
+        let Some(i2) = fan(triangles, adj, flags, i0)
+            .map(|(_, tr, k)| others(tr, k))
+            .find(|&(x, _)| x == i1)
+            .map(|(_, y)| y)
+        else {
+            continue;
+        };
+        let (p0, p1, p2) = (frame.at(i0), frame.at(i1), frame.at(i2));
+        let e10 = math::sub(p1, p0);
+        let e20 = math::sub(p2, p0);
+        let l2 = math::dot(e10, e10);
+        let proj = math::dot(e20, e10);
+        let perp = math::sub(math::scale(e20, l2), math::scale(e10, proj));
+        let pl2 = math::dot(perp, perp);
+        if !(l2 > math::TINY2 && pl2 > math::TINY2 && pl2.is_finite()) {
+            continue;
+        }
+        let n = math::scale(perp, math::rsqrt(pl2));
+        let face = triangle([p0, p1, p2], BORDER_WEIGHT);
+        let mut q = point_plane(n, math::sqrt(l2) * BORDER_WEIGHT);
+        for (s, y) in q.iter_mut().zip(&face) {
+            *s += y;
+        }
+        if d0 {
             add_to(quadrics, i0, &q);
+        }
+        if d1 {
             add_to(quadrics, i1, &q);
         }
+    }
+    for f in flags.iter_mut() {
+        *f &= !flag::DIRTY;
     }
 }

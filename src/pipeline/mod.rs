@@ -2,24 +2,23 @@
 //! memory, with every output valid.
 //!
 //! The pipeline follows `meshopt_simplifyEdge` of Arseny Kapoulkine's meshoptimizer
-//! (`src/simplifier.cpp`): per-vertex plane quadrics accumulated once (Garland's quadric
-//! error metric as Cheng, Pan and Shi 1998 use it, §2.3: the quadric `K_p = p pᵀ` of each
-//! triangle's plane, eq. 3, summed at its vertices and added on collapse; see `crate::quadric`), then
-//! passes that price every candidate once from the quadrics, order them by a counting sort on
-//! the top bits of the float cost, and collapse in that order while locking both ends of each
-//! collapse for the rest of the pass; a pass ends at its error goal (1.5 times the cost of the
-//! collapse that would reach the pass's goal, as meshoptimizer), the quadrics of collapsed
-//! pairs are merged and the triangle buffer compacted, and the next pass runs on the smaller
-//! mesh. Placement is the subset one of Lin 2007 §2 (a vertex collapses onto an existing
-//! vertex), so the positions are only read and may stay in flash.
+//! (`src/simplifier.cpp`): passes that price every candidate once from per-vertex plane
+//! quadrics (Garland's quadric error metric as Cheng, Pan and Shi 1998 use it, §2.3: the
+//! quadric `K_p = p pᵀ` of each triangle's plane, eq. 3, summed at its vertices; see
+//! `crate::quadric`), order them by a counting sort on the top bits of the float cost, and
+//! collapse in that order while locking both ends of each collapse for the rest of the pass;
+//! a pass ends at its error goal (1.5 times the cost of the collapse that would reach the
+//! pass's goal, as meshoptimizer), the triangle buffer is compacted, and the next pass runs on
+//! the smaller mesh. Placement is the subset one of Lin 2007 §2 (a vertex collapses onto an
+//! existing vertex), so the positions are only read and may stay in flash.
 //!
 //! ```text
 //! build     validate, drop degenerate triangles, fan lists
 //! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex;
 //!           drop duplicate triangles
-//! fill      face quadrics (sqrt(area) weight, as meshoptimizer) and border edge quadrics,
-//!           each in its vertex's frame
 //! loop {
+//!   fill      the quadrics of the vertices whose triangles changed (all in the first pass):
+//!             area-weighted face planes and border edge planes, each in its vertex's frame
 //!   pick      each vertex's cheapest collapse its kind allows, from its quadric
 //!   sort      counting sort on the cost's top 12 bits
 //!   perform   in order, to the pass's error goal: skip locked ends, check, collapse, lock both
@@ -27,11 +26,19 @@
 //! }
 //! ```
 //!
-//! Each vertex's quadric is kept in a frame centred on that vertex (moved to the kept vertex
-//! on a collapse, `quadric::translate`), as `StoredQuadric` keeps its own: a plane through the
-//! vertex then has offset zero exactly, and a collapse within a flat patch prices at zero
-//! instead of at the rounding of terms of order one, so CAD models lose their flat regions'
-//! triangles first and without error.
+//! The quadrics are not accumulated, as meshoptimizer's are, but filled before each pass from
+//! the triangles as they are then (the memoryless quadric of Lindstrom and Turk 1998, the
+//! default cost's): a collapse's price is the area-weighted squared distance from its target
+//! to the planes of the surface it changes, not to the input's surface near it. That orders
+//! collapses by the error they add to the current mesh, which lowers the mean error; and no
+//! quadric is merged on a collapse (in its pass neither end is priced again), so only the
+//! vertices whose triangles a collapse changed (the `DIRTY` flag) are filled again.
+//!
+//! Each vertex's quadric is in a frame centred on that vertex: every plane it holds passes
+//! through the vertex, so its offset terms are zero exactly and it is a
+//! [`PointQuadric`](crate::quadric::PointQuadric), the 3×3 part alone (24 bytes, not 40); and
+//! a collapse within a flat patch prices at zero instead of at the rounding of terms of order
+//! one, so CAD models lose their flat regions' triangles first and without error.
 //!
 //! Differences from meshoptimizer, each for a promise this crate makes: a vertex keeps one
 //! candidate (its cheapest allowed collapse) instead of one per edge, so the sort buffer is one
@@ -67,7 +74,7 @@ mod sort;
 use crate::error::Capacity;
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::quadric::VertexQuadric;
+use crate::quadric::PointQuadric;
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Error};
 
@@ -93,8 +100,11 @@ pub(crate) mod flag {
     pub const PASS: u8 = 4;
     /// Scratch mark (the link condition).
     pub const MARK: u8 = 8;
-    /// The bits of a fan list's start above the link type's width (see [`super::start`]).
-    pub const HIGH: u8 = 0xf0;
+    /// A collapse changed one of the vertex's triangles since its quadric was filled.
+    pub const DIRTY: u8 = 0x40;
+    /// The bits of a fan list's end above the link type's width (see [`super::end`]): two, as
+    /// `3·T` entries with `T ≤ L::COUNT` need at most two more bits than the link has.
+    pub const HIGH: u8 = 0x30;
     /// Shift of [`HIGH`].
     pub const HIGH_SHIFT: u32 = 4;
 }
@@ -104,12 +114,12 @@ pub(crate) mod flag {
 /// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
 /// * `V`, `T`: the largest mesh it takes (vertices, triangles).
 ///
-/// Per vertex: a quadric (10 `f32`, 40 B), four links (fan list end, border successor,
+/// Per vertex: a quadric (6 `f32`, 24 B), four links (fan list end, border successor,
 /// candidate target, sort slot), a candidate cost (`f32`) and a flag byte; per triangle three
 /// fan list entries (one per corner); plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
-/// `V ≈ T/2` that is about 32.5 bytes per triangle ([`FastWorkspace::BYTES`]).
+/// `V ≈ T/2` that is about 24.5 bytes per triangle ([`FastWorkspace::BYTES`]).
 pub struct FastWorkspace<L: Index, const V: usize, const T: usize> {
-    quadrics: [VertexQuadric; V],
+    quadrics: [PointQuadric; V],
     first: [L; V],
     border_next: [L; V],
     target: [L; V],
@@ -218,16 +228,15 @@ const fn bits<L>() -> u32 {
 
 /// Where `v`'s fan list ends in the fan lists (or, while they are built, the next free
 /// entry): its low bits in `first[v]`, the bits above the link type's width in `v`'s flag
-/// byte (3·T entries need two more bits than a `u16` link has, and the flag byte has four
-/// spare).
+/// byte's [`flag::HIGH`] (3·T entries need two more bits than a `u16` link has).
 #[inline]
 pub(crate) fn end<L: Index>(first: &[L], flags: &[u8], v: usize) -> usize {
     let lo = first.get(v).map_or(0, |l| l.to_usize());
-    let hi = (flags_of(flags, v) >> flag::HIGH_SHIFT) as usize;
+    let hi = ((flags_of(flags, v) & flag::HIGH) >> flag::HIGH_SHIFT) as usize;
     lo | hi.checked_shl(bits::<L>()).unwrap_or(0)
 }
 
-/// Sets `v`'s list end (below `16 << bits(L)`).
+/// Sets `v`'s list end (below `4 << bits(L)`).
 #[inline]
 pub(crate) fn set_end<L: Index>(first: &mut [L], flags: &mut [u8], v: usize, s: usize) {
     let hi = s.checked_shr(bits::<L>()).unwrap_or(0);
@@ -236,7 +245,7 @@ pub(crate) fn set_end<L: Index>(first: &mut [L], flags: &mut [u8], v: usize, s: 
         *l = L::narrow(lo);
     }
     if let Some(f) = flags.get_mut(v) {
-        *f = (*f & !flag::HIGH) | ((hi as u8) << flag::HIGH_SHIFT);
+        *f = (*f & !flag::HIGH) | (((hi as u8) << flag::HIGH_SHIFT) & flag::HIGH);
     }
 }
 
@@ -247,7 +256,7 @@ pub(crate) fn bump_end<L: Index>(first: &mut [L], flags: &mut [u8], v: usize) ->
         return NONE;
     };
     let lo = l.to_usize();
-    let hi = (*f >> flag::HIGH_SHIFT) as usize;
+    let hi = ((*f & flag::HIGH) >> flag::HIGH_SHIFT) as usize;
     let old = lo | hi.checked_shl(bits::<L>()).unwrap_or(0);
     match L::from_usize(lo + 1) {
         Some(n) if lo + 1 < L::COUNT => *l = n,
@@ -329,7 +338,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     /// An empty workspace; `const` and all zero bits, so a `static` goes to `.bss`.
     pub const fn new() -> Self {
         FastWorkspace {
-            quadrics: [[0.0; 10]; V],
+            quadrics: [[0.0; 6]; V],
             first: [L::ZERO; V],
             border_next: [L::ZERO; V],
             target: [L::ZERO; V],
@@ -419,9 +428,6 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         }
         let valid = nt;
 
-        // fill
-        fill::face_quadrics(&frame, triangles, nt, quadrics);
-        fill::border_quadrics(&frame, triangles, nt, flags, border_next, quadrics);
         // The limit as a price: a squared distance in the unit frame.
         let limit = config.error_limit * frame.scale;
         let limit = limit * limit;
@@ -439,6 +445,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             }
             let tris = triangles.get(..nt).unwrap_or(&[]);
             let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
+            fill::face_quadrics(&frame, tris, flags, quadrics, passes == 0);
+            fill::border_quadrics(&frame, tris, adj, flags, border_next, quadrics, passes == 0);
             pick::pick(
                 &frame,
                 tris,
@@ -462,7 +470,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 (&*first, lists.get(..3 * nt).unwrap_or(&[])),
                 flags,
                 border_next,
-                quadrics,
+                &*quadrics,
                 (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
                 (goal, limit),
                 &mut stats,

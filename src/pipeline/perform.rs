@@ -23,8 +23,7 @@
 //! unit frame, above the limit's square) is never collapsed.
 //!
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
-//! degenerate: compact drops them), adds a's quadric, moved to b's frame, to b's, and locks
-//! both ends.
+//! degenerate: compact drops them) and locks both ends.
 
 use super::{
     dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
@@ -32,7 +31,7 @@ use super::{
 use crate::index::Index;
 use crate::legality::Reject;
 use crate::math::{self, V3};
-use crate::quadric::{self, VertexQuadric};
+use crate::quadric::{self, PointQuadric};
 
 /// Below this a squared cross product (in the unit frame) has no direction: a triangle of area
 /// 5e-10 of the bounding box's face. Survivors must be above it, so fold tests never underflow.
@@ -103,8 +102,8 @@ pub(super) const fn on(name: &str) -> bool {
 /// which is its quadric's trace (every plane's normal is a unit vector; `StoredQuadric::error2`
 /// likewise): a weighted mean squared distance in the unit frame, zero without weight.
 #[inline]
-fn error(quadrics: &[VertexQuadric], a: usize, c: f32) -> f32 {
-    let w = quadrics.get(a).map_or(0.0, |q| q[0] + q[4] + q[7]);
+fn error(quadrics: &[PointQuadric], a: usize, c: f32) -> f32 {
+    let w = quadrics.get(a).map_or(0.0, quadric::point_weight);
     if w > 0.0 {
         c / w
     } else {
@@ -120,7 +119,7 @@ fn alternative<I: Index, L: Index>(
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     (flags, border_next): (&[u8], &[L]),
-    quadrics: &[VertexQuadric],
+    quadrics: &[PointQuadric],
     a: usize,
     b: usize,
 ) -> Option<(usize, f32)> {
@@ -144,7 +143,7 @@ fn alternative<I: Index, L: Index>(
             {
                 continue;
             }
-            let e = quadric::error(q, math::sub(frame.at(w), pa));
+            let e = quadric::point_error(q, math::sub(frame.at(w), pa));
             if best.is_none_or(|(v, c)| e < c || (e == c && w < v)) {
                 best = Some((w, e));
             }
@@ -162,7 +161,7 @@ pub(super) fn perform<I: Index, L: Index>(
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    quadrics: &mut [VertexQuadric],
+    quadrics: &[PointQuadric],
     (target, cost, order): (&mut [L], &[f32], &[L]),
     (goal, limit): (usize, f32),
     stats: &mut Stats,
@@ -220,7 +219,7 @@ pub(super) fn perform<I: Index, L: Index>(
                 }
             }
         };
-        collapse(frame, tris, adj, flags, border_next, quadrics, (a, b));
+        collapse(tris, adj, flags, border_next, (a, b));
         // The live triangles on a-b, which check counted, die.
         removed += dying;
         // b's candidate is spent for this pass: its slot names the vertex that moved onto it.
@@ -502,16 +501,15 @@ fn mark(flags: &mut [u8], v: usize, on: bool) {
     }
 }
 
-/// `a → b`: a's corners rewritten to b, a's quadric added to b's, border successors kept,
-/// both ends locked for the pass.
+/// `a → b`: a's corners rewritten to b, border successors kept, both ends locked for the
+/// pass. No quadric is merged: the next pass fills them afresh, and in this pass neither end
+/// is priced again.
 #[inline(never)]
 fn collapse<I: Index, L: Index>(
-    frame: &Frame<'_>,
     tris: &mut [[I; 3]],
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    quadrics: &mut [VertexQuadric],
     (a, b): (usize, usize),
 ) {
     if flags_of(flags, a) & flag::KIND == flag::BORDER {
@@ -542,16 +540,16 @@ fn collapse<I: Index, L: Index>(
         let Some(k) = tris.get(t).and_then(|x| slot(x.map(|v| v.to_usize()), a)) else {
             break;
         };
-        if let Some(c) = tris.get_mut(t).and_then(|x| x.get_mut(k)) {
-            *c = nb;
-        }
-    }
-    if let Some(&qa) = quadrics.get(a) {
-        if let Some(q) = quadrics.get_mut(b) {
-            *q = quadric::add(
-                q,
-                &quadric::translate(&qa, math::sub(frame.at(b), frame.at(a))),
-            );
+        if let Some(x) = tris.get_mut(t) {
+            // Each corner's quadric changes: the next fill takes it afresh.
+            for v in x.iter() {
+                if let Some(f) = flags.get_mut(v.to_usize()) {
+                    *f |= flag::DIRTY;
+                }
+            }
+            if let Some(c) = x.get_mut(k) {
+                *c = nb;
+            }
         }
     }
     if let Some(f) = flags.get_mut(a) {

@@ -8,7 +8,7 @@ use super::sort::key;
 use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
 use crate::index::Index;
 use crate::math;
-use crate::quadric::{self, VertexQuadric};
+use crate::quadric::{self, PointQuadric};
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
 /// the vertex after it in each triangle (the triangle across offers the other direction), a
@@ -23,7 +23,7 @@ pub(super) fn pick<I: Index, L: Index>(
     adj: (&[L], &[L]),
     flags: &[u8],
     border_next: &[L],
-    quadrics: &[VertexQuadric],
+    quadrics: &[PointQuadric],
     (target, cost): (&mut [L], &mut [f32]),
     histogram: &mut [L; BINS],
 ) {
@@ -40,10 +40,10 @@ pub(super) fn pick<I: Index, L: Index>(
         let (mut best, mut to) = (f32::INFINITY, NONE);
         let border = !free(ka) && ka == flag::BORDER;
         if free(ka) || border {
-            let q = quadrics.get(a).copied().unwrap_or([0.0; 10]);
+            let q = quadrics.get(a).copied().unwrap_or([0.0; 6]);
             let pa = frame.at(a);
             let mut offer = |b: usize| {
-                let e = quadric::error(&q, math::sub(frame.at(b), pa));
+                let e = quadric::point_error(&q, math::sub(frame.at(b), pa));
                 if e < best || (e == best && b < to) {
                     best = e;
                     to = b;
