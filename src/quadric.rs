@@ -47,12 +47,14 @@ pub(crate) fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
     [q[0], q[1], q[2], b0, q[4], q[5], b1, q[7], b2, form(q, s)]
 }
 
+#[cfg(feature = "fast")]
 /// A plane quadric kept in a frame centred on a point that each of its planes passes through
 /// (the fast mode's per-vertex quadric, of the planes of the vertex's own triangles): the
 /// offset terms of [`VertexQuadric`] are then zero, so only `A = Σ w n nᵀ` is kept, upper
 /// triangle row by row (`a², ab, ac, b², bc, c²` for one plane), 24 bytes.
 pub(crate) type PointQuadric = [f32; 6];
 
+#[cfg(feature = "fast")]
 /// `w · n nᵀ` for a plane of normal `n` through the frame's centre.
 #[inline]
 pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
@@ -67,6 +69,7 @@ pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
     ]
 }
 
+#[cfg(feature = "fast")]
 /// `dᵀ A d`, clamped at zero: the weighted sum of squared distances from `d` to the planes.
 #[inline]
 pub(crate) fn point_error(q: &PointQuadric, d: V3) -> f32 {
@@ -82,6 +85,7 @@ pub(crate) fn point_error(q: &PointQuadric, d: V3) -> f32 {
     }
 }
 
+#[cfg(feature = "fast")]
 /// The sum of the planes' weights (`trace A`: each normal is a unit vector).
 #[inline]
 pub(crate) fn point_weight(q: &PointQuadric) -> f32 {

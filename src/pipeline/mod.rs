@@ -36,7 +36,7 @@
 //!
 //! Each vertex's quadric is in a frame centred on that vertex: every plane it holds passes
 //! through the vertex, so its offset terms are zero exactly and it is a
-//! [`PointQuadric`](crate::quadric::PointQuadric), the 3×3 part alone (24 bytes, not 40); and
+//! `quadric::PointQuadric`, the 3×3 part alone (24 bytes, not 40); and
 //! a collapse within a flat patch prices at zero instead of at the rounding of terms of order
 //! one, so CAD models lose their flat regions' triangles first and without error.
 //!
