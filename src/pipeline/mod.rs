@@ -7,8 +7,8 @@
 //! quadric `K_p = p pᵀ` of each triangle's plane, eq. 3, summed at its vertices; see
 //! `crate::quadric`), order them by a counting sort on the top bits of the float cost, and
 //! collapse in that order while locking both ends of each collapse for the rest of the pass;
-//! a pass ends at its error goal (1.5 times the cost of the collapse that would reach the
-//! pass's goal, as meshoptimizer), the triangle buffer is compacted, and the next pass runs on
+//! a pass ends at its error goal (the cost of the collapse that would reach the pass's goal,
+//! which is half the live triangles at most), the triangle buffer is compacted, and the next pass runs on
 //! the smaller mesh. Placement is the subset one of Lin 2007 §2 (a vertex collapses onto an
 //! existing vertex), so the positions are only read and may stay in flash.
 //!
@@ -80,6 +80,13 @@ use crate::{Config, Error};
 
 /// Bins of the counting sort (12 bits of the cost: 8 of exponent, 4 of mantissa, from 2⁻⁴⁸).
 pub(crate) const BINS: usize = 1024;
+
+/// A pass removes at most `1 / PASS_SHARE` of the live triangles, however far the target is:
+/// a price from the current triangles goes stale as the pass changes them, so a pass that
+/// aims far collapses past prices that its locked vertices would have undercut (the batched
+/// schedule's `PASS_SHARE` for the memoryless cost, the same reason); meshoptimizer, whose
+/// accumulated quadrics do not go stale, aims each pass at the target.
+const PASS_SHARE: usize = 2;
 
 /// "No vertex" / "no triangle" as `usize`.
 pub(crate) const NONE: usize = usize::MAX;
@@ -462,7 +469,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
                 break Stop::NoLegalCollapse;
             }
             let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
-            let goal = nt - target_triangles;
+            // A pass aims at half the live triangles at most (see `PASS_SHARE`).
+            let goal = (nt - target_triangles).min((nt / PASS_SHARE).max(2));
             let refused = stats.over_limit;
             let done = perform::perform(
                 &frame,

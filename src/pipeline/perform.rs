@@ -2,7 +2,7 @@
 //!
 //! A candidate is skipped when either end is already an end of a collapse in this pass (so a
 //! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
-//! at its goal or at its error goal: 1.5 times the cost of the candidate that would reach the
+//! at its goal or at its error goal: the cost of the candidate that would reach the
 //! goal, once a sixth of the goal is done. A refused candidate is followed at once by a's
 //! next cheapest target, if it is within the error goal. Each candidate is checked on the
 //! current mesh, the rules in order of cost, each where it can fire:
@@ -38,6 +38,12 @@ use crate::quadric::{self, PointQuadric};
 const TINY: f32 = 1e-18;
 /// `|n|² / (Σ edge²)²` below this: a normal that rounding decides (zero area).
 const FLAT: f32 = 1e-8;
+/// The pass's error goal over the price of the candidate that would reach its goal.
+/// meshoptimizer takes 1.5 with its accumulated quadrics; with quadrics filled afresh each pass
+/// (a price that only sees the current triangles) a pass that runs past that price collapses
+/// vertices whose neighbours, locked by this pass, would have been cheaper: 1.0, as the
+/// batched schedule's `PASS_LIMIT` for the memoryless cost.
+const ERROR_GOAL: f32 = 1.0;
 /// meshoptimizer's flip limit, `cos ≈ 0.25` (about 75°), squared.
 const FLIP2: f32 = 0.0625;
 /// The checker's fold limit, `-0.9`, squared.
@@ -177,7 +183,7 @@ pub(super) fn perform<I: Index, L: Index>(
         let a = link(order, i);
         let c = cost_of(a);
         let error_goal = if edge_goal < m {
-            1.5 * cost_of(link(order, edge_goal))
+            ERROR_GOAL * cost_of(link(order, edge_goal))
         } else {
             f32::INFINITY
         };
