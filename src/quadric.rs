@@ -47,11 +47,10 @@ pub(crate) fn translate(q: &VertexQuadric, s: V3) -> VertexQuadric {
     [q[0], q[1], q[2], b0, q[4], q[5], b1, q[7], b2, form(q, s)]
 }
 
-#[cfg(feature = "fast")]
 /// A plane quadric kept in a frame centred on a point that each of its planes passes through
-/// (the fast mode's per-vertex quadric, of the planes of the vertex's own triangles): the
-/// offset terms of [`VertexQuadric`] are then zero, so only `A = Σ w n nᵀ` is kept, upper
-/// triangle row by row (`a², ab, ac, b², bc, c²` for one plane), 24 bytes.
+/// (the fast mode's per-vertex quadric, and the memoryless cost's fan summary, of the planes
+/// of the vertex's own triangles): the offset terms of [`VertexQuadric`] are then zero, so
+/// only `A = Σ w n nᵀ` is kept, upper triangle row by row (`a², ab, ac, b², bc, c²` for one plane), 24 bytes.
 pub(crate) type PointQuadric = [f32; 6];
 
 #[cfg(feature = "fast")]
@@ -69,7 +68,6 @@ pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
     ]
 }
 
-#[cfg(feature = "fast")]
 /// `dᵀ A d`, clamped at zero: the weighted sum of squared distances from `d` to the planes.
 #[inline]
 pub(crate) fn point_error(q: &PointQuadric, d: V3) -> f32 {

@@ -51,16 +51,7 @@ impl Default for Quadric {
 /// `dᵀ Q d` of the fan's quadric, clamped at zero (rounding can make it slightly negative).
 #[inline]
 fn form(f: &QuadricFan, d: [f32; 3]) -> f32 {
-    let q = &f.q;
-    let e = q[0] * d[0] * d[0]
-        + q[3] * d[1] * d[1]
-        + q[5] * d[2] * d[2]
-        + 2.0 * (q[1] * d[0] * d[1] + q[2] * d[0] * d[2] + q[4] * d[1] * d[2]);
-    if e > 0.0 {
-        e
-    } else {
-        0.0
-    }
+    crate::quadric::point_error(&f.q, d)
 }
 
 /// The fan summary of [`Quadric`]: `Q` (upper triangle, row by row) and twice the area.
