@@ -5,21 +5,39 @@
 //! valgrind --tool=callgrind --toggle-collect='fast_cow::run' target/release/examples/fast_cow
 //! ```
 //!
-//! `run` is the library call alone (`FastWorkspace::simplify`); reading the OBJ is outside
-//! it. Optional arguments: an OBJ path (default `tests/fixtures/cow.obj`), a ratio (0.1) and
+//! `run` is the library call alone (`FastWorkspace::simplify`, or with `FAST_COW_LEAN=1` the
+//! lean mode's `LeanWorkspace::simplify`); reading the OBJ is outside it. Optional arguments: an OBJ path (default `tests/fixtures/cow.obj`), a ratio (0.1) and
 //! an output OBJ path.
 
 use std::sync::Mutex;
-use tinydecimate::pipeline::FastWorkspace;
+use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
 use tinydecimate::{Config, Report};
 
 /// u16 links (the cow's case), and u32 links for the larger meshes.
 static SMALL: Mutex<FastWorkspace<u16, 65_535, 65_535>> = Mutex::new(FastWorkspace::new());
 static LARGE: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
+/// The lean mode's (`FAST_COW_LEAN=1`).
+static LEAN_SMALL: Mutex<LeanWorkspace<u16, 65_535, 65_535>> = Mutex::new(LeanWorkspace::new());
+static LEAN_LARGE: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
 
 #[inline(never)]
 fn run(positions: &[[f32; 3]], tris: &mut [[u32; 3]], ratio: f32) -> Report {
     let config = Config::new().with_ratio(ratio);
+    let small = positions.len() < 65_535 && tris.len() < 65_535;
+    if std::env::var_os("FAST_COW_LEAN").is_some() {
+        return if small {
+            LEAN_SMALL
+                .lock()
+                .unwrap()
+                .simplify(positions, tris, &config)
+        } else {
+            LEAN_LARGE
+                .lock()
+                .unwrap()
+                .simplify(positions, tris, &config)
+        }
+        .expect("simplify");
+    }
     if positions.len() < 65_535 && tris.len() < 65_535 {
         SMALL.lock().unwrap().simplify(positions, tris, &config)
     } else {

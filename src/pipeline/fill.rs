@@ -77,6 +77,73 @@ pub(super) fn face_quadrics<I: Index>(
     }
 }
 
+/// The quadric of open edge `p0 → p1` of triangle `(p0, p1, p2)`: the plane through the edge
+/// perpendicular to the triangle, weighted by the edge's length times [`BORDER_WEIGHT`], plus
+/// the triangle's plane at [`BORDER_WEIGHT`] times its area; `None` for a degenerate edge or
+/// triangle.
+#[inline]
+fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
+    let e10 = math::sub(p1, p0);
+    let e20 = math::sub(p2, p0);
+    let l2 = math::dot(e10, e10);
+    let proj = math::dot(e20, e10);
+    let perp = math::sub(math::scale(e20, l2), math::scale(e10, proj));
+    let pl2 = math::dot(perp, perp);
+    if !(l2 > math::TINY2 && pl2 > math::TINY2 && pl2.is_finite()) {
+        return None;
+    }
+    let n = math::scale(perp, math::rsqrt(pl2));
+    let face = triangle([p0, p1, p2], BORDER_WEIGHT);
+    let mut q = point_plane(n, math::sqrt(l2) * BORDER_WEIGHT);
+    for (s, y) in q.iter_mut().zip(&face) {
+        *s += y;
+    }
+    Some(q)
+}
+
+/// `v`'s quadric from its fan as it is now (the lean mode's, which stores none): the same
+/// planes as [`face_quadrics`] and [`border_quadrics`] give it, summed in fan order.
+#[inline]
+pub(super) fn vertex_quadric<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    border_next: &[L],
+    v: usize,
+) -> PointQuadric {
+    let mut q = [0.0; 6];
+    let border = flags_of(flags, v) & flag::KIND == flag::BORDER;
+    let pv = frame.at(v);
+    for (_, tr, k) in fan(triangles, adj, flags, v) {
+        if super::dead(tr) {
+            continue;
+        }
+        let (x, y) = others(tr, k);
+        let (px, py) = (frame.at(x), frame.at(y));
+        let mut add = |x: &PointQuadric| {
+            for (s, y) in q.iter_mut().zip(x) {
+                *s += y;
+            }
+        };
+        add(&triangle([pv, px, py], 1.0));
+        if border {
+            // v's open out-edge v → x, and its open in-edge y → v.
+            if x == link(border_next, v) {
+                if let Some(e) = edge_quadric(pv, px, py) {
+                    add(&e);
+                }
+            }
+            if flags_of(flags, y) & flag::KIND == flag::BORDER && link(border_next, y) == v {
+                if let Some(e) = edge_quadric(py, pv, px) {
+                    add(&e);
+                }
+            }
+        }
+    }
+    q
+}
+
 /// Adds the border edge quadrics at the due ends of each open edge `v → border_next[v]`, and
 /// clears the dirty bits.
 #[inline(never)]
@@ -106,22 +173,9 @@ pub(super) fn border_quadrics<I: Index, L: Index>(
         else {
             continue;
         };
-        let (p0, p1, p2) = (frame.at(i0), frame.at(i1), frame.at(i2));
-        let e10 = math::sub(p1, p0);
-        let e20 = math::sub(p2, p0);
-        let l2 = math::dot(e10, e10);
-        let proj = math::dot(e20, e10);
-        let perp = math::sub(math::scale(e20, l2), math::scale(e10, proj));
-        let pl2 = math::dot(perp, perp);
-        if !(l2 > math::TINY2 && pl2 > math::TINY2 && pl2.is_finite()) {
+        let Some(q) = edge_quadric(frame.at(i0), frame.at(i1), frame.at(i2)) else {
             continue;
-        }
-        let n = math::scale(perp, math::rsqrt(pl2));
-        let face = triangle([p0, p1, p2], BORDER_WEIGHT);
-        let mut q = point_plane(n, math::sqrt(l2) * BORDER_WEIGHT);
-        for (s, y) in q.iter_mut().zip(&face) {
-            *s += y;
-        }
+        };
         if d0 {
             add_to(quadrics, i0, &q);
         }
@@ -131,5 +185,95 @@ pub(super) fn border_quadrics<I: Index, L: Index>(
     }
     for f in flags.iter_mut() {
         *f &= !flag::DIRTY;
+    }
+}
+
+/// Where a pass reads a vertex's quadric: stored and filled before each pass (the fast
+/// mode), or built from the vertex's fan whenever it is read (the lean mode, for half the
+/// RAM). Both give the same planes; the stored sums run in triangle order, the fan's in fan
+/// order, so their roundings differ.
+pub(crate) trait Quadrics {
+    /// Before a pass: the stored quadrics of every vertex (`all`) or of the dirty ones.
+    fn fill<I: Index, L: Index>(
+        &mut self,
+        frame: &Frame<'_>,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &mut [u8],
+        border_next: &[L],
+        all: bool,
+    );
+
+    /// `v`'s quadric in this pass.
+    fn of<I: Index, L: Index>(
+        &self,
+        frame: &Frame<'_>,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        border_next: &[L],
+        v: usize,
+    ) -> PointQuadric;
+}
+
+/// The fast mode's quadrics: one per vertex, filled before each pass.
+pub(crate) struct Stored<'q>(pub(crate) &'q mut [PointQuadric]);
+
+impl Quadrics for Stored<'_> {
+    #[inline(always)]
+    fn fill<I: Index, L: Index>(
+        &mut self,
+        frame: &Frame<'_>,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &mut [u8],
+        border_next: &[L],
+        all: bool,
+    ) {
+        face_quadrics(frame, triangles, flags, self.0, all);
+        border_quadrics(frame, triangles, adj, flags, border_next, self.0, all);
+    }
+
+    #[inline(always)]
+    fn of<I: Index, L: Index>(
+        &self,
+        _: &Frame<'_>,
+        _: &[[I; 3]],
+        _: (&[L], &[L]),
+        _: &[u8],
+        _: &[L],
+        v: usize,
+    ) -> PointQuadric {
+        self.0.get(v).copied().unwrap_or([0.0; 6])
+    }
+}
+
+/// The lean mode's quadrics: none stored, each built from its fan when read.
+pub(crate) struct Fans;
+
+impl Quadrics for Fans {
+    #[inline(always)]
+    fn fill<I: Index, L: Index>(
+        &mut self,
+        _: &Frame<'_>,
+        _: &[[I; 3]],
+        _: (&[L], &[L]),
+        _: &mut [u8],
+        _: &[L],
+        _: bool,
+    ) {
+    }
+
+    #[inline(always)]
+    fn of<I: Index, L: Index>(
+        &self,
+        frame: &Frame<'_>,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        border_next: &[L],
+        v: usize,
+    ) -> PointQuadric {
+        vertex_quadric(frame, triangles, adj, flags, border_next, v)
     }
 }

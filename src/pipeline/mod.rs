@@ -374,157 +374,253 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
-        config.validate()?;
-        let (cv, ct) = (V.min(L::COUNT), T.min(L::COUNT));
-        let frame = build::validate(positions, triangles, (cv, ct), &mut self.flags)?;
         let nv = positions.len();
-        let short = Error::Capacity {
-            what: Capacity::Vertices,
-            needed: nv,
-            available: cv,
+        let arrays = Arrays {
+            first: &mut self.first,
+            border_next: &mut self.border_next,
+            target: &mut self.target,
+            cost: &mut self.cost,
+            order: &mut self.order,
+            flags: &mut self.flags,
+            lists: self.lists.as_flattened_mut(),
+            histogram: &mut self.histogram,
         };
-        let FastWorkspace {
-            quadrics,
-            first,
-            border_next,
-            target,
-            cost,
-            order,
-            flags,
-            lists,
-            histogram,
-        } = self;
-        let lists = lists.as_flattened_mut();
-        let (
-            Some(quadrics),
-            Some(first),
-            Some(border_next),
-            Some(target),
-            Some(cost),
-            Some(order),
-            Some(flags),
-        ) = (
-            quadrics.get_mut(..nv),
-            first.get_mut(..nv),
-            border_next.get_mut(..nv),
-            target.get_mut(..nv),
-            cost.get_mut(..nv),
-            order.get_mut(..nv),
-            flags.get_mut(..nv),
-        )
-        else {
-            return Err(short);
-        };
-        let triangles_in = triangles.len();
+        let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
+        run(positions, triangles, config, arrays, fill::Stored(quadrics))
+    }
+}
 
-        // build
-        let (mut nt, degenerate) = compact::compact(triangles, triangles_in, cost);
+/// The lean mode's working memory: the fast mode's without the stored quadrics (each vertex's
+/// quadric is built from its fan whenever a pass reads it), for about half the RAM.
+///
+/// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
+/// * `V`, `T`: the largest mesh it takes (vertices, triangles).
+///
+/// Per vertex four links (fan list end, border successor, candidate target, sort slot), a
+/// candidate cost (`f32`) and a flag byte; per triangle three fan list entries; plus a
+/// histogram of [`BINS`](LeanWorkspace::BINS) links. With `u16` links and `V ≈ T/2` that is
+/// about 12.5 bytes per triangle ([`LeanWorkspace::BYTES`]).
+pub struct LeanWorkspace<L: Index, const V: usize, const T: usize> {
+    first: [L; V],
+    border_next: [L; V],
+    target: [L; V],
+    cost: [f32; V],
+    order: [L; V],
+    flags: [u8; V],
+    lists: [[L; 3]; T],
+    histogram: [L; BINS],
+}
+
+impl<L: Index, const V: usize, const T: usize> Default for LeanWorkspace<L, V, T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
+    /// Size of the workspace in bytes: all of the lean mode's RAM apart from the caller's
+    /// triangle buffer, positions and a bounded stack frame.
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// Bins of the counting sort's histogram.
+    pub const BINS: usize = BINS;
+
+    /// An empty workspace; `const` and all zero bits, so a `static` goes to `.bss`.
+    pub const fn new() -> Self {
+        LeanWorkspace {
+            first: [L::ZERO; V],
+            border_next: [L::ZERO; V],
+            target: [L::ZERO; V],
+            cost: [0.0; V],
+            order: [L::ZERO; V],
+            flags: [0; V],
+            lists: [[L::ZERO; 3]; T],
+            histogram: [L::ZERO; BINS],
+        }
+    }
+
+    /// Simplifies `triangles` in place towards [`Config::target`], with read-only `positions`:
+    /// [`FastWorkspace::simplify`]'s contract, errors and configuration, its passes and checks,
+    /// each quadric built from its vertex's fan where the fast mode reads a stored one.
+    pub fn simplify<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        let arrays = Arrays {
+            first: &mut self.first,
+            border_next: &mut self.border_next,
+            target: &mut self.target,
+            cost: &mut self.cost,
+            order: &mut self.order,
+            flags: &mut self.flags,
+            lists: self.lists.as_flattened_mut(),
+            histogram: &mut self.histogram,
+        };
+        run(positions, triangles, config, arrays, fill::Fans)
+    }
+}
+
+/// A workspace's arrays apart from the quadrics, at its capacity.
+struct Arrays<'w, L: Index> {
+    first: &'w mut [L],
+    border_next: &'w mut [L],
+    target: &'w mut [L],
+    cost: &'w mut [f32],
+    order: &'w mut [L],
+    flags: &'w mut [u8],
+    lists: &'w mut [L],
+    histogram: &'w mut [L; BINS],
+}
+
+/// The pipeline, top to bottom (module documentation), with quadrics from `quadrics`.
+fn run<I: Index, L: Index, Q: fill::Quadrics>(
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+    w: Arrays<'_, L>,
+    mut quadrics: Q,
+) -> Result<Report, Error> {
+    config.validate()?;
+    let (cv, ct) = (
+        w.first.len().min(L::COUNT),
+        (w.lists.len() / 3).min(L::COUNT),
+    );
+    let frame = build::validate(positions, triangles, (cv, ct), w.flags)?;
+    let nv = positions.len();
+    let short = Error::Capacity {
+        what: Capacity::Vertices,
+        needed: nv,
+        available: cv,
+    };
+    let Arrays {
+        first,
+        border_next,
+        target,
+        cost,
+        order,
+        flags,
+        lists,
+        histogram,
+    } = w;
+    let (Some(first), Some(border_next), Some(target), Some(cost), Some(order), Some(flags)) = (
+        first.get_mut(..nv),
+        border_next.get_mut(..nv),
+        target.get_mut(..nv),
+        cost.get_mut(..nv),
+        order.get_mut(..nv),
+        flags.get_mut(..nv),
+    ) else {
+        return Err(short);
+    };
+    let triangles_in = triangles.len();
+    // build
+    let (mut nt, degenerate) = compact::compact(triangles, triangles_in, cost);
+    build::link(triangles, nt, (first, flags), cost, lists);
+
+    // classify (and duplicates)
+    let (locked, duplicates) = classify::classify(
+        triangles,
+        nt,
+        (&*first, lists.get(..3 * nt).unwrap_or(&[])),
+        flags,
+        border_next,
+    );
+    if duplicates > 0 {
+        nt = compact::compact(triangles, nt, cost).0;
         build::link(triangles, nt, (first, flags), cost, lists);
+    }
+    let valid = nt;
 
-        // classify (and duplicates)
-        let (locked, duplicates) = classify::classify(
-            triangles,
-            nt,
+    // The limit as a price: a squared distance in the unit frame.
+    let limit = config.error_limit * frame.scale;
+    let limit = limit * limit;
+
+    let target_triangles = config.target.triangles(valid);
+    let mut stats = Stats::default();
+    let mut passes = 0u32;
+    let mut pass_triangles = heapless::Vec::new();
+    let stop = loop {
+        if nt <= target_triangles {
+            break Stop::Target;
+        }
+        if passes >= config.max_passes {
+            break Stop::MaxPasses;
+        }
+        let tris = triangles.get(..nt).unwrap_or(&[]);
+        let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
+        quadrics.fill(&frame, tris, adj, flags, border_next, passes == 0);
+        pick::pick(
+            &frame,
+            tris,
+            adj,
+            flags,
+            border_next,
+            &quadrics,
+            (&mut *target, &mut *cost),
+            histogram,
+        );
+        let m = sort::sort(target, cost, order, histogram);
+        if m == 0 {
+            break Stop::NoLegalCollapse;
+        }
+        let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
+        // A pass aims at half the live triangles at most (see `PASS_SHARE`).
+        let goal = (nt - target_triangles).min((nt / PASS_SHARE).max(2));
+        let refused = stats.over_limit;
+        let done = perform::perform(
+            &frame,
+            tris,
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
+            &quadrics,
+            (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
+            (goal, limit),
+            &mut stats,
         );
-        if duplicates > 0 {
-            nt = compact::compact(triangles, nt, cost).0;
-            build::link(triangles, nt, (first, flags), cost, lists);
+        passes += 1;
+        nt = compact::compact(triangles, nt, cost).0;
+        let _ = pass_triangles.push(nt as u32);
+        if done == 0 {
+            break if stats.over_limit > refused {
+                Stop::ErrorLimit
+            } else {
+                Stop::NoLegalCollapse
+            };
         }
-        let valid = nt;
-
-        // The limit as a price: a squared distance in the unit frame.
-        let limit = config.error_limit * frame.scale;
-        let limit = limit * limit;
-
-        let target_triangles = config.target.triangles(valid);
-        let mut stats = Stats::default();
-        let mut passes = 0u32;
-        let mut pass_triangles = heapless::Vec::new();
-        let stop = loop {
-            if nt <= target_triangles {
-                break Stop::Target;
-            }
-            if passes >= config.max_passes {
-                break Stop::MaxPasses;
-            }
-            let tris = triangles.get(..nt).unwrap_or(&[]);
-            let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
-            fill::face_quadrics(&frame, tris, flags, quadrics, passes == 0);
-            fill::border_quadrics(&frame, tris, adj, flags, border_next, quadrics, passes == 0);
-            pick::pick(
-                &frame,
-                tris,
-                adj,
-                flags,
-                border_next,
-                quadrics,
-                (&mut *target, &mut *cost),
-                histogram,
-            );
-            let m = sort::sort(target, cost, order, histogram);
-            if m == 0 {
-                break Stop::NoLegalCollapse;
-            }
-            let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
-            // A pass aims at half the live triangles at most (see `PASS_SHARE`).
-            let goal = (nt - target_triangles).min((nt / PASS_SHARE).max(2));
-            let refused = stats.over_limit;
-            let done = perform::perform(
-                &frame,
-                tris,
-                (&*first, lists.get(..3 * nt).unwrap_or(&[])),
-                flags,
-                border_next,
-                &*quadrics,
-                (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
-                (goal, limit),
-                &mut stats,
-            );
-            passes += 1;
-            nt = compact::compact(triangles, nt, cost).0;
-            let _ = pass_triangles.push(nt as u32);
-            if done == 0 {
-                break if stats.over_limit > refused {
-                    Stop::ErrorLimit
-                } else {
-                    Stop::NoLegalCollapse
-                };
-            }
-            // No fan lists for a pass that will not run.
-            if nt > target_triangles && passes < config.max_passes {
-                build::link(triangles, nt, (first, flags), cost, lists);
-                compact::unlock(flags);
-            }
-        };
-        let collapse_error = if config.error_limit.is_finite() {
-            math::sqrt(stats.worst) / frame.scale
-        } else {
-            0.0
-        };
-        Ok(Report {
-            triangles_in,
-            degenerate_dropped: degenerate,
-            duplicates_dropped: duplicates,
-            twins: 0,
-            triangles_out: nt,
-            target_triangles,
-            target_reached: nt <= target_triangles,
-            stop,
-            collapses: stats.collapses,
-            vertices_removed: stats.collapses,
-            parts_removed: 0,
-            locked_vertices: locked,
-            feature_vertices: 0,
-            passes,
-            pass_triangles,
-            rejected: stats.rejected,
-            over_limit: stats.over_limit,
-            collapse_error,
-            max_error: None,
-            mean_error: None,
-        })
-    }
+        // No fan lists for a pass that will not run.
+        if nt > target_triangles && passes < config.max_passes {
+            build::link(triangles, nt, (first, flags), cost, lists);
+            compact::unlock(flags);
+        }
+    };
+    let collapse_error = if config.error_limit.is_finite() {
+        math::sqrt(stats.worst) / frame.scale
+    } else {
+        0.0
+    };
+    Ok(Report {
+        triangles_in,
+        degenerate_dropped: degenerate,
+        duplicates_dropped: duplicates,
+        twins: 0,
+        triangles_out: nt,
+        target_triangles,
+        target_reached: nt <= target_triangles,
+        stop,
+        collapses: stats.collapses,
+        vertices_removed: stats.collapses,
+        parts_removed: 0,
+        locked_vertices: locked,
+        feature_vertices: 0,
+        passes,
+        pass_triangles,
+        rejected: stats.rejected,
+        over_limit: stats.over_limit,
+        collapse_error,
+        max_error: None,
+        mean_error: None,
+    })
 }

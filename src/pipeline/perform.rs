@@ -25,13 +25,14 @@
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
 //! degenerate: compact drops them) and locks both ends.
 
+use super::fill::Quadrics;
 use super::{
     dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
 };
 use crate::index::Index;
 use crate::legality::Reject;
 use crate::math::{self, V3};
-use crate::quadric::{self, PointQuadric};
+use crate::quadric;
 
 /// Below this a squared cross product (in the unit frame) has no direction: a triangle of area
 /// 5e-10 of the bounding box's face. Survivors must be above it, so fold tests never underflow.
@@ -108,8 +109,8 @@ pub(super) const fn on(name: &str) -> bool {
 /// which is its quadric's trace (every plane's normal is a unit vector; `StoredQuadric::error2`
 /// likewise): a weighted mean squared distance in the unit frame, zero without weight.
 #[inline]
-fn error(quadrics: &[PointQuadric], a: usize, c: f32) -> f32 {
-    let w = quadrics.get(a).map_or(0.0, quadric::point_weight);
+fn error(q: &quadric::PointQuadric, c: f32) -> f32 {
+    let w = quadric::point_weight(q);
     if w > 0.0 {
         c / w
     } else {
@@ -125,11 +126,10 @@ fn alternative<I: Index, L: Index>(
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     (flags, border_next): (&[u8], &[L]),
-    quadrics: &[PointQuadric],
+    q: &quadric::PointQuadric,
     a: usize,
     b: usize,
 ) -> Option<(usize, f32)> {
-    let q = quadrics.get(a)?;
     let border = flags_of(flags, a) & flag::KIND == flag::BORDER;
     let pa = frame.at(a);
     let mut best: Option<(usize, f32)> = None;
@@ -161,13 +161,13 @@ fn alternative<I: Index, L: Index>(
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn perform<I: Index, L: Index>(
+pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
     frame: &Frame<'_>,
     tris: &mut [[I; 3]],
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    quadrics: &[PointQuadric],
+    quadrics: &Q,
     (target, cost, order): (&mut [L], &[f32], &[L]),
     (goal, limit): (usize, f32),
     stats: &mut Stats,
@@ -190,14 +190,22 @@ pub(super) fn perform<I: Index, L: Index>(
         if c > error_goal && c > worst && removed > goal / 6 {
             break;
         }
-        let e = error(quadrics, a, c);
+        let b = link(target, a);
+        if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
+            continue;
+        }
+        // a's quadric: read or built only when the error or a second target needs it.
+        let e = if limit.is_finite() {
+            error(
+                &quadrics.of(frame, &*tris, adj, &*flags, &*border_next, a),
+                c,
+            )
+        } else {
+            0.0
+        };
         if e > limit || e.is_nan() {
             // Sorted by price, not by error: a later candidate may still be under.
             stats.over_limit += 1;
-            continue;
-        }
-        let b = link(target, a);
-        if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
         let (b, dying) = match check(frame, tris, adj, flags, target, a, b) {
@@ -207,12 +215,17 @@ pub(super) fn perform<I: Index, L: Index>(
                 edge_goal += 1;
                 // a's next cheapest target, at once: a vertex keeps one candidate, so one
                 // whose cheapest collapse stays illegal would otherwise never move.
+                let qa = quadrics.of(frame, &*tris, adj, &*flags, &*border_next, a);
                 let Some((x, cx)) =
-                    alternative(frame, tris, adj, (&*flags, &*border_next), quadrics, a, b)
+                    alternative(frame, tris, adj, (&*flags, &*border_next), &qa, a, b)
                 else {
                     continue;
                 };
-                let ex = error(quadrics, a, cx);
+                let ex = if limit.is_finite() {
+                    error(&qa, cx)
+                } else {
+                    0.0
+                };
                 if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
                     continue;
                 }

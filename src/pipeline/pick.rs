@@ -4,11 +4,12 @@
 //! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
 //! along its border edge (either direction); a locked vertex never moves.
 
+use super::fill::Quadrics;
 use super::sort::key;
 use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
 use crate::index::Index;
 use crate::math;
-use crate::quadric::{self, PointQuadric};
+use crate::quadric;
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
 /// the vertex after it in each triangle (the triangle across offers the other direction), a
@@ -17,13 +18,13 @@ use crate::quadric::{self, PointQuadric};
 /// candidate's sort key in `histogram` (the counting sort's first pass).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn pick<I: Index, L: Index>(
+pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
     flags: &[u8],
     border_next: &[L],
-    quadrics: &[PointQuadric],
+    quadrics: &Q,
     (target, cost): (&mut [L], &mut [f32]),
     histogram: &mut [L; BINS],
 ) {
@@ -40,7 +41,7 @@ pub(super) fn pick<I: Index, L: Index>(
         let (mut best, mut to) = (f32::INFINITY, NONE);
         let border = !free(ka) && ka == flag::BORDER;
         if free(ka) || border {
-            let q = quadrics.get(a).copied().unwrap_or([0.0; 6]);
+            let q = quadrics.of(frame, triangles, adj, flags, border_next, a);
             let pa = frame.at(a);
             let mut offer = |b: usize| {
                 let e = quadric::point_error(&q, math::sub(frame.at(b), pa));
