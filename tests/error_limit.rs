@@ -162,28 +162,40 @@ fn diagonal(m: &MeshData) -> f32 {
     (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>().sqrt()
 }
 
-/// The fast mode (`pipeline::FastWorkspace`) prices from its quadrics over their weights, the
-/// same mean squared distance as the stored quadric: the same promises on the spike.
+/// The pipeline's modes (`pipeline::FastWorkspace`, `pipeline::LeanWorkspace`) price from
+/// their quadrics over their weights, the same mean squared distance as the stored quadric:
+/// the same promises on the spike.
 #[cfg(feature = "fast")]
 #[test]
-fn the_limit_holds_in_the_fast_mode() {
-    use tinydecimate::pipeline::FastWorkspace;
+fn the_limit_holds_in_the_fast_and_lean_modes() {
+    use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
     let (m, apex) = spike();
-    let fast = |config: &Config| {
-        let mut ws: Box<FastWorkspace<u16, 400, 600>> = Box::new(FastWorkspace::new());
-        let mut tris = m.triangles.clone();
-        let r = ws.simplify(&m.positions, &mut tris, config).expect("fast");
-        output(&m.positions, tris, r)
-    };
-    let config = Config::new().with_target(Target::Triangles(8));
-    // The fast mode refuses more of the spike than the greedy engines: its largest collapse
-    // without a limit is under 0.05, so the limit here is lower.
-    let limit = 0.02;
-    let (_, r) = fast(&config);
-    assert_eq!(r.collapse_error, 0.0, "tracked only with a limit");
-    let (_, r) = fast(&config.with_error_limit(1e6));
-    assert_eq!(r.over_limit, 0);
-    assert!(r.collapse_error > 2.0 * limit, "{r:?}");
-    let (out, r) = fast(&config.with_error_limit(limit));
-    assert_limited("fast", &m, apex, &out, &r, limit);
+    for lean in [false, true] {
+        let what = if lean { "lean" } else { "fast" };
+        let run = |config: &Config| {
+            let mut tris = m.triangles.clone();
+            let r = if lean {
+                Box::new(LeanWorkspace::<u16, 400, 600>::new())
+                    .as_mut()
+                    .simplify(&m.positions, &mut tris, config)
+            } else {
+                Box::new(FastWorkspace::<u16, 400, 600>::new())
+                    .as_mut()
+                    .simplify(&m.positions, &mut tris, config)
+            }
+            .expect(what);
+            output(&m.positions, tris, r)
+        };
+        let config = Config::new().with_target(Target::Triangles(8));
+        // The pipeline refuses more of the spike than the greedy engines: its largest collapse
+        // without a limit is under 0.05, so the limit here is lower.
+        let limit = 0.02;
+        let (_, r) = run(&config);
+        assert_eq!(r.collapse_error, 0.0, "{what}: tracked only with a limit");
+        let (_, r) = run(&config.with_error_limit(1e6));
+        assert_eq!(r.over_limit, 0, "{what}");
+        assert!(r.collapse_error > 2.0 * limit, "{what}: {r:?}");
+        let (out, r) = run(&config.with_error_limit(limit));
+        assert_limited(what, &m, apex, &out, &r, limit);
+    }
 }

@@ -1,16 +1,34 @@
-//! The fast mode (`pipeline::FastWorkspace`, crate feature `fast`): every shared mesh at 50 %,
-//! 25 % and 10 % gives a valid output (the shared checker, topology included); bad input is a
-//! typed error with the buffer untouched; two runs give the same bytes.
+//! The pipeline's two modes (crate feature `fast`), the fast one (`pipeline::FastWorkspace`)
+//! and the lean one (`pipeline::LeanWorkspace`): every shared mesh at 50 %, 25 % and 10 %
+//! gives a valid output (the shared checker, topology included); bad input is a typed error
+//! with the buffer untouched; two runs give the same bytes.
 #![cfg(feature = "fast")]
 
 mod common;
 use common::*;
 use std::sync::Mutex;
-use tinydecimate::pipeline::FastWorkspace;
+use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
 use tinydecimate::{Capacity, Config, Error, Report, Stop};
 
-type Big = FastWorkspace<u32, 65_536, 131_072>;
-static BIG_FAST: Mutex<Big> = Mutex::new(FastWorkspace::new());
+static BIG_FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
+static BIG_LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
+
+/// The pipeline's modes.
+#[derive(Clone, Copy, Debug)]
+enum Mode {
+    Fast,
+    Lean,
+}
+
+/// Both modes, or the one `PIPELINE_MODE` (`fast` or `lean`) names: with a rule switched off
+/// (`PIPELINE_RULE_OFF`), each mode alone must fail.
+fn modes() -> Vec<Mode> {
+    match std::env::var("PIPELINE_MODE").as_deref() {
+        Ok("fast") => vec![Mode::Fast],
+        Ok("lean") => vec![Mode::Lean],
+        _ => vec![Mode::Fast, Mode::Lean],
+    }
+}
 
 fn fixtures() -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(shared_meshes())
@@ -24,12 +42,22 @@ fn fixtures() -> Vec<String> {
     names
 }
 
-fn run(m: &MeshData, ratio: f32) -> (MeshData, Report) {
+fn run(mode: Mode, m: &MeshData, ratio: f32) -> (MeshData, Report) {
     let mut tris = m.triangles.clone();
-    let mut ws = BIG_FAST.lock().unwrap_or_else(|e| e.into_inner());
-    let r = ws
-        .simplify(&m.positions, &mut tris, &Config::new().with_ratio(ratio))
-        .expect("simplify");
+    let config = Config::new().with_ratio(ratio);
+    let r = match mode {
+        Mode::Fast => BIG_FAST.lock().unwrap_or_else(|e| e.into_inner()).simplify(
+            &m.positions,
+            &mut tris,
+            &config,
+        ),
+        Mode::Lean => BIG_LEAN.lock().unwrap_or_else(|e| e.into_inner()).simplify(
+            &m.positions,
+            &mut tris,
+            &config,
+        ),
+    }
+    .expect("simplify");
     output(&m.positions, tris, r)
 }
 
@@ -38,13 +66,16 @@ fn every_fixture_at_50_25_10_percent_is_valid() {
     let mut failures = Vec::new();
     for name in fixtures() {
         let input = load_obj(&name);
-        for ratio in [0.5f32, 0.25, 0.1] {
+        for (mode, ratio) in modes()
+            .into_iter()
+            .flat_map(|m| [(m, 0.5f32), (m, 0.25), (m, 0.1)])
+        {
             let t0 = std::time::Instant::now();
-            let (out, r) = run(&input, ratio);
+            let (out, r) = run(mode, &input, ratio);
             let dt = t0.elapsed();
             let v = verdict(&input, &out);
             eprintln!(
-                "{name} {ratio}: {} -> {} (target {}, {:?}, {} passes, {} collapses, locked {}) in {dt:.2?} {} rejected [{}]",
+                "{mode:?} {name} {ratio}: {} -> {} (target {}, {:?}, {} passes, {} collapses, locked {}) in {dt:.2?} {} rejected [{}]",
                 r.triangles_in,
                 r.triangles_out,
                 r.target_triangles,
@@ -56,7 +87,7 @@ fn every_fixture_at_50_25_10_percent_is_valid() {
                 r.rejected,
             );
             if !v.is_valid() {
-                failures.push(format!("{name} {ratio}:\n{}", v.describe(5)));
+                failures.push(format!("{mode:?} {name} {ratio}:\n{}", v.describe(5)));
             }
             assert_eq!(r.triangles_out, out.triangles.len());
             if r.stop == Stop::Target {
@@ -80,9 +111,12 @@ fn every_fixture_at_50_25_10_percent_is_valid() {
 fn the_target_is_reached_on_clean_closed_meshes() {
     for name in ["cow.obj", "spot.obj", "stanford_bunny.obj", "armadillo.obj"] {
         let input = load_obj(name);
-        for ratio in [0.5f32, 0.25, 0.1] {
-            let (_, r) = run(&input, ratio);
-            assert_eq!(r.stop, Stop::Target, "{name} {ratio}: {r:?}");
+        for (mode, ratio) in modes()
+            .into_iter()
+            .flat_map(|m| [(m, 0.5f32), (m, 0.25), (m, 0.1)])
+        {
+            let (_, r) = run(mode, &input, ratio);
+            assert_eq!(r.stop, Stop::Target, "{mode:?} {name} {ratio}: {r:?}");
         }
     }
 }
@@ -95,10 +129,16 @@ fn generated_meshes_are_valid() {
         ("cube", cube(8)),
         ("fin_and_pinch", fin_and_pinch(12)),
     ] {
-        for ratio in [0.5f32, 0.25, 0.1, 0.0] {
-            let (out, r) = run(&m, ratio);
-            let v = verdict(&m, &out);
-            assert!(v.is_valid(), "{what} {ratio}: {r:?}\n{}", v.describe(10));
+        for mode in modes() {
+            for ratio in [0.5f32, 0.25, 0.1, 0.0] {
+                let (out, r) = run(mode, &m, ratio);
+                let v = verdict(&m, &out);
+                assert!(
+                    v.is_valid(),
+                    "{mode:?} {what} {ratio}: {r:?}\n{}",
+                    v.describe(10)
+                );
+            }
         }
     }
 }
@@ -106,86 +146,102 @@ fn generated_meshes_are_valid() {
 #[test]
 fn two_runs_give_the_same_bytes() {
     let m = load_obj("cow.obj");
-    let (a, ra) = run(&m, 0.1);
-    let (b, rb) = run(&m, 0.1);
-    assert_eq!(a.triangles, b.triangles);
-    assert_eq!(ra, rb);
-    // A fresh workspace too (nothing read before it is written).
-    let mut ws: Box<FastWorkspace<u16, 4096, 8192>> = Box::new(FastWorkspace::new());
-    let mut tris = m.triangles.clone();
-    let r = ws
-        .simplify(&m.positions, &mut tris, &Config::new().with_ratio(0.1))
+    for mode in modes() {
+        let (a, ra) = run(mode, &m, 0.1);
+        let (b, rb) = run(mode, &m, 0.1);
+        assert_eq!(a.triangles, b.triangles, "{mode:?}");
+        assert_eq!(ra, rb, "{mode:?}");
+        // A fresh workspace too (nothing read before it is written).
+        let mut tris = m.triangles.clone();
+        let config = Config::new().with_ratio(0.1);
+        let r = match mode {
+            Mode::Fast => Box::new(FastWorkspace::<u16, 4096, 8192>::new())
+                .as_mut()
+                .simplify(&m.positions, &mut tris, &config),
+            Mode::Lean => Box::new(LeanWorkspace::<u16, 4096, 8192>::new())
+                .as_mut()
+                .simplify(&m.positions, &mut tris, &config),
+        }
         .unwrap();
-    tris.truncate(r.triangles_out);
-    assert_eq!(
-        tris, a.triangles,
-        "u16 links, another workspace: same bytes"
-    );
+        tris.truncate(r.triangles_out);
+        assert_eq!(
+            tris, a.triangles,
+            "{mode:?}: u16 links, another workspace: same bytes"
+        );
+    }
+}
+
+/// Bad input to `$ws::simplify`: a typed error, the buffer untouched.
+macro_rules! bad_input {
+    ($ws:ident) => {{
+        let m = icosphere(2);
+        let config = Config::new();
+        let mut ws: Box<$ws<u16, 200, 400>> = Box::new($ws::new());
+
+        // NaN position.
+        let mut p = m.positions.clone();
+        p[7][1] = f32::NAN;
+        let mut tris = m.triangles.clone();
+        assert_eq!(
+            ws.simplify(&p, &mut tris, &config),
+            Err(Error::NonFinitePosition { vertex: 7 })
+        );
+        assert_eq!(tris, m.triangles);
+        p[7][1] = f32::INFINITY;
+        assert_eq!(
+            ws.simplify(&p, &mut tris, &config),
+            Err(Error::NonFinitePosition { vertex: 7 })
+        );
+        assert_eq!(tris, m.triangles);
+
+        // Out-of-range index.
+        let mut bad = m.triangles.clone();
+        bad[100][2] = 5000;
+        let before = bad.clone();
+        assert_eq!(
+            ws.simplify(&m.positions, &mut bad, &config),
+            Err(Error::IndexOutOfRange {
+                triangle: 100,
+                index: 5000
+            })
+        );
+        assert_eq!(bad, before);
+
+        // Over capacity: vertices, then triangles.
+        let mut small: Box<$ws<u16, 100, 400>> = Box::new($ws::new());
+        let mut tris = m.triangles.clone();
+        assert_eq!(
+            small.simplify(&m.positions, &mut tris, &config),
+            Err(Error::Capacity {
+                what: Capacity::Vertices,
+                needed: 162,
+                available: 100
+            })
+        );
+        let mut small: Box<$ws<u16, 200, 300>> = Box::new($ws::new());
+        assert_eq!(
+            small.simplify(&m.positions, &mut tris, &config),
+            Err(Error::Capacity {
+                what: Capacity::Triangles,
+                needed: 320,
+                available: 300
+            })
+        );
+        assert_eq!(tris, m.triangles);
+
+        // A configuration out of range.
+        assert!(matches!(
+            ws.simplify(&m.positions, &mut tris, &Config::new().with_ratio(1.5)),
+            Err(Error::InvalidConfig { .. })
+        ));
+        assert_eq!(tris, m.triangles);
+    }};
 }
 
 #[test]
 fn bad_input_is_a_typed_error_and_the_buffer_is_untouched() {
-    let m = icosphere(2);
-    let config = Config::new();
-    let mut ws: Box<FastWorkspace<u16, 200, 400>> = Box::new(FastWorkspace::new());
-
-    // NaN position.
-    let mut p = m.positions.clone();
-    p[7][1] = f32::NAN;
-    let mut tris = m.triangles.clone();
-    assert_eq!(
-        ws.simplify(&p, &mut tris, &config),
-        Err(Error::NonFinitePosition { vertex: 7 })
-    );
-    assert_eq!(tris, m.triangles);
-    p[7][1] = f32::INFINITY;
-    assert_eq!(
-        ws.simplify(&p, &mut tris, &config),
-        Err(Error::NonFinitePosition { vertex: 7 })
-    );
-    assert_eq!(tris, m.triangles);
-
-    // Out-of-range index.
-    let mut bad = m.triangles.clone();
-    bad[100][2] = 5000;
-    let before = bad.clone();
-    assert_eq!(
-        ws.simplify(&m.positions, &mut bad, &config),
-        Err(Error::IndexOutOfRange {
-            triangle: 100,
-            index: 5000
-        })
-    );
-    assert_eq!(bad, before);
-
-    // Over capacity: vertices, then triangles.
-    let mut small: Box<FastWorkspace<u16, 100, 400>> = Box::new(FastWorkspace::new());
-    let mut tris = m.triangles.clone();
-    assert_eq!(
-        small.simplify(&m.positions, &mut tris, &config),
-        Err(Error::Capacity {
-            what: Capacity::Vertices,
-            needed: 162,
-            available: 100
-        })
-    );
-    let mut small: Box<FastWorkspace<u16, 200, 300>> = Box::new(FastWorkspace::new());
-    assert_eq!(
-        small.simplify(&m.positions, &mut tris, &config),
-        Err(Error::Capacity {
-            what: Capacity::Triangles,
-            needed: 320,
-            available: 300
-        })
-    );
-    assert_eq!(tris, m.triangles);
-
-    // A configuration out of range.
-    assert!(matches!(
-        ws.simplify(&m.positions, &mut tris, &Config::new().with_ratio(1.5)),
-        Err(Error::InvalidConfig { .. })
-    ));
-    assert_eq!(tris, m.triangles);
+    bad_input!(FastWorkspace);
+    bad_input!(LeanWorkspace);
 }
 
 #[test]
@@ -207,6 +263,14 @@ fn bytes_per_triangle_with_u16_links() {
         Half::BYTES
     );
     assert!(per <= 24.6, "{per}");
+    // The lean mode: the same without the quadric, 12.5 B.
+    type Lean = LeanWorkspace<u16, 32_000, 64_000>;
+    let per = Lean::BYTES as f64 / 64_000.0;
+    eprintln!(
+        "LeanWorkspace<u16, 32000, 64000>::BYTES = {} ({per:.2} B per triangle)",
+        Lean::BYTES
+    );
+    assert!(per <= 12.6, "{per}");
 }
 
 #[test]
@@ -226,14 +290,16 @@ fn small_closed_meshes_keep_their_topology() {
         ("octahedron", octa),
         ("icosahedron", icosphere(0)),
     ] {
-        let (out, r) = run(&m, 0.0);
-        let v = verdict(&m, &out);
-        eprintln!(
-            "{what}: {} -> {} {:?}",
-            r.triangles_in, r.triangles_out, r.stop
-        );
-        assert!(v.is_valid(), "{what}: {r:?}\n{}", v.describe(10));
-        assert_eq!(r.stop, Stop::NoLegalCollapse, "{what}");
+        for mode in modes() {
+            let (out, r) = run(mode, &m, 0.0);
+            let v = verdict(&m, &out);
+            eprintln!(
+                "{mode:?} {what}: {} -> {} {:?}",
+                r.triangles_in, r.triangles_out, r.stop
+            );
+            assert!(v.is_valid(), "{mode:?} {what}: {r:?}\n{}", v.describe(10));
+            assert_eq!(r.stop, Stop::NoLegalCollapse, "{mode:?} {what}");
+        }
     }
 }
 
@@ -250,20 +316,22 @@ fn each_rule_fires_where_it_should() {
             .find(|(rule, _)| rule.name == name)
             .map_or(0, |(_, n)| n)
     };
-    let (mut turn, mut sliver) = (0, 0);
-    for name in [
-        "cow.obj",
-        "fandisk.obj",
-        "tray_bottom.obj",
-        "pr2_sensor_mount.obj",
-    ] {
-        let (_, r) = run(&load_obj(name), 0.1);
-        turn += count(&r, "normal_turn");
-        sliver += count(&r, "sliver");
+    for mode in modes() {
+        let (mut turn, mut sliver) = (0, 0);
+        for name in [
+            "cow.obj",
+            "fandisk.obj",
+            "tray_bottom.obj",
+            "pr2_sensor_mount.obj",
+        ] {
+            let (_, r) = run(mode, &load_obj(name), 0.1);
+            turn += count(&r, "normal_turn");
+            sliver += count(&r, "sliver");
+        }
+        assert!(turn > 0, "{mode:?}: the flip test never refused");
+        assert!(sliver > 0, "{mode:?}: the zero-area test never refused");
+        let tetra = tetrahedron();
+        let (_, r) = run(mode, &tetra, 0.0);
+        assert!(count(&r, "duplicate") > 0, "{mode:?}: {r:?}");
     }
-    assert!(turn > 0, "the flip test never refused");
-    assert!(sliver > 0, "the zero-area test never refused");
-    let tetra = tetrahedron();
-    let (_, r) = run(&tetra, 0.0);
-    assert!(count(&r, "duplicate") > 0, "{r:?}");
 }

@@ -10,7 +10,7 @@
 //! origin: its offset terms are zero, exactly, so a [`PointQuadric`] (the 3×3 part, 24 bytes)
 //! holds it, and a collapse within a flat patch prices at zero, not at rounding.
 
-use super::{fan, flag, flags_of, link, others, tri, Frame};
+use super::{fan, flag, flags_of, link, others, tri, Frame, NONE};
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::quadric::{point_plane, PointQuadric};
@@ -109,11 +109,15 @@ pub(super) fn vertex_quadric<I: Index, L: Index>(
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
     flags: &[u8],
-    border_next: &[L],
     v: usize,
 ) -> PointQuadric {
     let mut q = [0.0; 6];
     let border = flags_of(flags, v) & flag::KIND == flag::BORDER;
+    let next = if border {
+        open_out(triangles, adj, flags, v)
+    } else {
+        NONE
+    };
     let pv = frame.at(v);
     for (_, tr, k) in fan(triangles, adj, flags, v) {
         if super::dead(tr) {
@@ -129,12 +133,14 @@ pub(super) fn vertex_quadric<I: Index, L: Index>(
         add(&triangle([pv, px, py], 1.0));
         if border {
             // v's open out-edge v → x, and its open in-edge y → v.
-            if x == link(border_next, v) {
+            if x == next {
                 if let Some(e) = edge_quadric(pv, px, py) {
                     add(&e);
                 }
             }
-            if flags_of(flags, y) & flag::KIND == flag::BORDER && link(border_next, y) == v {
+            if flags_of(flags, y) & flag::KIND == flag::BORDER
+                && opens_into(triangles, adj, flags, y, v)
+            {
                 if let Some(e) = edge_quadric(py, pv, px) {
                     add(&e);
                 }
@@ -142,6 +148,37 @@ pub(super) fn vertex_quadric<I: Index, L: Index>(
         }
     }
     q
+}
+
+/// The vertex across `v`'s open out-edge, from `v`'s fan alone (the lean mode stores no border
+/// successors): the vertex after `v` in one of its live triangles and before it in none
+/// (`NONE` without one).
+#[inline]
+pub(crate) fn open_out<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    v: usize,
+) -> usize {
+    let live = || fan(triangles, adj, flags, v).filter(|&(_, tr, _)| !super::dead(tr));
+    live()
+        .map(|(_, tr, k)| others(tr, k).0)
+        .find(|&x| !live().any(|(_, tr, k)| others(tr, k).1 == x))
+        .unwrap_or(NONE)
+}
+
+/// Whether `y → v` is an open edge, from `v`'s fan alone: `y` is before `v` in one of its
+/// live triangles and after it in none.
+#[inline]
+pub(crate) fn opens_into<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    y: usize,
+    v: usize,
+) -> bool {
+    let live = || fan(triangles, adj, flags, v).filter(|&(_, tr, _)| !super::dead(tr));
+    live().any(|(_, tr, k)| others(tr, k).1 == y) && !live().any(|(_, tr, k)| others(tr, k).0 == y)
 }
 
 /// Adds the border edge quadrics at the due ends of each open edge `v → border_next[v]`, and
@@ -193,6 +230,31 @@ pub(super) fn border_quadrics<I: Index, L: Index>(
 /// RAM). Both give the same planes; the stored sums run in triangle order, the fan's in fan
 /// order, so their roundings differ.
 pub(crate) trait Quadrics {
+    /// Whether border successors are stored (`border_next`, kept up by each collapse) or
+    /// found from the fans when read (the lean mode, which has no `border_next`).
+    const STORES_BORDERS: bool;
+
+    /// The vertex across border vertex `v`'s open out-edge (`NONE` without one).
+    fn next<I: Index, L: Index>(
+        &self,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        border_next: &[L],
+        v: usize,
+    ) -> usize;
+
+    /// Whether `y` is a border vertex whose open out-edge is `y → v`.
+    fn enters<I: Index, L: Index>(
+        &self,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        border_next: &[L],
+        y: usize,
+        v: usize,
+    ) -> bool;
+
     /// Before a pass: the stored quadrics of every vertex (`all`) or of the dirty ones.
     fn fill<I: Index, L: Index>(
         &mut self,
@@ -220,6 +282,33 @@ pub(crate) trait Quadrics {
 pub(crate) struct Stored<'q>(pub(crate) &'q mut [PointQuadric]);
 
 impl Quadrics for Stored<'_> {
+    const STORES_BORDERS: bool = true;
+
+    #[inline(always)]
+    fn next<I: Index, L: Index>(
+        &self,
+        _: &[[I; 3]],
+        _: (&[L], &[L]),
+        _: &[u8],
+        border_next: &[L],
+        v: usize,
+    ) -> usize {
+        link(border_next, v)
+    }
+
+    #[inline(always)]
+    fn enters<I: Index, L: Index>(
+        &self,
+        _: &[[I; 3]],
+        _: (&[L], &[L]),
+        flags: &[u8],
+        border_next: &[L],
+        y: usize,
+        v: usize,
+    ) -> bool {
+        flags_of(flags, y) & flag::KIND == flag::BORDER && link(border_next, y) == v
+    }
+
     #[inline(always)]
     fn fill<I: Index, L: Index>(
         &mut self,
@@ -252,6 +341,33 @@ impl Quadrics for Stored<'_> {
 pub(crate) struct Fans;
 
 impl Quadrics for Fans {
+    const STORES_BORDERS: bool = false;
+
+    #[inline(always)]
+    fn next<I: Index, L: Index>(
+        &self,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        _: &[L],
+        v: usize,
+    ) -> usize {
+        open_out(triangles, adj, flags, v)
+    }
+
+    #[inline(always)]
+    fn enters<I: Index, L: Index>(
+        &self,
+        triangles: &[[I; 3]],
+        adj: (&[L], &[L]),
+        flags: &[u8],
+        _: &[L],
+        y: usize,
+        v: usize,
+    ) -> bool {
+        flags_of(flags, y) & flag::KIND == flag::BORDER && opens_into(triangles, adj, flags, y, v)
+    }
+
     #[inline(always)]
     fn fill<I: Index, L: Index>(
         &mut self,
@@ -271,9 +387,9 @@ impl Quadrics for Fans {
         triangles: &[[I; 3]],
         adj: (&[L], &[L]),
         flags: &[u8],
-        border_next: &[L],
+        _: &[L],
         v: usize,
     ) -> PointQuadric {
-        vertex_quadric(frame, triangles, adj, flags, border_next, v)
+        vertex_quadric(frame, triangles, adj, flags, v)
     }
 }

@@ -396,13 +396,13 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
 /// * `L`: link type (`u16` or `u32`); with `u16` at most 65 535 vertices and triangles.
 /// * `V`, `T`: the largest mesh it takes (vertices, triangles).
 ///
-/// Per vertex four links (fan list end, border successor, candidate target, sort slot), a
-/// candidate cost (`f32`) and a flag byte; per triangle three fan list entries; plus a
-/// histogram of [`BINS`](LeanWorkspace::BINS) links. With `u16` links and `V ≈ T/2` that is
-/// about 12.5 bytes per triangle ([`LeanWorkspace::BYTES`]).
+/// Per vertex three links (fan list end, candidate target, sort slot), a candidate cost
+/// (`f32`) and a flag byte; per triangle three fan list entries; plus a histogram of
+/// [`BINS`](LeanWorkspace::BINS) links. A border vertex's open edges are found from its fan
+/// where the fast mode reads its stored successor. With `u16` links and `V ≈ T/2` that is
+/// about 11.5 bytes per triangle ([`LeanWorkspace::BYTES`]).
 pub struct LeanWorkspace<L: Index, const V: usize, const T: usize> {
     first: [L; V],
-    border_next: [L; V],
     target: [L; V],
     cost: [f32; V],
     order: [L; V],
@@ -429,7 +429,6 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     pub const fn new() -> Self {
         LeanWorkspace {
             first: [L::ZERO; V],
-            border_next: [L::ZERO; V],
             target: [L::ZERO; V],
             cost: [0.0; V],
             order: [L::ZERO; V],
@@ -450,7 +449,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     ) -> Result<Report, Error> {
         let arrays = Arrays {
             first: &mut self.first,
-            border_next: &mut self.border_next,
+            border_next: &mut [],
             target: &mut self.target,
             cost: &mut self.cost,
             order: &mut self.order,
@@ -462,7 +461,8 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     }
 }
 
-/// A workspace's arrays apart from the quadrics, at its capacity.
+/// A workspace's arrays apart from the quadrics, at its capacity (`border_next` empty in the
+/// lean mode).
 struct Arrays<'w, L: Index> {
     first: &'w mut [L],
     border_next: &'w mut [L],
@@ -504,9 +504,16 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
         lists,
         histogram,
     } = w;
+    // The lean mode has no border successors (an empty slice: `link` reads NONE, `set_link`
+    // writes nothing).
+    let border_next = if Q::STORES_BORDERS {
+        border_next.get_mut(..nv)
+    } else {
+        Some(border_next)
+    };
     let (Some(first), Some(border_next), Some(target), Some(cost), Some(order), Some(flags)) = (
         first.get_mut(..nv),
-        border_next.get_mut(..nv),
+        border_next,
         target.get_mut(..nv),
         cost.get_mut(..nv),
         order.get_mut(..nv),

@@ -121,16 +121,22 @@ fn error(q: &quadric::PointQuadric, c: f32) -> f32 {
 /// a's cheapest target other than `b` that its kind allows (pick's rules) and no collapse of
 /// this pass has touched, and its price.
 #[inline(never)]
-fn alternative<I: Index, L: Index>(
+#[allow(clippy::too_many_arguments)]
+fn alternative<I: Index, L: Index, Q: Quadrics>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     (flags, border_next): (&[u8], &[L]),
-    q: &quadric::PointQuadric,
+    (quadrics, q): (&Q, &quadric::PointQuadric),
     a: usize,
     b: usize,
 ) -> Option<(usize, f32)> {
     let border = flags_of(flags, a) & flag::KIND == flag::BORDER;
+    let next = if border {
+        quadrics.next(tris, adj, flags, border_next, a)
+    } else {
+        NONE
+    };
     let pa = frame.at(a);
     let mut best: Option<(usize, f32)> = None;
     for (_, tr, k) in fan(tris, adj, flags, a) {
@@ -145,7 +151,7 @@ fn alternative<I: Index, L: Index>(
             }
             if border
                 && !(fw & flag::KIND == flag::BORDER
-                    && (link(border_next, a) == w || link(border_next, w) == a))
+                    && (next == w || quadrics.enters(tris, adj, flags, border_next, w, a)))
             {
                 continue;
             }
@@ -216,9 +222,15 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
                 // a's next cheapest target, at once: a vertex keeps one candidate, so one
                 // whose cheapest collapse stays illegal would otherwise never move.
                 let qa = quadrics.of(frame, &*tris, adj, &*flags, &*border_next, a);
-                let Some((x, cx)) =
-                    alternative(frame, tris, adj, (&*flags, &*border_next), &qa, a, b)
-                else {
+                let Some((x, cx)) = alternative(
+                    frame,
+                    tris,
+                    adj,
+                    (&*flags, &*border_next),
+                    (quadrics, &qa),
+                    a,
+                    b,
+                ) else {
                     continue;
                 };
                 let ex = if limit.is_finite() {

@@ -6,7 +6,7 @@
 
 use super::fill::Quadrics;
 use super::sort::key;
-use super::{fan, flag, flags_of, link, others, Frame, BINS, NONE};
+use super::{fan, flag, flags_of, others, Frame, BINS, NONE};
 use crate::index::Index;
 use crate::math;
 use crate::quadric;
@@ -50,7 +50,11 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
                     to = b;
                 }
             };
-            let next = link(border_next, a);
+            let next = if border {
+                quadrics.next(triangles, adj, flags, border_next, a)
+            } else {
+                NONE
+            };
             for (_, tr, k) in fan(triangles, adj, flags, a) {
                 let (x, y) = others(tr, k);
                 if !border {
@@ -61,7 +65,7 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
                 if x == next && flags_of(flags, x) & flag::KIND == flag::BORDER {
                     offer(x);
                 }
-                if flags_of(flags, y) & flag::KIND == flag::BORDER && link(border_next, y) == a {
+                if quadrics.enters(triangles, adj, flags, border_next, y, a) {
                     offer(y);
                 }
             }
