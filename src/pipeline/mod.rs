@@ -1,5 +1,16 @@
-//! Fast mode (engine v4 prototype): meshoptimizer's edge-collapse pipeline in fixed caller
-//! memory, with every output valid.
+//! The pipeline (engine v4): meshoptimizer's edge-collapse pipeline in fixed caller memory,
+//! with every output valid, in two modes that differ only in what they store:
+//!
+//! | mode | workspace | per vertex | bytes per triangle (`u16` links) |
+//! |---|---|---|---|
+//! | fast | [`FastWorkspace`] | a quadric, filled before each pass; the border successor | 24.5 |
+//! | lean | [`LeanWorkspace`] | neither: both found from the vertex's fan whenever read | 11.5 |
+//!
+//! The lean mode walks a vertex's fan for its quadric each time a pass prices it (and for a
+//! border vertex's open edges), where the fast mode reads an array: more instructions for less
+//! than half the RAM. Both price with the same planes and apply the same rules; only the order
+//! of each quadric's sum differs (triangle order against fan order), so a price may differ in
+//! its last bits and the outputs with it.
 //!
 //! The pipeline follows `meshopt_simplifyEdge` of Arseny Kapoulkine's meshoptimizer
 //! (`src/simplifier.cpp`): passes that price every candidate once from per-vertex plane
@@ -56,11 +67,12 @@
 //! weights (the quadric's trace): a weighted mean squared distance, a distance in the input's
 //! units once its root is taken.
 //!
-//! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` runs it
-//! (seams welded by position before the call). Not in it: wedges (welded seams), parts, the
+//! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` (or
+//! `lean`) runs it (seams welded by position before the call). Not in it: wedges (welded seams), parts, the
 //! error bound and `step(budget)`. A vertex with more than 32 triangles is locked, and a
 //! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
-//! buffers. `examples/fast_cow.rs` runs it on one mesh, for callgrind and timing;
+//! buffers. `examples/fast_cow.rs` runs it on one mesh (`FAST_COW_LEAN=1`: the lean mode), for
+//! callgrind and timing;
 //! docs/speed.md#fast-mode has its instructions and the decisions behind its passes.
 
 mod build;
@@ -107,7 +119,8 @@ pub(crate) mod flag {
     pub const PASS: u8 = 4;
     /// Scratch mark (the link condition).
     pub const MARK: u8 = 8;
-    /// A collapse changed one of the vertex's triangles since its quadric was filled.
+    /// A collapse changed one of the vertex's triangles since its quadric was filled (read by
+    /// the fast mode's fill only; the lean mode fills nothing).
     pub const DIRTY: u8 = 0x40;
     /// The bits of a fan list's end above the link type's width (see [`super::end`]): two, as
     /// `3·T` entries with `T ≤ L::COUNT` need at most two more bits than the link has.
