@@ -13,7 +13,7 @@
 use super::{fan, flag, flags_of, link, others, tri, Frame, NONE};
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::quadric::{point_plane, PointQuadric};
+use crate::quadric::{point_error, point_plane, point_weight, PointQuadric};
 
 /// meshoptimizer's `kEdgeWeightBorder`.
 const BORDER_WEIGHT: f32 = 10.0;
@@ -38,6 +38,59 @@ fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
         return [0.0; 6];
     }
     point_plane(c, 0.5 * math::rsqrt(l2) * w)
+}
+
+/// The area of the first `triangles` (unit frame).
+#[inline(never)]
+pub(super) fn area<I: Index>(frame: &Frame<'_>, triangles: &[[I; 3]]) -> f32 {
+    let mut sum = 0.0;
+    for t in 0..triangles.len() {
+        let p = tri(triangles, t).map(|v| frame.at(v));
+        let c = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
+        sum += 0.5 * math::sqrt(math::dot(c, c));
+    }
+    sum
+}
+
+/// A price from a quadric: the default cost's (`cost::Quadric`), the squared distances to the
+/// planes weighted by their areas, times `1 + Ā/W` with `W` the planes' weight (the fan's
+/// area) and `Ā` the mean triangle area of the live mesh: a sum alone makes a fan of small
+/// triangles cheap to move however far it goes, so thin parts would go first.
+#[derive(Clone, Copy)]
+pub(crate) struct Price {
+    /// `Ā`: the input's area over the live triangles (a collapse keeps the area nearly).
+    pub(crate) mean_area: f32,
+}
+
+impl Price {
+    /// `1 + Ā/W` of quadric `q`.
+    #[inline]
+    pub(crate) fn factor(&self, q: &PointQuadric) -> f32 {
+        let w = point_weight(q);
+        if w > 0.0 {
+            1.0 + self.mean_area / w
+        } else {
+            1.0
+        }
+    }
+
+    /// The price of moving by `d` under `q`.
+    #[inline]
+    pub(crate) fn of(&self, q: &PointQuadric, d: V3) -> f32 {
+        point_error(q, d) * self.factor(q)
+    }
+
+    /// The error behind price `c` of quadric `q`: the mean squared distance, `c / (W + Ā)`
+    /// (`W · (1 + Ā/W)`), zero without weight.
+    #[inline]
+    pub(crate) fn error(&self, q: &PointQuadric, c: f32) -> f32 {
+        let w = point_weight(q);
+        if w > 0.0 {
+            c / (w + self.mean_area)
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Whether `v`'s quadric is filled in this pass: every vertex in the first, then those a
@@ -374,10 +427,14 @@ impl Quadrics for Fans {
         _: &Frame<'_>,
         _: &[[I; 3]],
         _: (&[L], &[L]),
-        _: &mut [u8],
+        flags: &mut [u8],
         _: &[L],
         _: bool,
     ) {
+        // Nothing is stored; the dirty bits say, in the pass, which fans a collapse changed.
+        for f in flags.iter_mut() {
+            *f &= !flag::DIRTY;
+        }
     }
 
     #[inline(always)]

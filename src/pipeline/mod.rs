@@ -560,6 +560,8 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
     let target_triangles = config.target.triangles(valid);
     let mut stats = Stats::default();
     let mut passes = 0u32;
+    // The input's area (unit frame), for the price's mean triangle area.
+    let mut area = 0.0f32;
     let mut pass_triangles = heapless::Vec::new();
     let stop = loop {
         if nt <= target_triangles {
@@ -569,6 +571,12 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             break Stop::MaxPasses;
         }
         let tris = triangles.get(..nt).unwrap_or(&[]);
+        if passes == 0 {
+            area = fill::area(&frame, tris);
+        }
+        let price = fill::Price {
+            mean_area: area / nt as f32,
+        };
         let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
         quadrics.fill(&frame, tris, adj, flags, border_next, passes == 0);
         pick::pick(
@@ -577,7 +585,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             adj,
             flags,
             border_next,
-            &quadrics,
+            (&quadrics, price),
             (&mut *target, &mut *cost),
             histogram,
         );
@@ -595,7 +603,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
-            &quadrics,
+            (&quadrics, price),
             (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
             (goal, limit),
             &mut stats,

@@ -25,7 +25,7 @@
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
 //! degenerate: compact drops them) and locks both ends.
 
-use super::fill::Quadrics;
+use super::fill::{vertex_quadric, Price, Quadrics};
 use super::{
     dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
 };
@@ -105,19 +105,6 @@ pub(super) const fn on(name: &str) -> bool {
     false
 }
 
-/// The error of a's candidate at price `c`: the price over the sum of a's planes' weights,
-/// which is its quadric's trace (every plane's normal is a unit vector; `StoredQuadric::error2`
-/// likewise): a weighted mean squared distance in the unit frame, zero without weight.
-#[inline]
-fn error(q: &quadric::PointQuadric, c: f32) -> f32 {
-    let w = quadric::point_weight(q);
-    if w > 0.0 {
-        c / w
-    } else {
-        0.0
-    }
-}
-
 /// a's cheapest target other than `b` that its kind allows (pick's rules) and no collapse of
 /// this pass has touched, and its price.
 #[inline(never)]
@@ -127,7 +114,7 @@ fn alternative<I: Index, L: Index, Q: Quadrics>(
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     (flags, border_next): (&[u8], &[L]),
-    (quadrics, q): (&Q, &quadric::PointQuadric),
+    (quadrics, q, price): (&Q, &quadric::PointQuadric, Price),
     a: usize,
     b: usize,
 ) -> Option<(usize, f32)> {
@@ -161,7 +148,8 @@ fn alternative<I: Index, L: Index, Q: Quadrics>(
             }
         }
     }
-    best
+    let factor = price.factor(q);
+    best.map(|(w, e)| (w, e * factor))
 }
 
 /// Runs one pass over `order`; returns the collapses made.
@@ -173,7 +161,7 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    quadrics: &Q,
+    (quadrics, price): (&Q, Price),
     (target, cost, order): (&mut [L], &[f32], &[L]),
     (goal, limit): (usize, f32),
     stats: &mut Stats,
@@ -200,12 +188,30 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
             continue;
         }
+        // A collapse of this pass changed a's triangles: its price is stale. Priced again
+        // from its fan as it is now (as the batched schedule prices a popped vertex again),
+        // and left to the next pass if that is over the pass's error goal.
+        let (c, fresh) = if flags_of(flags, a) & flag::DIRTY != 0 {
+            let q = vertex_quadric(frame, &*tris, adj, &*flags, a);
+            let c = price.of(&q, math::sub(frame.at(b), frame.at(a)));
+            if c > error_goal.max(cost_of(a)) {
+                // As a refusal: the goal's candidate moves one further.
+                if option_env!("FAST_SKIPGOAL").is_some() {
+                    edge_goal += 1;
+                }
+                continue;
+            }
+            (c, Some(q))
+        } else {
+            (c, None)
+        };
         // a's quadric: read or built only when the error or a second target needs it.
+        let qa = |flags: &[u8], tris: &[[I; 3]]| match fresh {
+            Some(q) => q,
+            None => quadrics.of(frame, tris, adj, flags, &*border_next, a),
+        };
         let e = if limit.is_finite() {
-            error(
-                &quadrics.of(frame, &*tris, adj, &*flags, &*border_next, a),
-                c,
-            )
+            price.error(&qa(&*flags, &*tris), c)
         } else {
             0.0
         };
@@ -221,20 +227,20 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
                 edge_goal += 1;
                 // a's next cheapest target, at once: a vertex keeps one candidate, so one
                 // whose cheapest collapse stays illegal would otherwise never move.
-                let qa = quadrics.of(frame, &*tris, adj, &*flags, &*border_next, a);
+                let qa = qa(&*flags, &*tris);
                 let Some((x, cx)) = alternative(
                     frame,
                     tris,
                     adj,
                     (&*flags, &*border_next),
-                    (quadrics, &qa),
+                    (quadrics, &qa, price),
                     a,
                     b,
                 ) else {
                     continue;
                 };
                 let ex = if limit.is_finite() {
-                    error(&qa, cx)
+                    price.error(&qa, cx)
                 } else {
                     0.0
                 };

@@ -4,7 +4,7 @@
 //! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
 //! along its border edge (either direction); a locked vertex never moves.
 
-use super::fill::Quadrics;
+use super::fill::{Price, Quadrics};
 use super::sort::key;
 use super::{fan, flag, flags_of, others, Frame, BINS, NONE};
 use crate::index::Index;
@@ -24,7 +24,7 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
     adj: (&[L], &[L]),
     flags: &[u8],
     border_next: &[L],
-    quadrics: &Q,
+    (quadrics, price): (&Q, Price),
     (target, cost): (&mut [L], &mut [f32]),
     histogram: &mut [L; BINS],
 ) {
@@ -68,6 +68,10 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
                 if quadrics.enters(triangles, adj, flags, border_next, y, a) {
                     offer(y);
                 }
+            }
+            // The factor is a's own: it does not change which target is cheapest.
+            if to != NONE {
+                best *= price.factor(&q);
             }
         }
         *ca = best;
