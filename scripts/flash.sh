@@ -2,7 +2,8 @@
 # Flash of one instantiation of tinydecimate, measured as a user would: the minimal firmware in
 # tests/flash (positions a static in flash, triangles a static RAM buffer, a static workspace)
 # is built without and with the call `Workspace<u16, 512, 1024>::simplify(.., &Config::new())`
-# (and with the fast mode's `FastWorkspace<u16, 512, 1024>::simplify` instead),
+# (and with the fast mode's `FastWorkspace<u16, 512, 1024>::simplify` instead, and the lean
+# mode's `LeanWorkspace<u16, 512, 1024>::simplify`),
 # opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
 # of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
 #
@@ -33,7 +34,7 @@ while [ $# -gt 0 ]; do
         --opt-level) opt=$2; shift ;;
         --symbols) nsym=$2; shift ;;
         --target) targets+=("$2"); shift ;;
-        -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown argument: $1 (see --help)" >&2; exit 2 ;;
     esac
     shift
@@ -59,7 +60,8 @@ images="$CARGO_TARGET_DIR/images"
 mkdir -p "$images"
 # Variants: name, cargo features (comma-separated, may be empty), what the row shows.
 variants=("without||-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
-    "fast|fast|fast mode: FastWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
+    "fast|fast|fast mode: FastWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
+    "lean|lean|lean mode: LeanWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
 if [ $all = 1 ]; then
     variants+=(
         "paper|paper|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::paper()"
@@ -139,7 +141,7 @@ if [ $all = 1 ]; then
     echo "what each addition costs over the single instantiation (Config::new(), u16):"
     for t in "${targets[@]}"; do
         one=${size[$t/call]}
-        for v in "${variants[@]:3}"; do
+        for v in "${variants[@]:4}"; do
             IFS='|' read -r name _ what <<<"$v"
             d=$((size[$t/$name] - one))
             printf '  %-22s %-82s %+7d B (%s)\n' "$t" "$what" "$d" "$(kb "$d")"

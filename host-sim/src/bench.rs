@@ -141,11 +141,14 @@ pub enum Method {
     /// tinydecimate's fast mode, `pipeline::FastWorkspace` with `Config::new()`:
     /// meshoptimizer's pipeline with every output valid (`host-sim simplify --engine fast`).
     Fast,
+    /// tinydecimate's lean mode, `pipeline::LeanWorkspace` with `Config::new()`: the fast
+    /// mode's pipeline without stored quadrics (`host-sim simplify --engine lean`).
+    Lean,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 11] = [
+    pub const ALL: [Method; 12] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -157,6 +160,7 @@ impl Method {
         Method::Energy,
         Method::Batched,
         Method::Fast,
+        Method::Lean,
     ];
 
     /// The operator of our modes.
@@ -196,15 +200,18 @@ impl Method {
             Method::Energy => "Hoppe's energy",
             Method::Batched => "batched quadric",
             Method::Fast => "fast mode",
+            Method::Lean => "lean mode",
         }
     }
 
     /// The library configuration (before the ratio); `None` for meshoptimizer.
     pub fn config(self) -> Option<Config> {
         match self {
-            Method::Default | Method::VertexDecimation | Method::Energy | Method::Fast => {
-                Some(Config::new())
-            }
+            Method::Default
+            | Method::VertexDecimation
+            | Method::Energy
+            | Method::Fast
+            | Method::Lean => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
@@ -227,6 +234,16 @@ impl Method {
             Method::Energy => "`Energy` (κ = 0.01) with `Config::new()`",
             Method::Batched => "`Config::new().with_schedule(Schedule::Batched)`",
             Method::Fast => "`pipeline::FastWorkspace` with `Config::new()`",
+            Method::Lean => "`pipeline::LeanWorkspace` with `Config::new()`",
+        }
+    }
+
+    /// The library's pipeline mode of the fast and the lean mode; `None` for the others.
+    pub fn pipeline(self) -> Option<crate::simplify::Pipeline> {
+        match self {
+            Method::Fast => Some(crate::simplify::Pipeline::Fast),
+            Method::Lean => Some(crate::simplify::Pipeline::Lean),
+            _ => None,
         }
     }
 
@@ -622,7 +639,7 @@ fn run_method(
                     weld: true,
                     prune,
                     energy: (method == Method::Energy).then_some(tinydecimate::cost::Energy::KAPPA),
-                    fast: method == Method::Fast,
+                    pipeline: method.pipeline(),
                     ..Default::default()
                 };
                 // The error limit measures a collapse or a removal (not a triangle collapse).
@@ -640,13 +657,14 @@ fn run_method(
                 };
                 // Vertex decimation runs without wedges and parts (`simplify_with`).
                 let edge = method.operator() == crate::simplify::OperatorArg::Edge;
-                let bytes = if method == Method::Fast {
-                    crate::simplify::fast_bytes(v, t)
-                } else {
-                    workspace_bytes(v, t).0
-                        + quadrics
-                        + if edge { wedge_bytes(mesh) } else { 0 }
-                        + part_bytes(v, &config, prune && edge)
+                let bytes = match method.pipeline() {
+                    Some(mode) => crate::simplify::pipeline_bytes(mode, v, t),
+                    None => {
+                        workspace_bytes(v, t).0
+                            + quadrics
+                            + if edge { wedge_bytes(mesh) } else { 0 }
+                            + part_bytes(v, &config, prune && edge)
+                    }
                 };
                 (out, elapsed, bytes, Some(report))
             }
@@ -1051,7 +1069,8 @@ mod tests {
         assert_eq!(Method::Paper.config(), Some(Config::paper()));
         assert_eq!(Method::Meshopt.config(), None);
         assert_eq!(Method::Fast.config(), Some(Config::new()));
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 9);
+        assert_eq!(Method::Lean.config(), Some(Config::new()));
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 10);
     }
 
     #[test]

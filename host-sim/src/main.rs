@@ -41,7 +41,8 @@ enum Command {
     /// The golden files in tests/golden: --check them on the host, or --bless (rewrite) them.
     Golden(golden::Args),
     /// First impression: one mesh simplified on the host and on an emulated Cortex-M4F, side by
-    /// side, and whether the outputs are byte-identical; then the same with the fast mode.
+    /// side, and whether the outputs are byte-identical; then the same with the fast and the
+    /// lean mode.
     Demo(demo::Args),
     /// Progressive meshes: encode a mesh as a base mesh plus vertex splits, decode a stream to
     /// a level, measure and draw a ladder of levels.

@@ -142,14 +142,19 @@ const MICROBIT_SKIPS: &[&str] = &[
     "grid8-dirty-fast-u32",
     "plate-cut-fast-u16",
     "cow-fast-u16",
+    "grid12-lean-u16",
+    "box6-lean-u16",
+    "grid8-dirty-lean-u32",
+    "plate-cut-lean-u16",
+    "cow-lean-u16",
     "pm-grid8",
     "pm-cow-quantised",
 ];
 /// No RAM for stored quadrics on the micro:bit and the lm3s6965evb (firmware
 /// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases (they borrow it) or the
 /// energy's samples either, no stack for vertex decimation (`board::VERTEX_DECIMATION`) and
-/// no fast mode (`board::FAST_VERTICES` = 0); the cow's cases need the 4 MB boards or the
-/// 400 KB RISC-V.
+/// no fast or lean mode (`board::FAST_VERTICES` = 0); the cow's cases need the 4 MB boards or
+/// the 400 KB RISC-V.
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
     "tray-new-u16",
@@ -175,15 +180,21 @@ const LM3S_SKIPS: &[&str] = &[
     "grid8-dirty-fast-u32",
     "plate-cut-fast-u16",
     "cow-fast-u16",
+    "grid12-lean-u16",
+    "box6-lean-u16",
+    "grid8-dirty-lean-u32",
+    "plate-cut-lean-u16",
+    "cow-lean-u16",
     "pm-cow-quantised",
 ];
 
 /// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream) but
-/// the cow's fast case: its fast workspace holds 2 000 vertices (`board::FAST_VERTICES`).
-const RISCV_400K_SKIPS: &[&str] = &["cow-fast-u16"];
+/// the cow's fast and lean cases: their workspace holds 2 000 vertices
+/// (`board::FAST_VERTICES`).
+const RISCV_400K_SKIPS: &[&str] = &["cow-fast-u16", "cow-lean-u16"];
 /// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
 /// no RAM for stored quadrics, bounds or the energy's samples, and the plate and the cow are
-/// too big, vertex decimation overflows its stack, and there is no fast mode.
+/// too big, vertex decimation overflows its stack, and there is no fast or lean mode.
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
@@ -210,6 +221,11 @@ const RISCV_32K_SKIPS: &[&str] = &[
     "grid8-dirty-fast-u32",
     "plate-cut-fast-u16",
     "cow-fast-u16",
+    "grid12-lean-u16",
+    "box6-lean-u16",
+    "grid8-dirty-lean-u32",
+    "plate-cut-lean-u16",
+    "cow-lean-u16",
     "pm-cow-quantised",
 ];
 
@@ -392,8 +408,10 @@ mod tests {
                         || c.triangles.len() > fit
                         || (c.per_vertex_storage() && (c.positions.len() > qv || qv == 0))
                         || (c.method == Some(golden::case::MethodName::VertexDecimation) && !vd)
-                        || (c.method == Some(golden::case::MethodName::Fast)
-                            && (c.positions.len() > fv || c.triangles.len() > ft))
+                        || (matches!(
+                            c.method,
+                            Some(golden::case::MethodName::Fast | golden::case::MethodName::Lean)
+                        ) && (c.positions.len() > fv || c.triangles.len() > ft))
                         || (c.config.max_error.is_finite() && qv == 0)
                         || (c.config.max_error.is_finite()
                             && c.triangles.len() * 3 * c.index_type.bytes()
@@ -538,8 +556,8 @@ impl StreamCapacity {
 mod capacity_tests {
     use super::StreamCapacity;
 
-    /// The fast workspace per board (firmware `board::FAST_VERTICES`, `FAST_TRIANGLES`; 0: no
-    /// fast mode).
+    /// The fast (and lean) workspace per board (firmware `board::FAST_VERTICES`,
+    /// `FAST_TRIANGLES`; 0: no fast or lean mode).
     pub(super) const FAST: &[(&str, usize, usize)] = &[
         ("microbit", 0, 0),
         ("lm3s6965evb", 0, 0),

@@ -10,7 +10,7 @@ use tinydecimate::bound::Controls;
 use tinydecimate::cost::{
     AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
 };
-use tinydecimate::pipeline::FastWorkspace;
+use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
 use tinydecimate::{
     Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse, VertexDecimation,
 };
@@ -108,10 +108,39 @@ pub struct Run {
     /// Hoppe's energy with this κ (`tinydecimate::cost::Energy`, subset placement) instead of
     /// the configuration's built-in cost; one `Samples` per vertex.
     pub energy: Option<f32>,
-    /// The fast mode (`tinydecimate::pipeline::FastWorkspace`, [`simplify_fast`]) instead of
+    /// The fast or the lean mode (`tinydecimate::pipeline`, [`simplify_pipeline`]) instead of
     /// the exact engine: seams welded by position when `weld` (the output keeps the welded
     /// numbering), no parts, wedges, bound or other cost.
-    pub fast: bool,
+    pub pipeline: Option<Pipeline>,
+}
+
+/// A mode of the library's pipeline (`tinydecimate::pipeline`): the same passes and rules,
+/// with or without stored quadrics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    /// The fast mode, `pipeline::FastWorkspace`: stored quadrics (about 24.5 B per triangle).
+    Fast,
+    /// The lean mode, `pipeline::LeanWorkspace`: each quadric built from its vertex's fan
+    /// whenever read (about 12.5 B per triangle).
+    Lean,
+}
+
+impl Pipeline {
+    /// The `--engine` value: `fast` or `lean`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::Fast => "fast",
+            Pipeline::Lean => "lean",
+        }
+    }
+
+    /// The library's workspace type: `FastWorkspace` or `LeanWorkspace`.
+    pub fn workspace(self) -> &'static str {
+        match self {
+            Pipeline::Fast => "FastWorkspace",
+            Pipeline::Lean => "LeanWorkspace",
+        }
+    }
 }
 
 /// Whether two vertices share a position (`-0.0` is `0.0`, as `seam::weld` compares them):
@@ -171,9 +200,9 @@ pub fn simplify_with_attributes(
         lock_seam_corners,
         prune,
         energy,
-        fast,
+        pipeline,
     } = *run;
-    if fast {
+    if let Some(mode) = pipeline {
         if attributes.is_some()
             || energy.is_some()
             || placement.is_some()
@@ -181,11 +210,12 @@ pub fn simplify_with_attributes(
             || operator != OperatorArg::Edge
         {
             return Err(anyhow!(
-                "--engine fast runs its own edge collapse on stored quadrics: it takes no \
-                 --max-error, --quadric, --cost energy, --operator or attributes"
+                "--engine {} runs its own edge collapse on plane quadrics: it takes no \
+                 --max-error, --quadric, --cost energy, --operator or attributes",
+                mode.name()
             ));
         }
-        return simplify_fast(mesh, config, weld);
+        return simplify_pipeline(mesh, config, weld, mode);
     }
     // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
     // its run is welded by position, and the output keeps the welded numbering.
@@ -387,19 +417,81 @@ pub fn simplify_with_attributes(
 static FAST_SMALL: Mutex<FastWorkspace<u16, 65_535, 65_535>> = Mutex::new(FastWorkspace::new());
 static FAST_LARGE: Mutex<FastWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES>> =
     Mutex::new(FastWorkspace::new());
+/// The lean mode's workspaces, as the fast mode's.
+static LEAN_SMALL: Mutex<LeanWorkspace<u16, 65_535, 65_535>> = Mutex::new(LeanWorkspace::new());
+static LEAN_LARGE: Mutex<LeanWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES>> =
+    Mutex::new(LeanWorkspace::new());
 
-/// The largest mesh `--engine fast` takes, in vertices.
+/// The largest mesh `--engine fast` (and `lean`) takes, in vertices.
 pub const FAST_VERTICES: usize = 1 << 20;
-/// The largest mesh `--engine fast` takes, in triangles.
+/// The largest mesh `--engine fast` (and `lean`) takes, in triangles.
 pub const FAST_TRIANGLES: usize = 1 << 21;
 
+/// A workspace of the pipeline: `FastWorkspace` or `LeanWorkspace`, whose `simplify` have one
+/// signature.
+trait PipelineWorkspace {
+    fn run<I: tinydecimate::Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, tinydecimate::Error>;
+}
+
+impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
+    for FastWorkspace<L, V, T>
+{
+    fn run<I: tinydecimate::Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, tinydecimate::Error> {
+        self.simplify(positions, triangles, config)
+    }
+}
+
+impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
+    for LeanWorkspace<L, V, T>
+{
+    fn run<I: tinydecimate::Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, tinydecimate::Error> {
+        self.simplify(positions, triangles, config)
+    }
+}
+
 /// Runs the fast mode on `mesh` (seams welded by position first when `weld`): the library
-/// call `FastWorkspace::simplify` on a workspace of the smallest link type that fits. The wall
-/// time is that of the weld and the library call.
+/// call `FastWorkspace::simplify` on a workspace of the smallest link type that fits.
 pub fn simplify_fast(
     mesh: &MeshData,
     config: &Config,
     weld: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    simplify_pipeline(mesh, config, weld, Pipeline::Fast)
+}
+
+/// Runs the lean mode on `mesh` (seams welded by position first when `weld`): the library
+/// call `LeanWorkspace::simplify` on a workspace of the smallest link type that fits.
+pub fn simplify_lean(
+    mesh: &MeshData,
+    config: &Config,
+    weld: bool,
+) -> Result<(MeshData, Report, Duration)> {
+    simplify_pipeline(mesh, config, weld, Pipeline::Lean)
+}
+
+/// Runs the pipeline in `mode` on `mesh` (seams welded by position first when `weld`): the
+/// library call on a workspace of the smallest link type that fits ([`pipeline_run`]). The
+/// wall time is that of the weld and the library call.
+pub fn simplify_pipeline(
+    mesh: &MeshData,
+    config: &Config,
+    weld: bool,
+    mode: Pipeline,
 ) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
     let mut order = vec![0u32; if weld { mesh.positions.len() } else { 0 }];
@@ -409,7 +501,7 @@ pub fn simplify_fast(
         tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
             .map_err(library_error)?;
     }
-    let report = fast_workspace_run(&mesh.positions, &mut tris, config).map_err(library_error)?;
+    let report = pipeline_run(mode, &mesh.positions, &mut tris, config).map_err(library_error)?;
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     Ok((
@@ -430,16 +522,43 @@ pub fn fast_workspace_run<I: tinydecimate::Index>(
     triangles: &mut [[I; 3]],
     config: &Config,
 ) -> Result<Report, tinydecimate::Error> {
-    if positions.len() < 65_535 && triangles.len() < 65_535 {
-        FAST_SMALL
-            .lock()
+    pipeline_run(Pipeline::Fast, positions, triangles, config)
+}
+
+/// The library call `LeanWorkspace::simplify`, as [`fast_workspace_run`]: the host's lean
+/// run, shared by [`simplify_lean`] and the golden reference of a lean case.
+pub fn lean_workspace_run<I: tinydecimate::Index>(
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    pipeline_run(Pipeline::Lean, positions, triangles, config)
+}
+
+/// The library call of `mode` on `triangles` as they are (any index type), on the workspace
+/// of the smallest link type that fits.
+pub fn pipeline_run<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    fn on<W: PipelineWorkspace, I: tinydecimate::Index>(
+        ws: &Mutex<W>,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, tinydecimate::Error> {
+        ws.lock()
             .unwrap_or_else(|e| e.into_inner())
-            .simplify(positions, triangles, config)
-    } else {
-        FAST_LARGE
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .simplify(positions, triangles, config)
+            .run(positions, triangles, config)
+    }
+    let small = positions.len() < 65_535 && triangles.len() < 65_535;
+    match (mode, small) {
+        (Pipeline::Fast, true) => on(&FAST_SMALL, positions, triangles, config),
+        (Pipeline::Fast, false) => on(&FAST_LARGE, positions, triangles, config),
+        (Pipeline::Lean, true) => on(&LEAN_SMALL, positions, triangles, config),
+        (Pipeline::Lean, false) => on(&LEAN_LARGE, positions, triangles, config),
     }
 }
 
@@ -447,20 +566,33 @@ pub fn fast_workspace_run<I: tinydecimate::Index>(
 /// (`FastWorkspace::BYTES`, per element from the library's own sizes), with `u16` links when
 /// both are below 65 535.
 pub fn fast_bytes(v: usize, t: usize) -> usize {
+    pipeline_bytes(Pipeline::Fast, v, t)
+}
+
+/// Bytes a lean-mode workspace sized exactly for `v` vertices and `t` triangles takes
+/// (`LeanWorkspace::BYTES`), as [`fast_bytes`].
+pub fn lean_bytes(v: usize, t: usize) -> usize {
+    pipeline_bytes(Pipeline::Lean, v, t)
+}
+
+/// Bytes the workspace of `mode` sized exactly for `v` vertices and `t` triangles takes (its
+/// `BYTES`, per element from the library's own sizes), with `u16` links when both are below
+/// 65 535.
+pub fn pipeline_bytes(mode: Pipeline, v: usize, t: usize) -> usize {
     const P: usize = 1024;
     macro_rules! per {
-        ($l:ty) => {{
-            let pv =
-                (FastWorkspace::<$l, { 2 * P }, 0>::BYTES - FastWorkspace::<$l, P, 0>::BYTES) / P;
-            let pt =
-                (FastWorkspace::<$l, 0, { 2 * P }>::BYTES - FastWorkspace::<$l, 0, P>::BYTES) / P;
-            FastWorkspace::<$l, 0, 0>::BYTES + v * pv + t * pt
+        ($w:ident, $l:ty) => {{
+            let pv = ($w::<$l, { 2 * P }, 0>::BYTES - $w::<$l, P, 0>::BYTES) / P;
+            let pt = ($w::<$l, 0, { 2 * P }>::BYTES - $w::<$l, 0, P>::BYTES) / P;
+            $w::<$l, 0, 0>::BYTES + v * pv + t * pt
         }};
     }
-    if v < 65_535 && t < 65_535 {
-        per!(u16)
-    } else {
-        per!(u32)
+    let small = v < 65_535 && t < 65_535;
+    match (mode, small) {
+        (Pipeline::Fast, true) => per!(FastWorkspace, u16),
+        (Pipeline::Fast, false) => per!(FastWorkspace, u32),
+        (Pipeline::Lean, true) => per!(LeanWorkspace, u16),
+        (Pipeline::Lean, false) => per!(LeanWorkspace, u32),
     }
 }
 

@@ -1,45 +1,49 @@
-//! `host-sim simplify --engine fast`: the fast mode (`tinydecimate::pipeline`) from the command
-//! line. Its outputs pass the shared check with `check`'s defaults (seams welded, parts may
-//! vanish whole), the error limit stops it as it stops the exact engine, and what it cannot
-//! run is refused with the option named. Each test runs the built binary.
+//! `host-sim simplify --engine fast` and `--engine lean`: the fast and the lean mode
+//! (`tinydecimate::pipeline`) from the command line. Their outputs pass the shared check with
+//! `check`'s defaults (seams welded, parts may vanish whole), the error limit stops them as it
+//! stops the exact engine, and what they cannot run is refused with the option named. Each
+//! test runs the built binary, once per engine.
 
 mod common;
 use common::{fixture, run, s, text};
 
+/// The pipeline's engines and their name in the JSON (`engine`).
+const ENGINES: [(&str, &str); 2] = [("fast", "Fast"), ("lean", "Lean")];
+
 /// A clean scan, a seam-split asset (welded by position), a raw CAD export and a multi-part
 /// model at 10 %: `simplify` says VALID, `check` agrees, and the JSON names the engine.
 #[test]
-fn fast_outputs_pass_check() {
+fn fast_and_lean_outputs_pass_check() {
     let d = tempfile::tempdir().unwrap();
     let mut failed = Vec::new();
-    for mesh in [
-        "stanford_bunny.obj",
-        "suzanne_seams.obj",
-        "pins.obj",
-        "wuson.obj",
-    ] {
-        let input = fixture(mesh);
-        let out = d.path().join(mesh);
-        let json = d.path().join(format!("{mesh}.json"));
-        let o = run(&[
-            "simplify",
-            s(&input),
-            s(&out),
-            "--ratio",
-            "0.1",
-            "--engine",
-            "fast",
-            "--json",
-        ]);
-        let so = text(&o.stdout);
-        assert_eq!(o.status.code(), Some(0), "{mesh}: {so}");
-        std::fs::write(&json, &so).unwrap();
-        let j: serde_json::Value = serde_json::from_str(&so).unwrap();
-        assert_eq!(j["engine"], "Fast", "{mesh}");
-        assert_eq!(j["valid"], true, "{mesh}");
-        let c = run(&["check", s(&input), s(&out)]);
-        if c.status.code() != Some(0) {
-            failed.push(format!("{mesh}:\n{}", text(&c.stdout)));
+    for (engine, json_name) in ENGINES {
+        for mesh in [
+            "stanford_bunny.obj",
+            "suzanne_seams.obj",
+            "pins.obj",
+            "wuson.obj",
+        ] {
+            let input = fixture(mesh);
+            let out = d.path().join(format!("{engine}-{mesh}"));
+            let o = run(&[
+                "simplify",
+                s(&input),
+                s(&out),
+                "--ratio",
+                "0.1",
+                "--engine",
+                engine,
+                "--json",
+            ]);
+            let so = text(&o.stdout);
+            assert_eq!(o.status.code(), Some(0), "{engine} {mesh}: {so}");
+            let j: serde_json::Value = serde_json::from_str(&so).unwrap();
+            assert_eq!(j["engine"], json_name, "{engine} {mesh}");
+            assert_eq!(j["valid"], true, "{engine} {mesh}");
+            let c = run(&["check", s(&input), s(&out)]);
+            if c.status.code() != Some(0) {
+                failed.push(format!("{engine} {mesh}:\n{}", text(&c.stdout)));
+            }
         }
     }
     assert!(failed.is_empty(), "{}", failed.join("\n"));
@@ -48,58 +52,43 @@ fn fast_outputs_pass_check() {
 /// The bunny to 1 % with a limit of 0.05 % of the diagonal stops on the limit, short of the
 /// target, with every collapse made under it; without a limit it reaches the count.
 #[test]
-fn the_error_limit_stops_the_fast_engine() {
+fn the_error_limit_stops_the_fast_and_lean_engines() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("stanford_bunny.obj");
     let out = d.path().join("b.obj");
-    let report =
-        |limit: &str| fast_json(&input, &out, "0.01", &["--error-limit", limit])["report"].clone();
-    let free = report("none");
-    assert_eq!(free["stop"], "Target", "{free}");
-    let limited = report("0.05%");
-    assert_eq!(limited["stop"], "ErrorLimit", "{limited}");
-    assert!(limited["over_limit"].as_u64().unwrap() > 0, "{limited}");
-    assert!(
-        limited["triangles_out"].as_u64().unwrap() > 2 * free["triangles_out"].as_u64().unwrap(),
-        "{limited}"
-    );
-    // 0.05 % of the bunny's diagonal (about 0.25 units): every collapse under it.
-    let diagonal = 0.2502f64;
-    assert!(
-        limited["collapse_error"].as_f64().unwrap() <= 0.0005 * diagonal * 1.001,
-        "{limited}"
-    );
+    for (engine, _) in ENGINES {
+        let report = |limit: &str| {
+            engine_json(engine, &input, &out, "0.01", &["--error-limit", limit])["report"].clone()
+        };
+        let free = report("none");
+        assert_eq!(free["stop"], "Target", "{engine}: {free}");
+        let limited = report("0.05%");
+        assert_eq!(limited["stop"], "ErrorLimit", "{engine}: {limited}");
+        assert!(
+            limited["over_limit"].as_u64().unwrap() > 0,
+            "{engine}: {limited}"
+        );
+        assert!(
+            limited["triangles_out"].as_u64().unwrap()
+                > 2 * free["triangles_out"].as_u64().unwrap(),
+            "{engine}: {limited}"
+        );
+        // 0.05 % of the bunny's diagonal (about 0.25 units): every collapse under it.
+        let diagonal = 0.2502f64;
+        assert!(
+            limited["collapse_error"].as_f64().unwrap() <= 0.0005 * diagonal * 1.001,
+            "{engine}: {limited}"
+        );
+    }
 }
 
-/// What the fast mode does not run is refused before any work, the option named.
+/// What the fast and the lean mode do not run is refused before any work, the option named.
 #[test]
-fn what_the_fast_engine_cannot_run_is_refused() {
+fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("cow.obj");
     let out = d.path().join("c.obj");
-    for (extra, named) in [
-        (&["--schedule", "passes"][..], "--schedule"),
-        (&["--quadric", "stored"][..], "--quadric"),
-        (&["--operator", "triangle"][..], "--operator"),
-        (&["--max-error", "1%"][..], "--max-error"),
-    ] {
-        let mut args = vec![
-            "simplify",
-            s(&input),
-            s(&out),
-            "--ratio",
-            "0.5",
-            "--engine",
-            "fast",
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args);
-        assert_ne!(o.status.code(), Some(0), "{extra:?}");
-        let e = text(&o.stderr);
-        assert!(e.contains(named), "{extra:?}: {e}");
-        assert!(!out.exists(), "{extra:?}: an output was written");
-    }
-    // Attributes: the fast mode would weld their seams away.
+    // Attributes: the fast and the lean mode would weld their seams away.
     let textured = d.path().join("quad.obj");
     std::fs::write(
         &textured,
@@ -107,22 +96,44 @@ fn what_the_fast_engine_cannot_run_is_refused() {
          f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
     )
     .unwrap();
-    let o = run(&[
-        "simplify",
-        s(&textured),
-        s(&out),
-        "--ratio",
-        "0.5",
-        "--engine",
-        "fast",
-    ]);
-    assert_ne!(o.status.code(), Some(0));
-    assert!(
-        text(&o.stderr).contains("positions only"),
-        "{}",
-        text(&o.stderr)
-    );
-    assert!(!out.exists());
+    for (engine, _) in ENGINES {
+        for (extra, named) in [
+            (&["--schedule", "passes"][..], "--schedule"),
+            (&["--quadric", "stored"][..], "--quadric"),
+            (&["--operator", "triangle"][..], "--operator"),
+            (&["--max-error", "1%"][..], "--max-error"),
+        ] {
+            let mut args = vec![
+                "simplify",
+                s(&input),
+                s(&out),
+                "--ratio",
+                "0.5",
+                "--engine",
+                engine,
+            ];
+            args.extend_from_slice(extra);
+            let o = run(&args);
+            assert_ne!(o.status.code(), Some(0), "{engine} {extra:?}");
+            let e = text(&o.stderr);
+            assert!(e.contains(named), "{engine} {extra:?}: {e}");
+            assert!(!out.exists(), "{engine} {extra:?}: an output was written");
+        }
+        let o = run(&[
+            "simplify",
+            s(&textured),
+            s(&out),
+            "--ratio",
+            "0.5",
+            "--engine",
+            engine,
+        ]);
+        assert_ne!(o.status.code(), Some(0), "{engine}");
+        let e = text(&o.stderr);
+        assert!(e.contains("positions only"), "{engine}: {e}");
+        assert!(e.contains(&format!("--engine {engine}")), "{engine}: {e}");
+        assert!(!out.exists(), "{engine}");
+    }
 }
 
 /// The fandisk (a CAD model: flat and cylindrical patches) to 50 %: every collapse it needs
@@ -134,13 +145,20 @@ fn collapses_within_flat_patches_cost_no_error() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("fandisk.obj");
     let out = d.path().join("f.obj");
-    let j = fast_json(&input, &out, "0.5", &["--measure"]);
-    let h = j["metro"]["hausdorff_pct"].as_f64().unwrap();
-    assert!(h < 0.005, "Hausdorff distance {h} % of the diagonal");
+    for (engine, _) in ENGINES {
+        let j = engine_json(engine, &input, &out, "0.5", &["--measure"]);
+        let h = j["metro"]["hausdorff_pct"].as_f64().unwrap();
+        assert!(
+            h < 0.005,
+            "{engine}: Hausdorff distance {h} % of the diagonal"
+        );
+    }
 }
 
-/// `simplify INPUT OUT --ratio R --engine fast --json EXTRA...`, which must succeed; its JSON.
-fn fast_json(
+/// `simplify INPUT OUT --ratio R --engine ENGINE --json EXTRA...`, which must succeed; its
+/// JSON.
+fn engine_json(
+    engine: &str,
     input: &std::path::Path,
     out: &std::path::Path,
     ratio: &str,
@@ -153,7 +171,7 @@ fn fast_json(
         "--ratio",
         ratio,
         "--engine",
-        "fast",
+        engine,
         "--json",
     ];
     args.extend_from_slice(extra);

@@ -61,11 +61,13 @@
 //! along their border edge and a lone triangle is never collapsed away, so the Euler
 //! characteristic, the boundary loops and the components are kept.
 //!
-//! Candidates are ordered by price: the source's quadric at the target, a weighted sum of
-//! squared distances, so a collapse over little area goes first. Its error, checked against
-//! [`Config::error_limit`] as for the stored quadric, is the price over the sum of the planes'
-//! weights (the quadric's trace): a weighted mean squared distance, a distance in the input's
-//! units once its root is taken.
+//! Candidates are ordered by price, the default cost's (`cost::Quadric`, see `fill::Price`):
+//! the source's quadric at the target, a sum of squared distances weighted by area, so a
+//! collapse over little area goes first, times `1 + Ā/W` (`W` the fan's area, `Ā` the mean
+//! triangle area), so that thin parts do not go first for being thin. Its error, checked
+//! against [`Config::error_limit`] as for the stored quadric, is the distance part over the
+//! planes' weight (the quadric's trace): a weighted mean squared distance, a distance in the
+//! input's units once its root is taken.
 //!
 //! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` (or
 //! `lean`) runs it (seams welded by position before the call). Not in it: wedges (welded seams), parts, the
@@ -119,8 +121,8 @@ pub(crate) mod flag {
     pub const PASS: u8 = 4;
     /// Scratch mark (the link condition).
     pub const MARK: u8 = 8;
-    /// A collapse changed one of the vertex's triangles since its quadric was filled (read by
-    /// the fast mode's fill only; the lean mode fills nothing).
+    /// A collapse changed one of the vertex's triangles in this pass (or, in the fast mode,
+    /// since its quadric was filled): fill takes its quadric again, perform its price.
     pub const DIRTY: u8 = 0x40;
     /// The bits of a fan list's end above the link type's width (see [`super::end`]): two, as
     /// `3·T` entries with `T ≤ L::COUNT` need at most two more bits than the link has.

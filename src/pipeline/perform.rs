@@ -3,8 +3,11 @@
 //! A candidate is skipped when either end is already an end of a collapse in this pass (so a
 //! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
 //! at its goal or at its error goal: the cost of the candidate that would reach the
-//! goal, once a sixth of the goal is done. A refused candidate is followed at once by a's
-//! next cheapest target, if it is within the error goal. Each candidate is checked on the
+//! goal, once a sixth of the goal is done. A candidate whose triangles a collapse of the pass
+//! changed is priced again from its fan as it is then (the batched schedule prices a popped
+//! vertex again for the same reason) and left to the next pass if that price is over the error
+//! goal. A refused candidate is followed at once by a's next cheapest target, if it is within
+//! the error goal. Each candidate is checked on the
 //! current mesh, the rules in order of cost, each where it can fire:
 //!
 //! 1. the edge: two triangles on a-b (one for a border vertex: its border edge);
@@ -195,10 +198,6 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
             let q = vertex_quadric(frame, &*tris, adj, &*flags, a);
             let c = price.of(&q, math::sub(frame.at(b), frame.at(a)));
             if c > error_goal.max(cost_of(a)) {
-                // As a refusal: the goal's candidate moves one further.
-                if option_env!("FAST_SKIPGOAL").is_some() {
-                    edge_goal += 1;
-                }
                 continue;
             }
             (c, Some(q))

@@ -24,9 +24,9 @@ mod sel {
     /// No stack for vertex decimation (a removal's fixed buffers overflow the Cortex-M3's
     /// 5.8 KB and the 32 KB RISC-V's 7 KB): its cases are skipped here and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
-    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
-    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
-    /// are skipped here.
+    /// No fast or lean mode: their code would not fit the flash beside the exact engine's, and
+    /// their workspace (the 2 KB histogram alone) is most of what this board's RAM holds:
+    /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
@@ -49,9 +49,9 @@ mod sel {
     /// Vertex decimation needs more stack than the ~5.8 KB left here (a removal's fixed
     /// buffers): its cases are skipped and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
-    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
-    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
-    /// are skipped here.
+    /// No fast or lean mode: their code would not fit the flash beside the exact engine's, and
+    /// their workspace (the 2 KB histogram alone) is most of what this board's RAM holds:
+    /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
@@ -89,7 +89,8 @@ mod sel {
     pub const VERTEX_DECIMATION: bool = true;
     /// The fast mode's workspace, `u16` links (53 B per vertex, 6 B per triangle, 2 KB of
     /// histogram: 2 082 048 B), shares the exact engine's RAM ([`Engine`]): as large a mesh
-    /// as fits it, 2 vertices per triangle.
+    /// as fits it, 2 vertices per triangle. The lean mode's workspace has the same capacity
+    /// (11 B per vertex: 738 048 B).
     pub const FAST_VERTICES: usize = 32_000;
     pub const FAST_TRIANGLES: usize = 64_000;
     pub type Link = u32;
@@ -117,7 +118,8 @@ mod sel {
     pub const VERTEX_DECIMATION: bool = true;
     /// The fast mode's workspace, `u16` links (53 B per vertex, 6 B per triangle, 2 KB of
     /// histogram: 132 048 B), shares the exact engine's RAM ([`Engine`]): as large a mesh
-    /// as fits it, 2 vertices per triangle (the cow does not).
+    /// as fits it, 2 vertices per triangle (the cow does not). The lean mode's workspace has
+    /// the same capacity (11 B per vertex: 48 048 B).
     pub const FAST_VERTICES: usize = 2_000;
     pub const FAST_TRIANGLES: usize = 4_000;
     pub type Link = u16;
@@ -140,9 +142,9 @@ mod sel {
     /// Vertex decimation overflows the ~7 KB of stack left here (a removal's fixed buffers):
     /// its cases are skipped and its code left out.
     pub const VERTEX_DECIMATION: bool = false;
-    /// No fast mode: its code would not fit the flash beside the exact engine's, and its
-    /// workspace (the 2 KB histogram alone) is most of what this board's RAM holds: its cases
-    /// are skipped here.
+    /// No fast or lean mode: their code would not fit the flash beside the exact engine's, and
+    /// their workspace (the 2 KB histogram alone) is most of what this board's RAM holds:
+    /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
     pub type Link = u16;
@@ -172,11 +174,13 @@ pub const fn bound_bytes(v: usize, t: usize, index_bytes: usize) -> usize {
 }
 
 /// The largest mesh (vertices, triangles of `it`) a case of `entry` takes on this board: the
-/// buffers', and for the fast mode its workspace's.
+/// buffers', and for the fast and the lean mode their workspace's.
 pub const fn capacity(it: IndexType, entry: meshfmt::Entry) -> (usize, usize) {
     let t = triangle_capacity(it);
     match entry {
-        meshfmt::Entry::Fast => (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t)),
+        meshfmt::Entry::Fast | meshfmt::Entry::Lean => {
+            (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t))
+        }
         _ => (MAX_VERTICES, t),
     }
 }
@@ -210,19 +214,25 @@ pub struct TriangleBytes(pub [u8; TRIANGLE_BYTES]);
 #[cfg(feature = "lib")]
 pub type Workspace = tinydecimate::Workspace<Link, MAX_VERTICES, MAX_TRIANGLES>;
 
-/// Whether the board runs the fast mode (`MethodCode::Fast`). Without it the firmware skips
-/// every fast case and leaves its code out of the image.
+/// Whether the board runs the fast and the lean mode (`MethodCode::Fast`, `MethodCode::Lean`).
+/// Without them the firmware skips every fast and lean case and leaves their code out of the
+/// image.
 pub const FAST: bool = FAST_VERTICES > 0;
 
 /// The fast mode's workspace (`u16` links on every board: it holds at most 32 000 vertices).
 #[cfg(feature = "lib")]
 pub type FastWorkspace = tinydecimate::pipeline::FastWorkspace<u16, FAST_VERTICES, FAST_TRIANGLES>;
 
-/// The working memory of a run, one static for both engines: a run is one case, so it needs
-/// the exact engine's workspace or the fast mode's, never both, and the RAM is the larger of
-/// the two rather than their sum (on the 4 MB boards their sum does not fit). `Exact` is
-/// variant 0 and both workspaces are all zero, so the static is all zero and sits in `.bss`;
-/// a fast case turns it into `Fast` before its run (`main.rs`, `fast_workspace`). The tag is a
+/// The lean mode's workspace: the fast mode's capacity, without its stored quadrics.
+#[cfg(feature = "lib")]
+pub type LeanWorkspace = tinydecimate::pipeline::LeanWorkspace<u16, FAST_VERTICES, FAST_TRIANGLES>;
+
+/// The working memory of a run, one static for every engine: a run is one case, so it needs
+/// the exact engine's workspace, the fast mode's or the lean mode's, never two, and the RAM is
+/// the largest of them rather than their sum (on the 4 MB boards their sum does not fit).
+/// `Exact` is variant 0 and every workspace is all zero, so the static is all zero and sits in
+/// `.bss`; a fast case turns it into `Fast` before its run (`main.rs`, `fast_workspace`), a
+/// lean case into `Lean` (`lean_workspace`). The tag is a
 /// `u32` so that no padding lies between it and the 4-aligned workspace: the switch is then a
 /// store of the tag and a memset of the workspace in place (with a `u8` tag the compiler built
 /// the new value on the stack and copied it, a frame of the workspace's size).
@@ -231,15 +241,20 @@ pub type FastWorkspace = tinydecimate::pipeline::FastWorkspace<u16, FAST_VERTICE
 // Both variants are large on purpose: the enum is how they share the RAM (no heap to box one).
 #[allow(clippy::large_enum_variant)]
 pub enum Engine {
-    /// `Workspace`, the exact engine (every method but the fast mode).
+    /// `Workspace`, the exact engine (every method but the fast and the lean mode).
     Exact(Workspace),
     /// `FastWorkspace`, the fast mode.
     Fast(FastWorkspace),
+    /// `LeanWorkspace`, the lean mode.
+    Lean(LeanWorkspace),
 }
 
 // The fast mode adds no RAM: its workspace fits in the exact engine's.
 #[cfg(feature = "lib")]
 const _: () = assert!(FastWorkspace::BYTES <= Workspace::BYTES);
+// Nor does the lean mode.
+#[cfg(feature = "lib")]
+const _: () = assert!(LeanWorkspace::BYTES <= Workspace::BYTES);
 
 /// What a progressive stream needs beyond the triangle and position buffers (which it reuses:
 /// the triangle bytes hold a list head per vertex, then the triangles and their links): a split

@@ -176,12 +176,13 @@ fn read_case(
     );
     // A board without quadric storage skips every case that borrows it (an empty one too), a
     // board without the stack for vertex decimation every vertex-decimation case, a board
-    // without the fast mode every fast case: `run_library` leaves their code out of the image.
+    // without the fast and lean modes every fast and lean case: `run_library` leaves their code
+    // out of the image.
     let entry = h.entry();
     let (cv, ct) = board::capacity(h.index_type, entry);
     if nv > cv
         || nt > ct
-        || (entry == meshfmt::Entry::Fast && !board::FAST)
+        || (pipeline(entry) && !board::FAST)
         || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
         || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
         || (entry == meshfmt::Entry::Bounded
@@ -190,6 +191,8 @@ fn read_case(
     {
         if entry == meshfmt::Entry::Fast && !board::FAST {
             defmt::warn!("no fast mode on this board");
+        } else if entry == meshfmt::Entry::Lean && !board::FAST {
+            defmt::warn!("no lean mode on this board");
         } else {
             defmt::warn!("the mesh does not fit this board");
         }
@@ -201,6 +204,11 @@ fn read_case(
     hostio::read_exact(&mut file, bytemuck::cast_slice_mut(&mut positions[..nv]))?;
     hostio::read_exact(&mut file, &mut triangles[..h.triangles_len()])?;
     Ok(Ok(h))
+}
+
+/// Whether `entry` runs on the pipeline's own workspace (the fast or the lean mode).
+fn pipeline(entry: meshfmt::Entry) -> bool {
+    matches!(entry, meshfmt::Entry::Fast | meshfmt::Entry::Lean)
 }
 
 /// Writes the result file: header, then the triangles (already in the file's byte order).
@@ -371,8 +379,8 @@ fn simplify(
 ) {
     // `Workspace::new` is const, so the workspace is initialised at compile time. (Building it
     // at run time, `StaticCell::uninit().write(Workspace::new())`, assembles it on the stack
-    // first: a 1.6 MB frame on the 4 MB boards.) The fast mode's workspace shares its RAM
-    // (`board::Engine`).
+    // first: a 1.6 MB frame on the 4 MB boards.) The fast and the lean mode's workspaces
+    // share its RAM (`board::Engine`).
     static ENGINE: ConstStaticCell<board::Engine> =
         ConstStaticCell::new(board::Engine::Exact(board::Workspace::new()));
     let engine = ENGINE.take();
@@ -381,9 +389,13 @@ fn simplify(
     let entry = h.entry();
 
     let sp = measure::paint();
-    // Not counted: the exact engine's workspace is ready at boot, the fast one is zeroed here.
+    // Not counted: the exact engine's workspace is ready at boot, the fast and the lean one
+    // are zeroed here.
     if entry == meshfmt::Entry::Fast && board::FAST {
         fast_workspace(engine);
+    }
+    if entry == meshfmt::Entry::Lean && board::FAST {
+        lean_workspace(engine);
     }
     measure::start(syst);
     let outcome =
@@ -397,6 +409,10 @@ fn simplify(
             board::Engine::Fast(ws) => match h.index_type {
                 IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_fast(ws, pos, t, &config)),
                 IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_fast(ws, pos, t, &config)),
+            },
+            board::Engine::Lean(ws) => match h.index_type {
+                IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_lean(ws, pos, t, &config)),
+                IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_lean(ws, pos, t, &config)),
             },
         };
     let Some(outcome) = outcome else {
@@ -436,10 +452,10 @@ fn write_header(
     r.ticks = ticks;
     r.stack_bytes = sp.saturating_sub(low) as u32;
     r.stack_high_water = measure::depth(low) as u32;
-    r.workspace_bytes = if entry == meshfmt::Entry::Fast {
-        board::FastWorkspace::BYTES as u32
-    } else {
-        board::Workspace::BYTES as u32
+    r.workspace_bytes = match entry {
+        meshfmt::Entry::Fast => board::FastWorkspace::BYTES as u32,
+        meshfmt::Entry::Lean => board::LeanWorkspace::BYTES as u32,
+        _ => board::Workspace::BYTES as u32,
     };
     match outcome {
         Ok(report) => defmt::info!("{}", report),
@@ -476,12 +492,12 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     // A board leaves out the entry points it cannot run (`read_case` skips their cases): the
     // ones that borrow the quadric storage where there is none, vertex decimation where the
     // stack is too small. With all of them the micro:bit's and the lm3s6965evb's images
-    // overflow their 256 KB of flash. A fast case runs on the fast workspace (`run_fast`),
-    // never here.
+    // overflow their 256 KB of flash. A fast or lean case runs on its own workspace
+    // (`run_fast`, `run_lean`), never here.
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
-        Entry::Fast => true,
+        Entry::Fast | Entry::Lean => true,
         _ => !board::HAS_QUADRICS,
     };
     if left_out {
@@ -508,7 +524,7 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
         ),
         Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
         Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
-        Entry::Fast => Err(left_out_error(positions.len())),
+        Entry::Fast | Entry::Lean => Err(left_out_error(positions.len())),
     }
 }
 
@@ -544,6 +560,30 @@ fn fast_workspace(engine: &mut board::Engine) {
 #[inline(never)]
 fn run_fast<I: tinydecimate::Index>(
     ws: &mut board::FastWorkspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    ws.simplify(positions, triangles, config)
+}
+
+/// Turns the run's working memory into the lean mode's workspace (zeroed), in place, as
+/// [`fast_workspace`] does for the fast mode.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn lean_workspace(engine: &mut board::Engine) {
+    const ZEROED: board::LeanWorkspace = board::LeanWorkspace::new();
+    if !matches!(engine, board::Engine::Lean(_)) {
+        *engine = board::Engine::Lean(ZEROED);
+    }
+}
+
+/// A lean case (`MethodCode::Lean`): `LeanWorkspace::simplify`, positions read. Never inlined,
+/// for the same reason as [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_lean<I: tinydecimate::Index>(
+    ws: &mut board::LeanWorkspace,
     positions: &[[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,

@@ -20,7 +20,7 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy, 6 = the fast mode |
+//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy, 6 = the fast mode, 7 = the lean mode |
 //! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
@@ -137,7 +137,7 @@ pub enum ScheduleCode {
 }
 
 /// Method code: the cost and operator a case runs (header byte 30). Codes 0-3 name a cost of
-/// the edge collapse, 4 and 5 a plug-in, 6 the fast mode's own pipeline; the byte was first the
+/// the edge collapse, 4 and 5 a plug-in, 6 and 7 the pipeline (fast and lean mode); the byte was first the
 /// cost alone, so the codes are the ones it had. A new code keeps the case version: a reader
 /// that predates it refuses the case ([`FormatError::Code`]) rather than run another method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,6 +159,9 @@ pub enum MethodCode {
     /// The fast mode (`pipeline::FastWorkspace::simplify`, positions read): its own workspace;
     /// of the configuration only the target, `max_passes` and `error_limit` count.
     Fast = 6,
+    /// The lean mode (`pipeline::LeanWorkspace::simplify`, positions read): the fast mode's
+    /// pipeline without stored quadrics, its own workspace; the configuration as for `Fast`.
+    Lean = 7,
 }
 
 /// The library entry point a case runs: its method and whether it is bounded, decided once
@@ -179,6 +182,8 @@ pub enum Entry {
     Energy,
     /// `pipeline::FastWorkspace::simplify`, positions read.
     Fast,
+    /// `pipeline::LeanWorkspace::simplify`, positions read.
+    Lean,
 }
 
 impl Entry {
@@ -367,6 +372,7 @@ impl CaseHeader {
             4 => MethodCode::VertexDecimation,
             5 => MethodCode::Energy,
             6 => MethodCode::Fast,
+            7 => MethodCode::Lean,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -409,6 +415,7 @@ impl CaseHeader {
             MethodCode::VertexDecimation => Entry::VertexDecimation,
             MethodCode::Energy => Entry::Energy,
             MethodCode::Fast => Entry::Fast,
+            MethodCode::Lean => Entry::Lean,
         }
     }
 
@@ -720,7 +727,8 @@ pub mod lib {
                 | MethodCode::StoredOptimal
                 | MethodCode::VertexDecimation
                 | MethodCode::Energy
-                | MethodCode::Fast => CostKind::Quadric,
+                | MethodCode::Fast
+                | MethodCode::Lean => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c.features = h.feature_mode != FeatureCode::Off;
@@ -1078,6 +1086,7 @@ mod tests {
             (MethodCode::VertexDecimation, 4, Entry::VertexDecimation),
             (MethodCode::Energy, 5, Entry::Energy),
             (MethodCode::Fast, 6, Entry::Fast),
+            (MethodCode::Lean, 7, Entry::Lean),
         ];
         for (method, code, entry) in cases {
             let mut h = case();
@@ -1098,7 +1107,7 @@ mod tests {
             assert_eq!(h.entry(), Entry::Bounded);
         }
         let mut b = case().to_bytes();
-        b[30] = 7;
+        b[30] = 8;
         assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
     }
 

@@ -5,7 +5,8 @@
 //! (`pipeline::FastWorkspace`, case method `Fast`) on both: its rows say "fast mode", with its
 //! emulated instructions per collapse, and its outputs must be byte-identical too (exit 1 if
 //! not). A board without the fast mode, or whose fast workspace the mesh does not fit, says so
-//! in its row instead.
+//! in its row instead. Then the same again with the lean mode (`pipeline::LeanWorkspace`, case
+//! method `Lean`): its rows say "lean mode".
 //!
 //! On a fresh machine it first makes sure the tools are there ([`qemu::preflight`]): a missing
 //! Rust target is installed with `rustup target add`; a missing `qemu-system-arm` is installed
@@ -24,6 +25,7 @@ use crate::backend::Backend;
 use crate::golden::case::MethodName;
 use crate::golden::{self, Case, Golden, Outcome, Verdict};
 use crate::qemu;
+use crate::simplify::Pipeline;
 
 /// `host-sim demo`.
 #[derive(Clone, Debug, clap::Args)]
@@ -175,30 +177,37 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     );
     let exact = compare(&case, backend, &host, &device)?;
     sha_row("output sha256", &exact);
-    // 4. The fast mode: the same mesh, target and board.
-    let fast_case = fast_case(&case);
-    let (fast_device, fast_run) =
-        qemu::run_case(board, &elf, &fast_case, Duration::from_secs(a.timeout))?;
-    if a.verbose {
-        crate::outln!("{}", fast_run.describe());
+    // 4. The fast mode, then the lean mode: the same mesh, target and board.
+    let mut modes = Vec::new();
+    for mode in [Pipeline::Fast, Pipeline::Lean] {
+        let mode_case = pipeline_case(&case, mode);
+        let (mode_device, mode_run) =
+            qemu::run_case(board, &elf, &mode_case, Duration::from_secs(a.timeout))?;
+        if a.verbose {
+            crate::outln!("{}", mode_run.describe());
+        }
+        let t0 = Instant::now();
+        let mode_host = golden::reference(&mode_case)?;
+        let mode_wall = t0.elapsed();
+        let c = pipeline_rows(
+            board,
+            backend,
+            &mode_case,
+            mode,
+            (&mode_host, mode_wall),
+            (mode_device.as_ref(), &mode_run),
+        )?;
+        modes.push((mode, c));
     }
-    let t0 = Instant::now();
-    let fast_host = golden::reference(&fast_case)?;
-    let fast_wall = t0.elapsed();
-    let fast = fast_rows(
-        board,
-        backend,
-        &fast_case,
-        (&fast_host, fast_wall),
-        (fast_device.as_ref(), &fast_run),
-    )?;
     crate::outln!();
     let ok = verdict("byte-identical", &exact);
-    let fast_ok = match &fast {
-        Some(f) => verdict("byte-identical, fast mode", f),
-        None => true,
-    };
-    Ok(if ok && fast_ok {
+    let mut modes_ok = true;
+    for (mode, c) in &modes {
+        if let Some(c) = c {
+            modes_ok &= verdict(&format!("byte-identical, {} mode", mode.name()), c);
+        }
+    }
+    Ok(if ok && modes_ok {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(1)
@@ -242,11 +251,15 @@ fn demo_case(a: &Args) -> Result<Case> {
     })
 }
 
-/// The fast mode's run of `case`: the same mesh, index type and configuration, method `Fast`.
-fn fast_case(case: &Case) -> Case {
+/// The run of `case` in the pipeline's `mode`: the same mesh, index type and configuration,
+/// method `Fast` or `Lean`.
+fn pipeline_case(case: &Case, mode: Pipeline) -> Case {
     Case {
-        name: format!("{}-fast", case.name),
-        method: Some(MethodName::Fast),
+        name: format!("{}-{}", case.name, mode.name()),
+        method: Some(match mode {
+            Pipeline::Fast => MethodName::Fast,
+            Pipeline::Lean => MethodName::Lean,
+        }),
         ..case.clone()
     }
 }
@@ -411,21 +424,24 @@ fn instructions_text(board: &qemu::Board, d: &meshfmt::ResultHeader) -> String {
     )
 }
 
-/// The fast mode's rows: the host's and the device's run of `case` (method `Fast`). Returns
-/// their comparison, or `None` when the device did not run it because the mesh does not fit
-/// its fast workspace or the board has none (the row says which).
-fn fast_rows(
+/// The rows of the fast or the lean mode (`mode`): the host's and the device's run of `case`
+/// (method `Fast` or `Lean`), each label ending in "fast mode" or "lean mode". Returns their
+/// comparison, or `None` when the device did not run it because the mesh does not fit the
+/// mode's workspace or the board has none (the row says which).
+fn pipeline_rows(
     board: &qemu::Board,
     backend: Backend,
     case: &Case,
+    mode: Pipeline,
     (host, host_wall): (&Outcome, Duration),
     (device, run): (Option<&Outcome>, &qemu::Run),
 ) -> Result<Option<Comparison>> {
     crate::outln!();
+    let name = mode.name();
     let h = &host.header;
     let Some(device) = device else {
         row(
-            "fast mode",
+            &format!("{name} mode"),
             status_text(h),
             format!("no result: {}", run.describe()),
         );
@@ -438,25 +454,37 @@ fn fast_rows(
     let d = &device.header;
     if d.status == Status::TooBig {
         let why = if d.capacity_vertices == 0 {
-            format!("{} has no fast mode", board.name)
+            format!("{} has no {name} mode", board.name)
         } else {
             format!(
-                "does not fit the fast workspace ({} V / {} T)",
+                "does not fit the {name} workspace ({} V / {} T)",
                 d.capacity_vertices, d.capacity_triangles
             )
         };
-        row("fast mode", status_text(h), why);
+        row(&format!("{name} mode"), status_text(h), why);
         return Ok(None);
     }
-    row("status, fast mode", status_text(h), status_text(d));
-    run_rows(", fast mode", board, (h, d), host_wall, run.wall);
     row(
-        "workspace RAM, fast mode",
+        &format!("status, {name} mode"),
+        status_text(h),
+        status_text(d),
+    );
+    run_rows(
+        &format!(", {name} mode"),
+        board,
+        (h, d),
+        host_wall,
+        run.wall,
+    );
+    row(
+        &format!("workspace RAM, {name} mode"),
         format!(
             "{} B (sized to the mesh)",
-            thousands(
-                crate::simplify::fast_bytes(case.positions.len(), case.triangles.len()) as u64
-            ),
+            thousands(crate::simplify::pipeline_bytes(
+                mode,
+                case.positions.len(),
+                case.triangles.len()
+            ) as u64),
         ),
         format!(
             "{} B ({} V / {} T capacity)",
@@ -466,7 +494,7 @@ fn fast_rows(
         ),
     );
     row(
-        "stack high-water, fast mode",
+        &format!("stack high-water, {name} mode"),
         "-".into(),
         format!(
             "{} B (library: {} B)",
@@ -475,7 +503,7 @@ fn fast_rows(
         ),
     );
     let c = compare(case, backend, host, device)?;
-    sha_row("output sha256, fast mode", &c);
+    sha_row(&format!("output sha256, {name} mode"), &c);
     Ok(Some(c))
 }
 
@@ -570,9 +598,10 @@ mod tests {
     }
 
     /// The demo's fast run is a case of method `Fast` (code 6 in the case file) whose host
-    /// reference is the library's fast mode; its instructions row divides by its collapses.
+    /// reference is the library's fast mode, its lean run one of method `Lean` (code 7) with
+    /// the lean mode; the instructions row divides by the collapses.
     #[test]
-    fn the_fast_run_is_the_fast_mode() {
+    fn the_fast_and_lean_runs_are_those_modes() {
         let m = meshfmt::golden::bumpy_grid(10);
         let case = Case {
             name: "g".into(),
@@ -584,7 +613,7 @@ mod tests {
             stored: None,
             method: None,
         };
-        let fast = fast_case(&case);
+        let fast = pipeline_case(&case, Pipeline::Fast);
         assert_eq!(fast.header().method, meshfmt::MethodCode::Fast);
         assert_eq!(fast.encode().unwrap()[30], 6);
         assert_eq!(fast.positions, case.positions);
@@ -592,6 +621,17 @@ mod tests {
         let host = golden::reference(&fast).unwrap();
         let mut t = case.triangles.clone();
         let r = crate::simplify::fast_workspace_run(&case.positions, &mut t, &case.config).unwrap();
+        t.truncate(r.triangles_out);
+        assert_eq!(host.triangles, t);
+        assert_eq!(host.header.collapses as usize, r.collapses);
+        // The lean run likewise: method `Lean` (code 7), the library's lean mode.
+        let lean = pipeline_case(&case, Pipeline::Lean);
+        assert_eq!(lean.header().method, meshfmt::MethodCode::Lean);
+        assert_eq!(lean.encode().unwrap()[30], 7);
+        assert_eq!(lean.name, "g-lean");
+        let host = golden::reference(&lean).unwrap();
+        let mut t = case.triangles.clone();
+        let r = crate::simplify::lean_workspace_run(&case.positions, &mut t, &case.config).unwrap();
         t.truncate(r.triangles_out);
         assert_eq!(host.triangles, t);
         assert_eq!(host.header.collapses as usize, r.collapses);

@@ -52,6 +52,21 @@ pub enum EngineArg {
     /// output valid. Positions only: seams welded by position (the output keeps the welded
     /// numbering), no parts pruned; of the options it takes the target and --error-limit.
     Fast,
+    /// The lean mode (`tinydecimate::pipeline::LeanWorkspace`): the fast mode's pipeline
+    /// without stored quadrics (each built from its vertex's fan whenever a pass reads it),
+    /// for about half the RAM; the same options as `fast`.
+    Lean,
+}
+
+impl EngineArg {
+    /// The library's pipeline mode of `fast` and `lean`; `None` for the exact engine.
+    pub fn pipeline(self) -> Option<crate::simplify::Pipeline> {
+        match self {
+            EngineArg::Exact => None,
+            EngineArg::Fast => Some(crate::simplify::Pipeline::Fast),
+            EngineArg::Lean => Some(crate::simplify::Pipeline::Lean),
+        }
+    }
 }
 
 /// Which cost, on the command line (`Config::with_cost`).
@@ -423,7 +438,8 @@ pub struct Args {
     /// --max-error for one).
     #[arg(long, value_parser = parse_error_limit)]
     pub error_limit: Option<ErrorLimit>,
-    /// Engine: `fast` is meshoptimizer's pipeline (positions only; target and --error-limit).
+    /// Engine: `fast` is meshoptimizer's pipeline (positions only; target and --error-limit),
+    /// `lean` the same without stored quadrics.
     #[arg(long, value_enum, default_value_t = EngineArg::Exact)]
     pub engine: EngineArg,
     /// Collapse schedule.
@@ -639,9 +655,12 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
             args.input.display()
         );
     }
-    let fast = args.engine == EngineArg::Fast;
-    if fast && args.schedule != ScheduleArg::Greedy {
-        bail!("--engine fast has its own passes: drop --schedule");
+    let pipeline = args.engine.pipeline();
+    if let Some(mode) = pipeline.filter(|_| args.schedule != ScheduleArg::Greedy) {
+        bail!(
+            "--engine {} has its own passes: drop --schedule",
+            mode.name()
+        );
     }
     let stored = args.quadric == QuadricArg::Stored;
     // Optimal placement moves vertices: only their numbering says which input vertex each
@@ -668,7 +687,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         lock_seam_corners: false,
         prune: args.parts == PartsArg::Prune,
         energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
-        fast,
+        pipeline,
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
@@ -727,6 +746,12 @@ fn run_text(args: &Args, run: &Run) -> String {
             "  engine                 fast (meshoptimizer's pipeline: stored quadrics, sorted \
              passes, subset placement)"
         );
+    } else if args.engine == EngineArg::Lean {
+        let _ = writeln!(
+            text,
+            "  engine                 lean (meshoptimizer's pipeline: quadrics from each \
+             vertex's fan, sorted passes, subset placement)"
+        );
     } else if *stored {
         let _ = writeln!(
             text,
@@ -775,14 +800,18 @@ fn run_text(args: &Args, run: &Run) -> String {
     );
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let per_tri = |b: usize| b as f64 / t.max(1) as f64;
-    if args.engine == EngineArg::Fast {
-        let need = crate::simplify::fast_bytes(v, t);
-        let _ =
-            writeln!(
+    if let Some(mode) = args.engine.pipeline() {
+        let need = crate::simplify::pipeline_bytes(mode, v, t);
+        let _ = writeln!(
             text,
-            "  workspace (right-size) {need} bytes: FastWorkspace for V = {v}, T = {t} with {} \
-             links ({:.2} bytes per input triangle)",
-            if v < 65_535 && t < 65_535 { "u16" } else { "u32" },
+            "  workspace (right-size) {need} bytes: {} for V = {v}, T = {t} with {} links \
+             ({:.2} bytes per input triangle)",
+            mode.workspace(),
+            if v < 65_535 && t < 65_535 {
+                "u16"
+            } else {
+                "u32"
+            },
             per_tri(need)
         );
         return text;
@@ -867,10 +896,9 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "report": report_json(&run.report),
         "advice": advice_for(args, &run.report).map(|(_, a)| a),
         "library_ms": run.elapsed.as_secs_f64() * 1e3,
-        "workspace_bytes": if args.engine == EngineArg::Fast {
-            crate::simplify::fast_bytes(v, t)
-        } else {
-            workspace_bytes(v, t).0
+        "workspace_bytes": match args.engine.pipeline() {
+            Some(mode) => crate::simplify::pipeline_bytes(mode, v, t),
+            None => workspace_bytes(v, t).0,
         },
     })
 }

@@ -74,6 +74,9 @@ pub enum MethodName {
     /// The fast mode (`pipeline::FastWorkspace::simplify`): meshoptimizer's pipeline, its own
     /// quadrics and workspace.
     Fast,
+    /// The lean mode (`pipeline::LeanWorkspace::simplify`): the fast mode's pipeline without
+    /// stored quadrics, its own workspace.
+    Lean,
 }
 
 impl MethodName {
@@ -83,6 +86,7 @@ impl MethodName {
             MethodName::VertexDecimation => MethodCode::VertexDecimation,
             MethodName::Energy => MethodCode::Energy,
             MethodName::Fast => MethodCode::Fast,
+            MethodName::Lean => MethodCode::Lean,
         }
     }
 }
@@ -139,7 +143,8 @@ pub struct CaseSpec {
     #[serde(default)]
     pub quadric: Option<QuadricName>,
     /// Optional: `vertex-decimation` (the operator `VertexDecimation`), `energy` (the cost
-    /// `cost::Energy`) or `fast` (the fast mode, `pipeline::FastWorkspace`); none with
+    /// `cost::Energy`), `fast` (the fast mode, `pipeline::FastWorkspace`) or `lean` (the lean
+    /// mode, `pipeline::LeanWorkspace`); none with
     /// `quadric` or `max_error`.
     #[serde(default)]
     pub method: Option<MethodName>,
@@ -504,5 +509,6 @@ fn run_reference<I: tinydecimate::Index>(
             )?
             .run(),
         Entry::Fast => crate::simplify::fast_workspace_run(positions, triangles, config)?,
+        Entry::Lean => crate::simplify::lean_workspace_run(positions, triangles, config)?,
     })
 }

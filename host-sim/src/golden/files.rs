@@ -145,6 +145,9 @@ impl Golden {
             Some(super::case::MethodName::Fast) => {
                 writeln!(w, "method = \"the fast mode (pipeline::FastWorkspace)\"")?
             }
+            Some(super::case::MethodName::Lean) => {
+                writeln!(w, "method = \"the lean mode (pipeline::LeanWorkspace)\"")?
+            }
             None => {}
         }
         if case.config.max_error.is_finite() {
@@ -315,6 +318,8 @@ pub fn judge(
                 " (vertex decimation: the firmware's VERTEX_DECIMATION, stack for a removal's buffers)"
             } else if case.method == Some(super::case::MethodName::Fast) {
                 " (the fast mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
+            } else if case.method == Some(super::case::MethodName::Lean) {
+                " (the lean mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
             } else if case.config.max_error.is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {

@@ -6,7 +6,8 @@
 //! resulting triangle count to `black_box`, as firmware would use it. Without it, `main` touches
 //! the same statics and nothing else, so (image with) - (image without) is the library.
 //! `paper`, `u32-triangles` and `u32-links` change or add instantiations, `fast` calls the fast
-//! mode (`pipeline::FastWorkspace<u16, 512, 1024>`) instead (see Cargo.toml).
+//! mode (`pipeline::FastWorkspace<u16, 512, 1024>`) instead, `lean` the lean mode
+//! (`pipeline::LeanWorkspace<u16, 512, 1024>`) (see Cargo.toml).
 //!
 //! Never run, only linked and measured: `scripts/flash.sh` (and `host-sim qemu --measure`).
 #![no_std]
@@ -117,11 +118,15 @@ fn run(
     #[cfg(feature = "call")]
     {
         // What firmware does with the result: use the triangle count, or the error.
-        #[cfg(not(feature = "fast"))]
+        #[cfg(not(any(feature = "fast", feature = "lean")))]
         let result = ws.simplify(&POSITIONS, &mut *tris, &CONFIG);
         // The fast mode's workspace instead (on the stack: this firmware is only linked).
         #[cfg(feature = "fast")]
         let result = black_box(tinydecimate::pipeline::FastWorkspace::<u16, 512, 1024>::new())
+            .simplify(&POSITIONS, &mut *tris, &CONFIG);
+        // The lean mode's workspace instead (likewise).
+        #[cfg(all(feature = "lean", not(feature = "fast")))]
+        let result = black_box(tinydecimate::pipeline::LeanWorkspace::<u16, 512, 1024>::new())
             .simplify(&POSITIONS, &mut *tris, &CONFIG);
         let n = match result {
             Ok(report) => report.triangles_out,

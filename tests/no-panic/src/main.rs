@@ -823,6 +823,23 @@ fn run_fast<L: Index, I: Index, const V: usize, const T: usize>() {
     black_box(&tris);
 }
 
+/// The lean mode (`pipeline::LeanWorkspace`): its one entry point on opaque input.
+fn run_lean<L: Index, I: Index, const V: usize, const T: usize>() {
+    let mut ws = black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T>::new());
+    black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T>::BYTES);
+    let positions: [[f32; 3]; V] = black_box([[opaque_f32(5); 3]; V]);
+    let mut tris: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let (np, nt) = (input(3) as usize, input(4) as usize);
+    let (Some(p), Some(t)) = (positions.get(..np), tris.get_mut(..nt)) else {
+        return;
+    };
+    match ws.simplify(p, t, &opaque_config()) {
+        Ok(r) => use_report(&r),
+        Err(e) => display(&e),
+    }
+    black_box(&tris);
+}
+
 #[entry]
 fn main() -> ! {
     #[cfg(feature = "selftest")]
@@ -837,6 +854,8 @@ fn main() -> ! {
     run_cluster::<u32, u32, 64>();
     run_fast::<u16, u16, 96, 160>();
     run_fast::<u32, u32, 96, 160>();
+    run_lean::<u16, u16, 96, 160>();
+    run_lean::<u32, u32, 96, 160>();
     loop {
         black_box(());
     }

@@ -32,10 +32,11 @@ fn run_library(
     args: &Args,
     attributes: Option<&crate::simplify::Attributes>,
 ) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
-    if args.engine == super::EngineArg::Fast {
+    if let Some(mode) = args.engine.pipeline() {
         bail!(
-            "--engine fast takes positions only: it would weld the seams of these attributes \
-             away; use the default engine for glTF and OBJ with vt or vn"
+            "--engine {} takes positions only: it would weld the seams of these attributes \
+             away; use the default engine for glTF and OBJ with vt or vn",
+            mode.name()
         );
     }
     let stored = args.quadric == QuadricArg::Stored;
