@@ -7,10 +7,10 @@
 //! | lean | [`LeanWorkspace`] | neither: both found from the vertex's fan whenever read | 11.5 |
 //!
 //! The lean mode walks a vertex's fan for its quadric each time a pass prices it (and for a
-//! border vertex's open edges), where the fast mode reads an array: more instructions for less
-//! than half the RAM. Both price with the same planes and apply the same rules; only the order
-//! of each quadric's sum differs (triangle order against fan order), so a price may differ in
-//! its last bits and the outputs with it.
+//! border vertex's open edges), where the fast mode reads an array: it trades instructions for
+//! RAM (both modes' figures: docs/speed.md#lean-mode). Both price with the same planes and
+//! apply the same rules; only the order of each quadric's sum differs (triangle order
+//! against fan order), so a price may differ in its last bits and the outputs with it.
 //!
 //! The pipeline follows `meshopt_simplifyEdge` of Arseny Kapoulkine's meshoptimizer
 //! (`src/simplifier.cpp`): passes that price every candidate once from per-vertex plane
