@@ -2,8 +2,10 @@
 //!
 //! A candidate is skipped when either end is already an end of a collapse in this pass (so a
 //! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
-//! at its goal or at its error goal: the cost of the candidate that would reach the
-//! goal, once a sixth of the goal is done. A candidate whose triangles a collapse of the pass
+//! at its goal or at its error goal: a factor of the cost of the candidate that would reach
+//! the goal ([`ERROR_GOAL`], [`TAIL_GOAL`] in a run's tail), once a sixth of the goal is done.
+//! A candidate over the error goal is skipped, and the pass ends at the first whose sort key
+//! is over the error goal's (the counting sort orders a bin by vertex, not by price). A candidate whose triangles a collapse of the pass
 //! changed is priced again from its fan as it is then (the batched schedule prices a popped
 //! vertex again for the same reason) and left to the next pass if that price is over the error
 //! goal. A refused candidate is followed at once by a's next cheapest target, if it is within
@@ -29,6 +31,7 @@
 //! degenerate: compact drops them) and locks both ends.
 
 use super::fill::{vertex_quadric, Price, Quadrics};
+use super::sort::key;
 use super::{
     dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
 };
@@ -45,9 +48,15 @@ const FLAT: f32 = 1e-8;
 /// The pass's error goal over the price of the candidate that would reach its goal.
 /// meshoptimizer takes 1.5 with its accumulated quadrics; with quadrics filled afresh each pass
 /// (a price that only sees the current triangles) a pass that runs past that price collapses
-/// vertices whose neighbours, locked by this pass, would have been cheaper: 1.0, as the
-/// batched schedule's `PASS_LIMIT` for the memoryless cost.
-const ERROR_GOAL: f32 = 1.0;
+/// vertices whose neighbours, locked by this pass, would have been cheaper: below 1, so that
+/// more, shorter passes price from fresher triangles.
+const ERROR_GOAL: f32 = 0.9;
+/// The error goal's factor in the tail of a run, a pass whose goal is under `1 / TAIL_SHARE` of
+/// its candidates: there the cheap candidates left are mostly refused, pass after pass, and a
+/// goal below 1 ends each pass after a collapse or two (a pass costs a sweep of the mesh).
+const TAIL_GOAL: f32 = 1.5;
+/// See [`TAIL_GOAL`].
+const TAIL_SHARE: usize = 8;
 /// meshoptimizer's flip limit, `cos ≈ 0.25` (about 75°), squared.
 const FLIP2: f32 = 0.0625;
 /// The checker's fold limit, `-0.9`, squared.
@@ -171,6 +180,11 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
 ) -> usize {
     let m = order.len();
     let cost_of = |v: usize| cost.get(v).copied().unwrap_or(f32::INFINITY);
+    let factor = if goal * TAIL_SHARE < m {
+        TAIL_GOAL
+    } else {
+        ERROR_GOAL
+    };
     let mut edge_goal = goal / 2;
     let (mut removed, mut done, mut worst) = (0usize, 0usize, 0.0f32);
     for i in 0..m {
@@ -180,12 +194,17 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
         let a = link(order, i);
         let c = cost_of(a);
         let error_goal = if edge_goal < m {
-            ERROR_GOAL * cost_of(link(order, edge_goal))
+            factor * cost_of(link(order, edge_goal))
         } else {
             f32::INFINITY
         };
         if c > error_goal && c > worst && removed > goal / 6 {
-            break;
+            // Sorted by key: within a bin the order is by vertex, not by price, so a dearer
+            // candidate ends the pass only once the bins are past the goal's.
+            if key(c) > key(error_goal) {
+                break;
+            }
+            continue;
         }
         let b = link(target, a);
         if (flags_of(flags, a) | flags_of(flags, b)) & flag::PASS != 0 {
