@@ -27,17 +27,25 @@ fn add_to(q: &mut [PointQuadric], v: usize, x: &PointQuadric) {
     }
 }
 
-/// The plane quadric of triangle `p`, weighted by its area times `w`, zero without area. With
-/// `c` the cross product of two edges, `area · n nᵀ = c cᵀ / (2|c|)`: one reciprocal square
-/// root, no normalisation.
+/// The plane quadric of triangle `p`, weighted by its area times `w`, zero without area, and
+/// that area (as [`area`] sums it). With `c` the cross product of two edges,
+/// `area · n nᵀ = c cᵀ / (2|c|)`: one reciprocal square root, no normalisation.
 #[inline]
-fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
+fn plane(p: [V3; 3], w: f32) -> (PointQuadric, f32) {
     let c = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
     let l2 = math::dot(c, c);
     if !(l2 > math::TINY2 && l2.is_finite()) {
-        return [0.0; 6];
+        return ([0.0; 6], 0.0);
     }
-    point_plane(c, 0.5 * math::rsqrt(l2) * w)
+    let r = math::rsqrt(l2);
+    // `math::sqrt(l2)` is `l2 · rsqrt(l2)`.
+    (point_plane(c, 0.5 * r * w), 0.5 * (l2 * r))
+}
+
+/// The plane quadric of triangle `p`, weighted by its area times `w` ([`plane`]).
+#[inline]
+fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
+    plane(p, w).0
 }
 
 /// The area of the first `triangles` (unit frame).
@@ -101,7 +109,8 @@ fn due(flags: &[u8], v: usize, all: bool) -> bool {
     all || flags_of(flags, v) & flag::DIRTY != 0
 }
 
-/// Zeroes the due quadrics and adds every triangle's plane at its due vertices.
+/// Zeroes the due quadrics and adds every triangle's plane at its due vertices; returns the
+/// area of the triangles it took (all of them with `all`, summed as [`area`] sums it).
 #[inline(never)]
 pub(super) fn face_quadrics<I: Index>(
     frame: &Frame<'_>,
@@ -109,25 +118,28 @@ pub(super) fn face_quadrics<I: Index>(
     flags: &[u8],
     quadrics: &mut [PointQuadric],
     all: bool,
-) {
+) -> f32 {
     for (v, q) in quadrics.iter_mut().enumerate() {
         if due(flags, v, all) {
             *q = [0.0; 6];
         }
     }
+    let mut sum = 0.0;
     for t in 0..triangles.len() {
         let tr = tri(triangles, t);
         let d = tr.map(|v| due(flags, v, all));
         if !(d[0] || d[1] || d[2]) {
             continue;
         }
-        let q = triangle(tr.map(|v| frame.at(v)), 1.0);
+        let (q, area) = plane(tr.map(|v| frame.at(v)), 1.0);
+        sum += area;
         for (v, d) in tr.into_iter().zip(d) {
             if d {
                 add_to(quadrics, v, &q);
             }
         }
     }
+    sum
 }
 
 /// The quadric of open edge `p0 → p1` of triangle `(p0, p1, p2)`: the plane through the edge
@@ -154,20 +166,22 @@ fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
     Some(q)
 }
 
-/// `v`'s quadric from its fan as it is now (the lean mode's, which stores none): the same
-/// planes as [`face_quadrics`] and [`border_quadrics`] give it, summed in fan order.
+/// `v`'s quadric from its fan as it is now (the lean mode's, which stores none; the fast
+/// mode's for a vertex whose fan changed in the pass): the same planes as [`face_quadrics`]
+/// and [`border_quadrics`] give it, summed in fan order, with `quadrics`' open edges.
 #[inline]
-pub(super) fn vertex_quadric<I: Index, L: Index>(
+pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
-    flags: &[u8],
+    (flags, border_next): (&[u8], &[L]),
+    quadrics: &Q,
     v: usize,
 ) -> PointQuadric {
     let mut q = [0.0; 6];
     let border = flags_of(flags, v) & flag::KIND == flag::BORDER;
     let next = if border {
-        open_out(triangles, adj, flags, v)
+        quadrics.next(triangles, adj, flags, border_next, v)
     } else {
         NONE
     };
@@ -178,29 +192,50 @@ pub(super) fn vertex_quadric<I: Index, L: Index>(
         }
         let (x, y) = others(tr, k);
         let (px, py) = (frame.at(x), frame.at(y));
-        let mut add = |x: &PointQuadric| {
-            for (s, y) in q.iter_mut().zip(x) {
-                *s += y;
-            }
-        };
-        add(&triangle([pv, px, py], 1.0));
+        for (s, t) in q.iter_mut().zip(&triangle([pv, px, py], 1.0)) {
+            *s += t;
+        }
         if border {
-            // v's open out-edge v → x, and its open in-edge y → v.
-            if x == next {
-                if let Some(e) = edge_quadric(pv, px, py) {
-                    add(&e);
-                }
-            }
-            if flags_of(flags, y) & flag::KIND == flag::BORDER
-                && opens_into(triangles, adj, flags, y, v)
-            {
-                if let Some(e) = edge_quadric(py, pv, px) {
-                    add(&e);
-                }
-            }
+            border_planes(
+                (triangles, adj, flags, border_next),
+                quadrics,
+                (v, x, y, next),
+                [pv, px, py],
+                &mut q,
+            );
         }
     }
     q
+}
+
+/// The border edge planes [`vertex_quadric`] adds at border vertex `v` for its live triangle
+/// `(v, x, y)` (positions `p`), in that order: those of `v → x` if it is v's open out-edge
+/// (`x` is `next`), and of `y → v` if that is an open edge. Not inlined: a border vertex's
+/// case, rare, kept out of the fan loop and to one copy in flash.
+#[inline(never)]
+#[allow(clippy::type_complexity)]
+fn border_planes<I: Index, L: Index, Q: Quadrics>(
+    (triangles, adj, flags, border_next): (&[[I; 3]], (&[L], &[L]), &[u8], &[L]),
+    quadrics: &Q,
+    (v, x, y, next): (usize, usize, usize, usize),
+    [pv, px, py]: [V3; 3],
+    q: &mut PointQuadric,
+) {
+    let mut add = |x: &PointQuadric| {
+        for (s, y) in q.iter_mut().zip(x) {
+            *s += y;
+        }
+    };
+    if x == next {
+        if let Some(e) = edge_quadric(pv, px, py) {
+            add(&e);
+        }
+    }
+    if quadrics.enters(triangles, adj, flags, border_next, y, v) {
+        if let Some(e) = edge_quadric(py, pv, px) {
+            add(&e);
+        }
+    }
 }
 
 /// The vertex across `v`'s open out-edge, from `v`'s fan alone (the lean mode stores no border
@@ -309,6 +344,7 @@ pub(crate) trait Quadrics {
     ) -> bool;
 
     /// Before a pass: the stored quadrics of every vertex (`all`) or of the dirty ones.
+    /// Returns the triangles' area if it summed it on the way (the fast mode, with `all`).
     fn fill<I: Index, L: Index>(
         &mut self,
         frame: &Frame<'_>,
@@ -317,7 +353,7 @@ pub(crate) trait Quadrics {
         flags: &mut [u8],
         border_next: &[L],
         all: bool,
-    );
+    ) -> Option<f32>;
 
     /// `v`'s quadric in this pass.
     fn of<I: Index, L: Index>(
@@ -371,9 +407,10 @@ impl Quadrics for Stored<'_> {
         flags: &mut [u8],
         border_next: &[L],
         all: bool,
-    ) {
-        face_quadrics(frame, triangles, flags, self.0, all);
+    ) -> Option<f32> {
+        let area = face_quadrics(frame, triangles, flags, self.0, all);
         border_quadrics(frame, triangles, adj, flags, border_next, self.0, all);
+        all.then_some(area)
     }
 
     #[inline(always)]
@@ -430,11 +467,12 @@ impl Quadrics for Fans {
         flags: &mut [u8],
         _: &[L],
         _: bool,
-    ) {
+    ) -> Option<f32> {
         // Nothing is stored; the dirty bits say, in the pass, which fans a collapse changed.
         for f in flags.iter_mut() {
             *f &= !flag::DIRTY;
         }
+        None
     }
 
     #[inline(always)]
@@ -447,6 +485,6 @@ impl Quadrics for Fans {
         _: &[L],
         v: usize,
     ) -> PointQuadric {
-        vertex_quadric(frame, triangles, adj, flags, v)
+        vertex_quadric(frame, triangles, adj, (flags, &[]), self, v)
     }
 }

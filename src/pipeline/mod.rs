@@ -573,14 +573,14 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             break Stop::MaxPasses;
         }
         let tris = triangles.get(..nt).unwrap_or(&[]);
+        let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
+        let summed = quadrics.fill(&frame, tris, adj, flags, border_next, passes == 0);
         if passes == 0 {
-            area = fill::area(&frame, tris);
+            area = summed.unwrap_or_else(|| fill::area(&frame, tris));
         }
         let price = fill::Price {
             mean_area: area / nt as f32,
         };
-        let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
-        quadrics.fill(&frame, tris, adj, flags, border_next, passes == 0);
         pick::pick(
             &frame,
             tris,

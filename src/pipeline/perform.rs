@@ -214,7 +214,7 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
         // from its fan as it is now (as the batched schedule prices a popped vertex again),
         // and left to the next pass if that is over the pass's error goal.
         let (c, fresh) = if flags_of(flags, a) & flag::DIRTY != 0 {
-            let q = vertex_quadric(frame, &*tris, adj, &*flags, a);
+            let q = vertex_quadric(frame, &*tris, adj, (&*flags, &*border_next), quadrics, a);
             let c = price.of(&q, math::sub(frame.at(b), frame.at(a)));
             if c > error_goal.max(cost_of(a)) {
                 continue;
