@@ -20,8 +20,9 @@
 //! collapse in that order while locking both ends of each collapse for the rest of the pass;
 //! a pass ends at its error goal (a factor of the cost of the collapse that would reach the
 //! pass's goal, which is half the live triangles at most), the triangle buffer is compacted,
-//! and the next pass runs on the smaller mesh. Placement is the subset one of Lin 2007 §2 (a vertex collapses onto an
-//! existing vertex), so the positions are only read and may stay in flash.
+//! and the next pass runs on the smaller mesh. Placement is the subset one of Lin 2007 §2 (a
+//! vertex collapses onto an existing vertex), so the positions are only read and may stay in
+//! flash.
 //!
 //! ```text
 //! build     validate, drop degenerate triangles, fan lists

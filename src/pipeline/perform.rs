@@ -5,12 +5,12 @@
 //! at its goal or at its error goal: a factor of the cost of the candidate that would reach
 //! the goal ([`ERROR_GOAL`], [`TAIL_GOAL`] in a run's tail), once a sixth of the goal is done.
 //! A candidate over the error goal is skipped, and the pass ends at the first whose sort key
-//! is over the error goal's (the counting sort orders a bin by vertex, not by price). A candidate whose triangles a collapse of the pass
-//! changed is priced again from its fan as it is then (the batched schedule prices a popped
-//! vertex again for the same reason) and left to the next pass if that price is over the error
-//! goal. A refused candidate is followed at once by a's next cheapest target, if it is within
-//! the error goal. Each candidate is checked on the
-//! current mesh, the rules in order of cost, each where it can fire:
+//! is over the error goal's (the counting sort orders a bin by vertex, not by price). A
+//! candidate whose triangles a collapse of the pass changed is priced again from its fan as it
+//! is then (the batched schedule prices a popped vertex again for the same reason) and left to
+//! the next pass if that price is over the error goal. A refused candidate is followed at once
+//! by a's next cheapest target, if it is within the error goal. Each candidate is checked on
+//! the current mesh, the rules in order of cost, each where it can fire:
 //!
 //! 1. the edge: two triangles on a-b (one for a border vertex: its border edge);
 //! 2. meshoptimizer's flip test (`hasTriangleFlip`) on each surviving triangle of a's fan:
