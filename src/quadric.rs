@@ -68,6 +68,14 @@ pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
     ]
 }
 
+/// Adds `x` to `q`, term by term.
+#[inline]
+pub(crate) fn point_add(q: &mut PointQuadric, x: &PointQuadric) {
+    for (s, y) in q.iter_mut().zip(x) {
+        *s += y;
+    }
+}
+
 /// `dᵀ A d`, clamped at zero: the weighted sum of squared distances from `d` to the planes.
 #[inline]
 pub(crate) fn point_error(q: &PointQuadric, d: V3) -> f32 {

@@ -13,7 +13,7 @@
 use super::{fan, flag, flags_of, link, others, tri, Frame, NONE};
 use crate::index::Index;
 use crate::math::{self, V3};
-use crate::quadric::{point_error, point_plane, point_weight, PointQuadric};
+use crate::quadric::{point_add, point_error, point_plane, point_weight, PointQuadric};
 
 /// meshoptimizer's `kEdgeWeightBorder`.
 const BORDER_WEIGHT: f32 = 10.0;
@@ -21,9 +21,7 @@ const BORDER_WEIGHT: f32 = 10.0;
 #[inline]
 fn add_to(q: &mut [PointQuadric], v: usize, x: &PointQuadric) {
     if let Some(q) = q.get_mut(v) {
-        for (s, y) in q.iter_mut().zip(x) {
-            *s += y;
-        }
+        point_add(q, x);
     }
 }
 
@@ -160,9 +158,7 @@ fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
     let n = math::scale(perp, math::rsqrt(pl2));
     let face = triangle([p0, p1, p2], BORDER_WEIGHT);
     let mut q = point_plane(n, math::sqrt(l2) * BORDER_WEIGHT);
-    for (s, y) in q.iter_mut().zip(&face) {
-        *s += y;
-    }
+    point_add(&mut q, &face);
     Some(q)
 }
 
@@ -192,9 +188,7 @@ pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics>(
         }
         let (x, y) = others(tr, k);
         let (px, py) = (frame.at(x), frame.at(y));
-        for (s, t) in q.iter_mut().zip(&triangle([pv, px, py], 1.0)) {
-            *s += t;
-        }
+        point_add(&mut q, &triangle([pv, px, py], 1.0));
         if border {
             border_planes(
                 (triangles, adj, flags, border_next),
@@ -221,19 +215,14 @@ fn border_planes<I: Index, L: Index, Q: Quadrics>(
     [pv, px, py]: [V3; 3],
     q: &mut PointQuadric,
 ) {
-    let mut add = |x: &PointQuadric| {
-        for (s, y) in q.iter_mut().zip(x) {
-            *s += y;
-        }
-    };
     if x == next {
         if let Some(e) = edge_quadric(pv, px, py) {
-            add(&e);
+            point_add(q, &e);
         }
     }
     if quadrics.enters(triangles, adj, flags, border_next, y, v) {
         if let Some(e) = edge_quadric(py, pv, px) {
-            add(&e);
+            point_add(q, &e);
         }
     }
 }
