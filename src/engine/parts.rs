@@ -5,7 +5,7 @@
 //! its last few triangles however far the rest goes: a screw's four faces cost as much of the
 //! triangle budget as four faces of the body. This is meshoptimizer's `meshopt_SimplifyPrune`
 //! (`simplifier.cpp`: `buildComponents`, `measureComponents`, `pruneComponents`): components
-//! by union-find over the triangles, each measured once by its squared radius about its
+//! by union-find over the triangles, each sized once by its squared radius about its
 //! centroid, and removed in order of size while they are below the current error; then, short
 //! of the target with no collapse left, the smallest ones up to the error limit
 //! ([`Config::max_cost`](crate::Config::max_cost) here). Two differences: a part's size is in
