@@ -68,6 +68,7 @@ pub(crate) fn point_plane(n: V3, w: f32) -> PointQuadric {
     ]
 }
 
+#[cfg(feature = "fast")]
 /// Adds `x` to `q`, term by term.
 #[inline]
 pub(crate) fn point_add(q: &mut PointQuadric, x: &PointQuadric) {
