@@ -5,8 +5,10 @@
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Schedule {
     /// Always collapse the cheapest legal edge of the whole mesh (indexed priority queue).
-    /// The priority is the paper's normal variation W scaled by the squared edge length, so
-    /// that it measures how far the surface moves, not only how far normals turn.
+    /// The priority is the configured cost ([`Config::cost`]): the memoryless quadric by
+    /// default, or the paper's normal variation W scaled by the squared edge length
+    /// ([`CostKind::NormalVariation`]), so that it measures how far the surface moves, not
+    /// only how far normals turn.
     Greedy,
     /// The paper's own schedule (Lin 2007, Algorithms 3-4): each pass recomputes feature
     /// flags, sweeps vertices in index order and pairs each unprocessed non-feature vertex with
@@ -14,9 +16,9 @@ pub enum Schedule {
     Passes,
     /// Greedy in batches (meshoptimizer's pass structure): each pass prices every vertex's
     /// cheapest candidate once, orders them by price and collapses them in that order, skipping
-    /// a vertex whose price a collapse earlier in the pass made stale; a pass ends at its error
-    /// limit (1.5 times the price of the candidate that would reach the target) and the next
-    /// pass prices afresh. Same rules, limits and stops as [`Schedule::Greedy`], with no
+    /// a vertex whose price a collapse earlier in the pass made stale; a pass aims at half the
+    /// live triangles at most, ends at its error limit (the price of the candidate that would
+    /// reach that goal) and the next pass prices afresh. Same rules, limits and stops as [`Schedule::Greedy`], with no
     /// re-pricing after each collapse; the order is exact within a pass only. Needs the crate
     /// feature `batched` (else [`Storage::start`](crate::Storage::start) refuses it).
     Batched,

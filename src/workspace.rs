@@ -275,8 +275,8 @@ impl<'a, L: Index> Storage<'a, L> {
 ///   reserved as "none").
 /// * `MAX_VERTICES`, `MAX_TRIANGLES`: the largest mesh it takes.
 ///
-/// Its size is [`Workspace::BYTES`]: per vertex two links of adjacency and queue position, a
-/// heap slot, a 4-byte key and a flag byte; per triangle three corner links. With `u16` links
+/// Its size is [`Workspace::BYTES`]: per vertex three links (corner-list head, heap slot, heap
+/// position), a 4-byte key and a flag byte; per triangle three corner links. With `u16` links
 /// and the usual `V ≈ T/2` that is 11.5 bytes per triangle. [`Workspace::new`] is a `const fn`,
 /// so a workspace can be a `static` in `.bss` instead of living on the stack.
 ///

@@ -1,11 +1,10 @@
 //! `host-sim bench`: every tinydecimate mode against meshoptimizer on a directory of meshes, in
 //! one process and one run, written as Markdown and JSON.
 //!
-//! For every mesh and ratio `r` four simplifiers run on the same input ([`Method`]):
+//! For every mesh and ratio `r` every simplifier of [`Method`] (or those `--modes` names) runs
+//! on the same input: our modes as `host-sim simplify` runs them (each variant's `Method` docs
+//! give its configuration), and the reference:
 //!
-//! * **default**: `Config::new().with_ratio(r)` (greedy schedule, `CostKind::Quadric`);
-//! * **greedy W**: `Config::new().with_cost(CostKind::NormalVariation).with_ratio(r)`;
-//! * **paper**: `Config::paper().with_ratio(r)` (the paper's passes, normal variation W);
 //! * **meshopt**: `meshopt::simplify` (meshoptimizer [`MESHOPTIMIZER_VERSION`], bundled by the
 //!   `meshopt` crate [`MESHOPT_CRATE_VERSION`]) with a target index count of
 //!   `3·⌊r·T⌋` (the library's own rounding of the ratio), target error 1.0 (100 % of the mesh
