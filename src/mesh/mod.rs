@@ -201,8 +201,8 @@ impl<'a, L: Index, I: Index> Mesh<'a, L, I> {
     }
 
     /// The corner of `v` in triangle `t`, or `NIL` if `t` does not hold `v`. Three plain
-    /// comparisons: inlined into every list walk, `position` over the triple took 0.8-1.2 KB
-    /// more flash (scripts/flash.sh).
+    /// comparisons, not `position` over the triple: this is inlined into every list walk, and
+    /// the iterator's code there costs flash (scripts/flash.sh).
     #[inline]
     fn corner_of(&self, t: usize, v: usize) -> usize {
         let [x, y, z] = self.tri(t);

@@ -60,8 +60,8 @@ const COS_HARD: f32 = 0.5;
 /// the ends of feature spokes (a dart or a soft corner moves along one of its feature lines; an
 /// interior-edge vertex along its line), and only a vertex with more than two spokes sharper
 /// than 60° is a corner that never goes. Schroeder's distance orders by shape alone and the
-/// loop splitting fills for shape alone, so error piles up where vertices go in turn (the cow
-/// at 10 %: Metro mean 1.14 % of the diagonal as written, 0.26 % fitted; docs/decimation.md).
+/// loop splitting fills for shape alone, so error piles up where vertices go in turn (both
+/// fills measured: docs/decimation.md).
 ///
 /// Triangulation: recursive loop splitting. A split line joins two loop vertices that are not
 /// neighbours; its split plane holds the line and the average plane's normal. A split is

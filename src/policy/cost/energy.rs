@@ -70,12 +70,10 @@ pub type Samples = [f32; 10];
 /// optimisation); with subset placement no vertex moves, and the spring only prefers targets
 /// whose new edges are short (better-shaped triangles), and breaks the ties of flat regions,
 /// where every move's `E_dist` is zero. `κ` is in units of sample weight: a created edge of
-/// length ℓ costs as much as κ samples at distance ℓ from the new planes. Measured on the
-/// cow, plate_holes, fandisk and pins at 10 % (`host-sim simplify --cost energy --spring κ`):
-/// κ = 0 gives the lowest Metro error on three of the four, 0.01 on pins, and 0.1 to 10
-/// raise the cow's mean error steadily (0.23 % at 0 to 0.49 % at 10); on a flat grid the
-/// spring raises the mean triangle quality from 0.78 to 0.86 (tests/energy.rs). The default
-/// [`Energy::KAPPA`] = 0.01 keeps distance leading and the spring as the tie-breaker.
+/// length ℓ costs as much as κ samples at distance ℓ from the new planes. A larger κ trades
+/// distance for triangle shape; the default [`Energy::KAPPA`] = 0.01 keeps distance leading
+/// and the spring as the tie-breaker (the measurements behind it: docs/algorithm.md; the
+/// shape it buys on a flat grid: tests/energy.rs).
 ///
 /// **Cost.** 40 bytes per vertex (the samples) instead of the memoryless quadric's none and
 /// the stored quadric's 40; [`EnergyFan`] on the stack per walked fan ([`RING`] offsets,
@@ -84,8 +82,8 @@ pub type Samples = [f32; 10];
 /// triangle's two other corners ([`Cost::corner`]). Its price reads the fan, so every vertex
 /// whose fan a collapse changed is re-keyed in full (the engine does so for a storing cost
 /// with [`Cost::needs_fan`]). Each candidate costs one pass over the ring (a cross product
-/// and a 1/√ per triangle) against the quadric's one 3×3 form: 1.6 times the default's
-/// instructions on the cow (docs/algorithm.md).
+/// and a 1/√ per triangle) against the quadric's one 3×3 form (its instructions:
+/// docs/algorithm.md).
 pub struct Energy<'s> {
     samples: &'s mut [Samples],
     /// Weight of `E_dist`.
