@@ -42,7 +42,7 @@ fn plane(p: [V3; 3], w: f32) -> (PointQuadric, f32) {
 
 /// The plane quadric of triangle `p`, weighted by its area times `w` ([`plane`]).
 #[inline]
-fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
+pub(super) fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
     plane(p, w).0
 }
 
@@ -237,11 +237,7 @@ pub(crate) fn open_out<I: Index, L: Index>(
     flags: &[u8],
     v: usize,
 ) -> usize {
-    let live = || fan(triangles, adj, flags, v).filter(|&(_, tr, _)| !super::dead(tr));
-    live()
-        .map(|(_, tr, k)| others(tr, k).0)
-        .find(|&x| !live().any(|(_, tr, k)| others(tr, k).1 == x))
-        .unwrap_or(NONE)
+    unmatched(triangles, adj, flags, v, true, NONE)
 }
 
 /// Whether `y → v` is an open edge, from `v`'s fan alone: `y` is before `v` in one of its
@@ -254,8 +250,35 @@ pub(crate) fn opens_into<I: Index, L: Index>(
     y: usize,
     v: usize,
 ) -> bool {
+    y != NONE && unmatched(triangles, adj, flags, v, false, y) == y
+}
+
+/// The first vertex (in fan order; `only`, if given) that is after `v` (`after`) or before it
+/// in one of its live triangles and in the other role in none; `NONE` without one. One search
+/// for both of the lean mode's open-edge questions, so one copy in flash.
+#[inline(never)]
+fn unmatched<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    v: usize,
+    after: bool,
+    only: usize,
+) -> usize {
     let live = || fan(triangles, adj, flags, v).filter(|&(_, tr, _)| !super::dead(tr));
-    live().any(|(_, tr, k)| others(tr, k).1 == y) && !live().any(|(_, tr, k)| others(tr, k).0 == y)
+    let role = |tr: [usize; 3], k: usize, after: bool| {
+        let (x, y) = others(tr, k);
+        if after {
+            x
+        } else {
+            y
+        }
+    };
+    live()
+        .map(|(_, tr, k)| role(tr, k, after))
+        .filter(|&w| only == NONE || w == only)
+        .find(|&w| !live().any(|(_, tr, k)| role(tr, k, !after) == w))
+        .unwrap_or(NONE)
 }
 
 /// Adds the border edge quadrics at the due ends of each open edge `v → border_next[v]`, and

@@ -8,7 +8,7 @@ use super::fill::{Price, Quadrics};
 use super::sort::key;
 use super::{fan, flag, flags_of, others, Frame, BINS, NONE};
 use crate::index::Index;
-use crate::math;
+use crate::math::{self, V3};
 use crate::quadric;
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
@@ -36,11 +36,26 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
             || (!const { super::perform::on("border") } && k == flag::BORDER)
             || (!const { super::perform::on("locked") } && k == flag::LOCKED)
     };
+    // The lean mode's neighbours of one fan, reused vertex to vertex.
+    let mut seen = [(0u32, [0.0f32; 3]); FAN];
     for (a, (ta, ca)) in target.iter_mut().zip(cost.iter_mut()).enumerate() {
         let ka = flags_of(flags, a) & flag::KIND;
         let (mut best, mut to) = (f32::INFINITY, NONE);
         let border = !free(ka) && ka == flag::BORDER;
-        if free(ka) || border {
+        // Without stored quadrics, a free vertex's quadric and offers come from one walk of
+        // its fan (a border vertex's offers need its open edges, found from the fan again).
+        let once = if !Q::STORES_BORDERS && ka != flag::BORDER && free(ka) {
+            once(frame, triangles, adj, flags, a, &mut seen)
+        } else {
+            None
+        };
+        if let Some((b, e, q)) = once {
+            if b != NONE {
+                // The factor is a's own: it does not change which target is cheapest.
+                best = e * price.factor(&q);
+                to = b;
+            }
+        } else if free(ka) || border {
             let q = quadrics.of(frame, triangles, adj, flags, border_next, a);
             let pa = frame.at(a);
             let mut offer = |b: usize| {
@@ -85,3 +100,42 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
         };
     }
 }
+
+/// A free vertex's cheapest target (`NONE` without one), its error and its quadric from one
+/// walk of its fan: the quadric summed in fan order, as
+/// [`vertex_quadric`](super::fill::vertex_quadric) sums it, each neighbour kept in `seen` for
+/// the offers. `None` for a fan larger than `seen` (the caller walks it twice).
+#[inline]
+fn once<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    a: usize,
+    seen: &mut [(u32, V3); FAN],
+) -> Option<(usize, f32, quadric::PointQuadric)> {
+    let mut q = [0.0; 6];
+    let mut n = 0;
+    let pa = frame.at(a);
+    for (_, tr, k) in fan(triangles, adj, flags, a) {
+        let (x, y) = others(tr, k);
+        let px = frame.at(x);
+        *seen.get_mut(n)? = (x as u32, px);
+        n += 1;
+        // No triangle is dead at pick (compact dropped them).
+        quadric::point_add(&mut q, &super::fill::triangle([pa, px, frame.at(y)], 1.0));
+    }
+    let (mut best, mut to) = (f32::INFINITY, NONE);
+    for &(b, pb) in seen.get(..n)? {
+        let b = b as usize;
+        let e = quadric::point_error(&q, math::sub(pb, pa));
+        if e < best || (e == best && b < to) {
+            best = e;
+            to = b;
+        }
+    }
+    Some((to, best, q))
+}
+
+/// Neighbours one fan walk keeps for the lean mode's offers (a larger fan is walked twice).
+const FAN: usize = 32;
