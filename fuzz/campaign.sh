@@ -19,7 +19,7 @@ runs="${RUNS:-10000000}"
 workers="${WORKERS:-1}"
 limit=()
 if [ -n "${MAX_TIME:-}" ]; then limit=(-max_total_time="$MAX_TIME"); fi
-if [ "$#" -gt 0 ]; then targets=("$@"); else targets=(simplify obj ply stl gltf case result stream roundtrip tdpm); fi
+if [ "$#" -gt 0 ]; then targets=("$@"); else targets=(simplify pipeline obj ply stl gltf case result stream roundtrip tdpm); fi
 base=(-O -a -s none)
 flags_for() {
     if [ "$1" = simplify ]; then echo "${base[*]} --no-trace-compares --target-dir target/ntc"

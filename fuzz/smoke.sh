@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 secs="${SECONDS_PER_TARGET:-30}"
-targets=(simplify obj ply stl gltf case result stream roundtrip tdpm)
+targets=(simplify pipeline obj ply stl gltf case result stream roundtrip tdpm)
 # -O: optimised; -a: debug assertions (overflow checks) on; no sanitizer: the code is safe Rust.
 flags=(-O -a -s none)
 cargo +nightly fuzz build "${flags[@]}"

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
 use tinydecimate::cost::{NormalVariation, Quadric};
+use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
 use tinydecimate::{
     Config, EdgeCollapse, Error, FeatureMode, Index, Report, Schedule, Stop, Target, Workspace,
 };
@@ -473,23 +474,124 @@ impl Case {
     }
 }
 
+impl Case {
+    /// The pipeline's two modes on the case (its configuration: target, passes, error limit),
+    /// each on a fresh workspace and again on the same one; panics with a description on a
+    /// violation.
+    pub fn check_pipeline(&self) {
+        match (self.workspace, self.wide) {
+            (0, false) => pipeline::<u16, u16, 64, 64>(self),
+            (0, true) => pipeline::<u16, u32, 64, 64>(self),
+            (1, false) => pipeline::<u16, u16, 512, 512>(self),
+            (1, true) => pipeline::<u16, u32, 512, 512>(self),
+            (_, false) => pipeline::<u32, u16, 512, 1024>(self),
+            (_, true) => pipeline::<u32, u32, 512, 1024>(self),
+        }
+    }
+}
+
+fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &Case) {
+    let input: Vec<[I; 3]> = case.triangles.iter().map(|t| t.map(I::from_u32)).collect();
+    // The pipeline's triangle capacity is `T` links, not a third of them.
+    let expected = checked_error(
+        &case.positions,
+        &input,
+        &case.config,
+        (V.min(L::COUNT), T.min(L::COUNT)),
+    );
+    let mut fast = Box::new(FastWorkspace::<L, V, T>::new());
+    let mut lean = Box::new(LeanWorkspace::<L, V, T>::new());
+    for mode in ["fast", "lean"] {
+        let mut runs = Vec::new();
+        for _ in 0..2 {
+            let mut buf = input.clone();
+            let r = if mode == "fast" {
+                fast.simplify(&case.positions, &mut buf, &case.config)
+            } else {
+                lean.simplify(&case.positions, &mut buf, &case.config)
+            };
+            match &r {
+                Err(e) => {
+                    assert_eq!(Some(*e), expected, "{mode}: unexpected error");
+                    assert!(buf == input, "{mode}: buffer modified on error {e:?}");
+                }
+                Ok(report) => {
+                    assert_eq!(expected, None, "{mode}: expected an error");
+                    assert_ne!(report.stop, Stop::Running);
+                    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
+                    let view = pipeline_view(&case.positions, &inp);
+                    check_output(case, &input, &buf, report, &view, mode);
+                }
+            }
+            runs.push((r, buf));
+        }
+        assert!(
+            runs[0] == runs[1],
+            "{mode}: a reused workspace gave another result"
+        );
+    }
+}
+
+/// The positions as the pipeline sees them: translated by the bounding box's corner (over the
+/// vertices the triangles use) and scaled by a power of two (exact) to an extent near one.
+pub fn pipeline_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for t in tris {
+        for &i in t {
+            if let Some(p) = pos.get(i as usize) {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+    }
+    let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f32, f32::max);
+    let scale = if extent.is_finite() && extent >= f32::MIN_POSITIVE {
+        let e = (extent.to_bits() >> 23) as i32 - 127;
+        2.0f32.powi(-e)
+    } else {
+        0.0
+    };
+    let lo = if lo[0].is_finite() { lo } else { [0.0; 3] };
+    pos.iter()
+        .map(|q| [0, 1, 2].map(|a| (q[a] - lo[a]) * scale))
+        .collect()
+}
+
 /// The error `start` must return, by the documented order of checks.
 fn expected_error<L: Index, I: Idx, const V: usize, const T: usize>(
     positions: &[[f32; 3]],
     tris: &[[I; 3]],
     config: &Config,
 ) -> Option<Error> {
+    checked_error(
+        positions,
+        tris,
+        config,
+        (V.min(L::COUNT), T.min(L::COUNT / 3)),
+    )
+}
+
+/// The error of a run that checks, in order, the configuration, the vertex and the triangle
+/// capacity, then each corner's index and position.
+fn checked_error<I: Idx>(
+    positions: &[[f32; 3]],
+    tris: &[[I; 3]],
+    config: &Config,
+    (cap_v, cap_t): (usize, usize),
+) -> Option<Error> {
     if let Err(e) = config.validate() {
         return Some(e);
     }
-    if positions.len() > V.min(L::COUNT) {
+    if positions.len() > cap_v {
         return Some(Error::Capacity {
             what: tinydecimate::Capacity::Vertices,
             needed: positions.len(),
-            available: V.min(L::COUNT),
+            available: cap_v,
         });
     }
-    let cap_t = T.min(L::COUNT / 3);
     if tris.len() > cap_t {
         return Some(Error::Capacity {
             what: tinydecimate::Capacity::Triangles,
@@ -697,13 +799,15 @@ fn run<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &Case) 
     }
     let report = r1.unwrap();
     assert_ne!(report.stop, Stop::Running);
-    check_output(case, &input, &one, &report, "complete");
+    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
+    let view = engine_view(&case.positions, &inp);
+    check_output(case, &input, &one, &report, &view, "complete");
 
     // 3. Finished early: still a valid mesh.
     if let Some(k) = case.early {
         let mut three = input.clone();
         let r3 = stepped(&mut ws, case, &mut three, Some(k as usize)).expect("early run");
-        check_output(case, &input, &three, &r3, "early");
+        check_output(case, &input, &three, &r3, &view, "early");
     }
 }
 
@@ -712,6 +816,7 @@ fn check_output<I: Idx>(
     input: &[[I; 3]],
     buf: &[[I; 3]],
     report: &Report,
+    view: &[[f32; 3]],
     what: &str,
 ) {
     let pos = &case.positions;
@@ -749,10 +854,9 @@ fn check_output<I: Idx>(
     // The shared checker. Folds and new zero-area triangles count only if the true geometry
     // (f64) and the engine's own f32 view of it agree: where they disagree, the input has
     // detail below f32 resolution at its scale.
-    let view = engine_view(pos, &inp);
     let opts = meshcheck::Options {
         view: Some(meshcheck::View {
-            positions: &view,
+            positions: view,
             margin: FOLD_MARGIN,
             min_quality: MIN_Q,
         }),
@@ -773,7 +877,7 @@ pub const FOLD_MARGIN: f64 = 1e-4;
 /// Below this quality (`4√3·area / Σ edge²`, f64) a triangle's f32 normal may point anywhere.
 pub const MIN_Q: f64 = 1e-3;
 
-/// The positions as the engine sees them: its affine map of the input's bounding box (over
+/// The positions as the exact engine sees them: its affine map of the input's bounding box (over
 /// the vertices the triangles use) into about `[-1, 1]³`, in f32 (src/mesh.rs, `Mesh::build`).
 /// Fold checks use these, so that geometry finer than f32 resolves at the mesh's scale (say a
 /// 1e-20 detail beside a 1e-11 extent) does not count as a fold the engine failed to see.
