@@ -499,6 +499,8 @@ fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &C
         &case.config,
         (V.min(L::COUNT), T.min(L::COUNT)),
     );
+    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
+    let view = pipeline_view(&case.positions, &inp);
     let mut fast = Box::new(FastWorkspace::<L, V, T>::new());
     let mut lean = Box::new(LeanWorkspace::<L, V, T>::new());
     for mode in ["fast", "lean"] {
@@ -518,8 +520,6 @@ fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &C
                 Ok(report) => {
                     assert_eq!(expected, None, "{mode}: expected an error");
                     assert_ne!(report.stop, Stop::Running);
-                    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
-                    let view = pipeline_view(&case.positions, &inp);
                     check_output(case, &input, &buf, report, &view, mode);
                 }
             }
@@ -532,9 +532,9 @@ fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &C
     }
 }
 
-/// The positions as the pipeline sees them: translated by the bounding box's corner (over the
-/// vertices the triangles use) and scaled by a power of two (exact) to an extent near one.
-pub fn pipeline_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
+/// The bounding box (low and high corners) of the vertices the triangles use; infinite
+/// corners without any.
+fn used_bounds(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> ([f32; 3], [f32; 3]) {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     for t in tris {
@@ -547,6 +547,13 @@ pub fn pipeline_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
             }
         }
     }
+    (lo, hi)
+}
+
+/// The positions as the pipeline sees them: translated by the bounding box's corner (over the
+/// vertices the triangles use) and scaled by a power of two (exact) to an extent near one.
+pub fn pipeline_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
+    let (lo, hi) = used_bounds(pos, tris);
     let extent = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f32, f32::max);
     let scale = if extent.is_finite() && extent >= f32::MIN_POSITIVE {
         let e = (extent.to_bits() >> 23) as i32 - 127;
@@ -882,18 +889,7 @@ pub const MIN_Q: f64 = 1e-3;
 /// Fold checks use these, so that geometry finer than f32 resolves at the mesh's scale (say a
 /// 1e-20 detail beside a 1e-11 extent) does not count as a fold the engine failed to see.
 pub fn engine_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for t in tris {
-        for &i in t {
-            if let Some(p) = pos.get(i as usize) {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a]);
-                    hi[a] = hi[a].max(p[a]);
-                }
-            }
-        }
-    }
+    let (lo, hi) = used_bounds(pos, tris);
     let mut centre = [0.0f32; 3];
     let mut half = 0.0f32;
     if !tris.is_empty() {
