@@ -11,6 +11,10 @@
 //! * `locked_seam_corners_keep_every_chart_whole`: a grid in four charts meeting at one
 //!   position: with the corners locked no output triangle takes corners from two charts, and
 //!   with them moving some do (so the lock is what keeps them).
+//! * `the_pipeline_keeps_seams_closed_and_charts_whole` (crate feature `fast` too): the
+//!   pipeline's `simplify_with_wedges`, both modes, on the grids above, on a chart one column
+//!   wide between two and on a seam that ends inside: the target reached with no crack, no
+//!   wedge of a kept position lost, no triangle across two charts.
 #![cfg(feature = "seams")]
 
 mod common;
@@ -254,4 +258,180 @@ fn locked_seam_corners_keep_every_chart_whole() {
         torn_moving.iter().any(|&n| n > 0),
         "moving seam corners tore no chart: the test cannot fail"
     );
+}
+
+/// A wavy `n` x `n` grid cut along its vertices where `seam(column, row)`: each triangle on a
+/// cut vertex takes the copy of that vertex for its side, `side(x)` of its centroid's column
+/// `x` (in columns).
+#[cfg(feature = "fast")]
+fn split_grid(n: u32, seam: impl Fn(u32, u32) -> bool, side: impl Fn(f32) -> u8) -> MeshData {
+    let g = grid(n, n, 0.25);
+    let mut m = MeshData {
+        positions: g.positions.clone(),
+        triangles: Vec::new(),
+    };
+    let mut copy = std::collections::HashMap::new();
+    for t in &g.triangles {
+        let x = t.iter().map(|&v| (v % (n + 1)) as f32).sum::<f32>() / 3.0;
+        let s = side(x);
+        m.triangles.push(t.map(|v| {
+            if !seam(v % (n + 1), v / (n + 1)) || s == 0 {
+                return v;
+            }
+            *copy.entry((s, v)).or_insert_with(|| {
+                m.positions.push(g.positions[v as usize]);
+                m.positions.len() as u32 - 1
+            })
+        }));
+    }
+    m
+}
+
+/// Each vertex's chart: the vertices connected through the triangles (wedges are split on
+/// every seam, so a chart is a connected piece of the split mesh).
+#[cfg(feature = "fast")]
+fn charts(m: &MeshData) -> Vec<u32> {
+    let mut parent: Vec<u32> = (0..m.positions.len() as u32).collect();
+    fn root(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    for t in &m.triangles {
+        for k in 1..3 {
+            let (a, b) = (root(&mut parent, t[0]), root(&mut parent, t[k]));
+            parent[a.max(b) as usize] = a.min(b);
+        }
+    }
+    (0..m.positions.len() as u32)
+        .map(|v| root(&mut parent, v))
+        .collect()
+}
+
+#[cfg(feature = "fast")]
+#[test]
+fn the_pipeline_keeps_seams_closed_and_charts_whole() {
+    use std::sync::Mutex;
+    use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+    static FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
+    static LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
+    let run = |m: &MeshData, ratio: f32, lean: bool| {
+        let mut tris = m.triangles.clone();
+        let mut wedges = vec![[0u32; 3]; tris.len()];
+        let mut order = vec![0u32; m.positions.len()];
+        let moved = seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
+        assert!(moved > 0, "the mesh has seams");
+        let config = Config::new().with_ratio(ratio);
+        let report = if lean {
+            LEAN.lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+        } else {
+            FAST.lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+        }
+        .expect("simplify");
+        output(&m.positions, tris, report)
+    };
+    let n = 24;
+    let meshes = [
+        ("two charts", two_charts(n).0),
+        ("four charts", four_charts(16).0),
+        // A chart one column wide between two: seam vertices of both seams are neighbours
+        // across spokes where no wedge changes.
+        (
+            "a strip",
+            split_grid(
+                n,
+                |i, _| i == n / 2 || i == n / 2 + 1,
+                |x| u8::from(x > n as f32 / 2.0) + u8::from(x > n as f32 / 2.0 + 1.0),
+            ),
+        ),
+        // A seam from the border to the middle (one chart, cut): it ends at a vertex with one
+        // wedge whose neighbour down the seam has two.
+        (
+            "a slit",
+            split_grid(
+                n,
+                |i, j| i == n / 2 && j < n / 2,
+                |x| u8::from(x > n as f32 / 2.0),
+            ),
+        ),
+    ];
+    let mut seam_refusals = 0;
+    for (name, m) in &meshes {
+        let chart = charts(m);
+        for lean in [false, true] {
+            for ratio in [0.5, 0.25, 0.1] {
+                let what = format!("{name}, lean {lean}, {ratio}");
+                let (out, report) = run(m, ratio, lean);
+                assert_eq!(report.stop, Stop::Target, "{what}: {report:?}");
+                seam_refusals += report.rejected.get(tinydecimate::Reject::Seam);
+                let v = welded_verdict(m, &out);
+                v.assert_valid(&what);
+                assert_eq!(v.lost_wedges, 0, "{what}: wedges of kept positions lost");
+                for t in &out.triangles {
+                    let sides: BTreeSet<u32> = t.iter().map(|&x| chart[x as usize]).collect();
+                    assert_eq!(sides.len(), 1, "{what}: triangle {t:?} takes two charts");
+                }
+            }
+        }
+    }
+    // The strip's seam vertices are offered each other across the strip: the seam rule
+    // refuses (switched off, `PIPELINE_RULE_OFF=seam`, the strip's output is invalid).
+    assert!(seam_refusals > 0, "the seam rule never refused");
+}
+
+/// The pipeline's wedge buffer, refused before either buffer is touched: shorter than the
+/// triangles, or naming a vertex past the positions.
+#[cfg(feature = "fast")]
+#[test]
+fn the_pipeline_refuses_bad_wedges_untouched() {
+    use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+    use tinydecimate::{Capacity, Error};
+    let (m, _) = two_charts(4);
+    let mut tris = m.triangles.clone();
+    let mut wedges = vec![[0u32; 3]; tris.len()];
+    let mut order = vec![0u32; m.positions.len()];
+    seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
+    let config = Config::new().with_ratio(0.5);
+    let nv = m.positions.len() as u32;
+    let mut bad = wedges.clone();
+    bad[3][1] = nv;
+    let cases: [(Vec<[u32; 3]>, Error); 2] = [
+        (
+            wedges[..wedges.len() - 1].to_vec(),
+            Error::Capacity {
+                what: Capacity::Triangles,
+                needed: tris.len(),
+                available: tris.len() - 1,
+            },
+        ),
+        (
+            bad,
+            Error::IndexOutOfRange {
+                triangle: 3,
+                index: nv as usize,
+            },
+        ),
+    ];
+    for (w, expected) in cases {
+        for lean in [false, true] {
+            let (mut t, mut w) = (tris.clone(), w.clone());
+            let r = if lean {
+                Box::new(LeanWorkspace::<u16, 1024, 2048>::new())
+                    .as_mut()
+                    .simplify_with_wedges(&m.positions, &mut t, &mut w, &config)
+            } else {
+                Box::new(FastWorkspace::<u16, 1024, 2048>::new())
+                    .as_mut()
+                    .simplify_with_wedges(&m.positions, &mut t, &mut w, &config)
+            };
+            assert_eq!(r, Err(expected), "lean {lean}");
+            assert_eq!(t, tris, "lean {lean}: triangles touched");
+        }
+    }
 }

@@ -4,7 +4,7 @@
 //! two wound the same way, or a pinched fan), gone (no triangle); and duplicate triangles
 //! dropped on the way.
 
-use super::{dead, flag, list, others, set_link, slot, tri, NONE};
+use super::{dead, flag, flags_of, list, others, set_link, slot, tri, NONE};
 use crate::index::Index;
 
 /// Writes every vertex's kind and border successor, and drops duplicate triangles: every
@@ -22,15 +22,13 @@ pub(super) fn classify<I: Index, L: Index>(
 ) -> (usize, usize) {
     let (mut locked, mut duplicates) = (0, 0);
     for v in 0..flags.len() {
-        set_link(border_next, v, NONE);
         let l = list(first, flags, lists, v);
         let (kind, end) = match fast(triangles, nt, l, v) {
             Some(r) => r,
             None => slow(triangles, nt, l, v, &mut duplicates),
         };
-        if kind == flag::BORDER {
-            set_link(border_next, v, end);
-        }
+        // `NONE` but for a border vertex.
+        set_link(border_next, v, end);
         if kind == flag::LOCKED {
             locked += 1;
         }
@@ -39,6 +37,74 @@ pub(super) fn classify<I: Index, L: Index>(
         }
     }
     (locked, duplicates)
+}
+
+/// With wedges, after [`classify`]: a manifold vertex with two wedges in its fan is a seam
+/// vertex ([`flag::SEAM`]); one with more (seams meet: no wedge of a kept vertex belongs to
+/// every region), or a border vertex with more than one (a seam ends on the border), is
+/// locked, as meshoptimizer locks its complex vertices. A border vertex locked here keeps its
+/// successor (its open edge's planes). Returns how many it locked.
+#[inline(never)]
+pub(super) fn seams<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    wedges: &[[I; 3]],
+    nt: usize,
+    (first, lists): (&[L], &[L]),
+    flags: &mut [u8],
+) -> usize {
+    let mut locked = 0;
+    for v in 0..flags.len() {
+        let kind = flags_of(flags, v) & flag::KIND;
+        let l = list(first, flags, lists, v);
+        let new = seam(triangles, wedges, nt, l, v, kind);
+        if new != kind {
+            if new == flag::LOCKED {
+                locked += 1;
+            }
+            if let Some(f) = flags.get_mut(v) {
+                *f = (*f & !flag::KIND) | new;
+            }
+        }
+    }
+    locked
+}
+
+/// [`seams`] for one vertex: its kind with the [`flag::SEAM`] bit.
+fn seam<I: Index, L: Index>(
+    triangles: &[[I; 3]],
+    wedges: &[[I; 3]],
+    nt: usize,
+    l: &[L],
+    v: usize,
+    kind: u8,
+) -> u8 {
+    if kind != flag::MANIFOLD && kind != flag::BORDER {
+        return kind;
+    }
+    let (mut first, mut second, mut more) = (NONE, NONE, false);
+    for &t in l {
+        let t = t.to_usize();
+        let tr = tri(triangles, t);
+        if t >= nt || dead(tr) {
+            continue;
+        }
+        let Some(w) = slot(tr, v).and_then(|k| wedges.get(t).and_then(|w| w.get(k))) else {
+            continue;
+        };
+        let w = w.to_usize();
+        if first == NONE || w == first {
+            first = w;
+        } else if second == NONE || w == second {
+            second = w;
+        } else {
+            more = true;
+        }
+    }
+    match (kind, second != NONE, more) {
+        (_, false, _) => kind,
+        (flag::MANIFOLD, true, false) => kind | flag::SEAM,
+        _ => flag::LOCKED,
+    }
 }
 
 /// The kind of `v` from its fan as listed, when no triangle of the fan can be a duplicate:

@@ -14,6 +14,25 @@ pub(super) fn compact<I: Index>(
     nt: usize,
     counts: &mut [f32],
 ) -> (usize, usize) {
+    compact_with::<I, false>((triangles, &mut []), nt, counts)
+}
+
+/// [`compact`] with wedges: each triangle's wedges move with it.
+#[inline(never)]
+pub(super) fn compact_wedges<I: Index>(
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
+    nt: usize,
+    counts: &mut [f32],
+) -> (usize, usize) {
+    compact_with::<I, true>((triangles, wedges), nt, counts)
+}
+
+#[inline(always)]
+fn compact_with<I: Index, const W: bool>(
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
+    nt: usize,
+    counts: &mut [f32],
+) -> (usize, usize) {
     for c in counts.iter_mut() {
         *c = f32::from_bits(0);
     }
@@ -34,6 +53,13 @@ pub(super) fn compact<I: Index>(
             if let Some(y) = triangles.get_mut(w) {
                 *y = x;
             }
+            if W {
+                if let Some(&c) = wedges.get(r) {
+                    if let Some(d) = wedges.get_mut(w) {
+                        *d = c;
+                    }
+                }
+            }
         }
         w += 1;
     }
@@ -44,6 +70,6 @@ pub(super) fn compact<I: Index>(
 #[inline(never)]
 pub(super) fn unlock(flags: &mut [u8]) {
     for f in flags.iter_mut() {
-        *f &= flag::KIND | flag::HIGH | flag::DIRTY;
+        *f &= flag::KIND | flag::HIGH | flag::DIRTY | flag::SEAM;
     }
 }

@@ -26,8 +26,8 @@
 //!
 //! ```text
 //! build     validate, drop degenerate triangles, fan lists
-//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex;
-//!           drop duplicate triangles
+//! classify  manifold / border / locked (non-manifold, pinched, inconsistent) per vertex,
+//!           with wedges seam or locked (more than two wedges); drop duplicate triangles
 //! loop {
 //!   fill      the quadrics of the vertices whose triangles changed (all in the first pass):
 //!             area-weighted face planes and border edge planes, each in its vertex's frame
@@ -70,9 +70,20 @@
 //! planes' weight (the quadric's trace): a weighted mean squared distance, a distance in the
 //! input's units once its root is taken.
 //!
+//! Welded seams: [`FastWorkspace::simplify_with_wedges`] (crate feature `seams` too) takes the
+//! triangles welded by position ([`crate::seam::weld`]) with the caller's wedges, and keeps
+//! both up to date: a vertex on a seam (two wedges in its fan) slides only along it, one where
+//! more than two meet never moves, and a moved corner takes its new vertex's wedge on its own
+//! side (meshoptimizer's seam kind and `remap`/`wedge` pair; the exact engine's
+//! [`Simplifier::with_wedges`](crate::Simplifier::with_wedges) with
+//! [`SeamCorners::Lock`](crate::seam::SeamCorners::Lock)). Welding adds no RAM to the
+//! workspace (one flag bit) and, as a separate instantiation, no flash to a firmware that
+//! does not call it.
+//!
 //! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` (or
-//! `lean`) runs it (seams welded by position before the call). Not in it: wedges (welded seams), parts, the
-//! error bound and `step(budget)`. A vertex with more than 32 triangles is locked, and a
+//! `lean`) runs it (positions only: seams welded by position before the call; with
+//! attributes, glTF or OBJ with `vt`/`vn`, with wedges). Not in it: parts, the error bound
+//! and `step(budget)`. A vertex with more than 32 triangles is locked, and a
 //! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
 //! buffers. `examples/fast_cow.rs` runs it on one mesh (`FAST_COW_LEAN=1`: the lean mode), for
 //! callgrind and timing;
@@ -130,6 +141,9 @@ pub(crate) mod flag {
     pub const HIGH: u8 = 0x30;
     /// Shift of [`HIGH`].
     pub const HIGH_SHIFT: u32 = 4;
+    /// With wedges: a manifold vertex whose fan holds two wedges (a seam runs through it). It
+    /// collapses only along a spoke where its wedge changes, onto a seam or locked vertex.
+    pub const SEAM: u8 = 0x80;
 }
 
 /// The fast mode's working memory, sized at compile time (it can be a `static`).
@@ -402,7 +416,56 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             histogram: &mut self.histogram,
         };
         let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
-        run(positions, triangles, config, arrays, fill::Stored(quadrics))
+        run::<I, L, _, false>(
+            positions,
+            (triangles, &mut []),
+            config,
+            arrays,
+            fill::Stored(quadrics),
+        )
+    }
+
+    /// [`simplify`](Self::simplify) on a welded mesh with wedges ([`crate::seam`]):
+    /// `triangles` numbered by position (as [`crate::seam::weld`] leaves them) and `wedges`
+    /// the same triangles as the caller's vertices (one entry per triangle). The seams move
+    /// as one surface: a vertex where the wedge changes across two of its spokes slides only
+    /// along that seam, one where more than two wedges meet (or two on a border) never moves,
+    /// and each moved corner takes the wedge of its new vertex on its own side of the seam
+    /// (from the removed triangle of that side). On success the first
+    /// `report.triangles_out` entries of `triangles` hold the result as wedges (the caller's
+    /// vertices); `wedges` is scratch.
+    ///
+    /// Crate features `fast` and `seams`. Errors, before either buffer is touched: those of
+    /// [`simplify`](Self::simplify), and
+    /// [`Error::Capacity`] (triangles) if `wedges` is shorter than `triangles`,
+    /// [`Error::IndexOutOfRange`] for a wedge past `positions`.
+    #[cfg(feature = "seams")]
+    pub fn simplify_with_wedges<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        wedges: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        let nv = positions.len();
+        let arrays = Arrays {
+            first: &mut self.first,
+            border_next: &mut self.border_next,
+            target: &mut self.target,
+            cost: &mut self.cost,
+            order: &mut self.order,
+            flags: &mut self.flags,
+            lists: self.lists.as_flattened_mut(),
+            histogram: &mut self.histogram,
+        };
+        let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
+        run::<I, L, _, true>(
+            positions,
+            (triangles, wedges),
+            config,
+            arrays,
+            fill::Stored(quadrics),
+        )
     }
 }
 
@@ -473,8 +536,67 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
             lists: self.lists.as_flattened_mut(),
             histogram: &mut self.histogram,
         };
-        run(positions, triangles, config, arrays, fill::Fans)
+        run::<I, L, _, false>(positions, (triangles, &mut []), config, arrays, fill::Fans)
     }
+
+    /// [`FastWorkspace::simplify_with_wedges`] in the lean mode: a welded mesh with wedges,
+    /// the same contract and errors.
+    #[cfg(feature = "seams")]
+    pub fn simplify_with_wedges<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        wedges: &mut [[I; 3]],
+        config: &Config,
+    ) -> Result<Report, Error> {
+        let arrays = Arrays {
+            first: &mut self.first,
+            border_next: &mut [],
+            target: &mut self.target,
+            cost: &mut self.cost,
+            order: &mut self.order,
+            flags: &mut self.flags,
+            lists: self.lists.as_flattened_mut(),
+            histogram: &mut self.histogram,
+        };
+        run::<I, L, _, true>(positions, (triangles, wedges), config, arrays, fill::Fans)
+    }
+}
+
+/// compact, with the wedges when `W`.
+#[inline(always)]
+fn compact_pass<I: Index, const W: bool>(
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
+    nt: usize,
+    counts: &mut [f32],
+) -> (usize, usize) {
+    if W {
+        compact::compact_wedges((triangles, wedges), nt, counts)
+    } else {
+        compact::compact(triangles, nt, counts)
+    }
+}
+
+/// The wedge buffer against the triangles: long enough, every wedge a vertex.
+fn check_wedges<I: Index>(nv: usize, nt: usize, wedges: &[[I; 3]]) -> Result<(), Error> {
+    let Some(wedges) = wedges.get(..nt) else {
+        return Err(Error::Capacity {
+            what: Capacity::Triangles,
+            needed: nt,
+            available: wedges.len(),
+        });
+    };
+    for (t, w) in wedges.iter().enumerate() {
+        for &i in w {
+            if i.to_usize() >= nv {
+                return Err(Error::IndexOutOfRange {
+                    triangle: t,
+                    index: i.to_usize(),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A workspace's arrays apart from the quadrics, at its capacity (`border_next` empty in the
@@ -490,15 +612,24 @@ struct Arrays<'w, L: Index> {
     histogram: &'w mut [L; BINS],
 }
 
-/// The pipeline, top to bottom (module documentation), with quadrics from `quadrics`.
-fn run<I: Index, L: Index, Q: fill::Quadrics>(
+/// The pipeline, top to bottom (module documentation), with quadrics from `quadrics`; with
+/// wedges when `W` (`wedges` then at least as long as `triangles`, else unused).
+fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
     positions: &[[f32; 3]],
-    triangles: &mut [[I; 3]],
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     config: &Config,
     w: Arrays<'_, L>,
     mut quadrics: Q,
 ) -> Result<Report, Error> {
     config.validate()?;
+    if W {
+        check_wedges(positions.len(), triangles.len(), wedges)?;
+    }
+    let wedges = if W {
+        wedges.get_mut(..triangles.len()).unwrap_or(&mut [])
+    } else {
+        &mut []
+    };
     let (cv, ct) = (
         w.first.len().min(L::COUNT),
         (w.lists.len() / 3).min(L::COUNT),
@@ -539,11 +670,11 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
     };
     let triangles_in = triangles.len();
     // build
-    let (mut nt, degenerate) = compact::compact(triangles, triangles_in, cost);
+    let (mut nt, degenerate) = compact_pass::<I, W>((triangles, wedges), triangles_in, cost);
     build::link(triangles, nt, (first, flags), cost, lists);
 
     // classify (and duplicates)
-    let (locked, duplicates) = classify::classify(
+    let (mut locked, duplicates) = classify::classify(
         triangles,
         nt,
         (&*first, lists.get(..3 * nt).unwrap_or(&[])),
@@ -551,8 +682,12 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
         border_next,
     );
     if duplicates > 0 {
-        nt = compact::compact(triangles, nt, cost).0;
+        nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
         build::link(triangles, nt, (first, flags), cost, lists);
+    }
+    if W {
+        let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
+        locked += classify::seams(triangles, wedges, nt, adj, flags);
     }
     let valid = nt;
 
@@ -582,7 +717,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
         let price = fill::Price {
             mean_area: area / nt as f32,
         };
-        pick::pick(
+        pick::pick::<I, L, Q, W>(
             &frame,
             tris,
             adj,
@@ -597,12 +732,13 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             break Stop::NoLegalCollapse;
         }
         let tris = triangles.get_mut(..nt).unwrap_or(&mut []);
+        let corners = wedges.get_mut(..nt).unwrap_or(&mut []);
         // A pass aims at half the live triangles at most (see `PASS_SHARE`).
         let goal = (nt - target_triangles).min((nt / PASS_SHARE).max(2));
         let refused = stats.over_limit;
-        let done = perform::perform(
+        let done = perform::perform::<I, L, Q, W>(
             &frame,
-            tris,
+            (tris, corners),
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
@@ -612,7 +748,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             &mut stats,
         );
         passes += 1;
-        nt = compact::compact(triangles, nt, cost).0;
+        nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
         let _ = pass_triangles.push(nt as u32);
         if done == 0 {
             break if stats.over_limit > refused {
@@ -627,6 +763,12 @@ fn run<I: Index, L: Index, Q: fill::Quadrics>(
             compact::unlock(flags);
         }
     };
+    // With wedges the output names them.
+    if W {
+        for (t, w) in triangles.iter_mut().zip(wedges.iter()).take(nt) {
+            *t = *w;
+        }
+    }
     let collapse_error = if config.error_limit.is_finite() {
         math::sqrt(stats.worst) / frame.scale
     } else {

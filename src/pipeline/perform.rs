@@ -24,11 +24,15 @@
 //! 4. no fold: each surviving triangle against its neighbours across its three edges after
 //!    the collapse (unit normals' dot below -0.9, as the shared checker).
 //!
+//! With wedges, after rule 1: the seam rule ([`along_seam`]), each of a's wedges must have a
+//! wedge of b to go to, from the removed triangle on its side.
+//!
 //! A candidate over the error limit (its error, the price as a mean squared distance in the
 //! unit frame, above the limit's square) is never collapsed.
 //!
 //! A collapse rewrites a's corners to b in the caller's triangles (the two on a-b become
-//! degenerate: compact drops them) and locks both ends.
+//! degenerate: compact drops them), with wedges each moved corner's wedge too, and locks both
+//! ends.
 
 use super::fill::{vertex_quadric, Price, Quadrics};
 use super::sort::key;
@@ -95,6 +99,7 @@ const RULE_DUPLICATE: &str = "duplicate";
 const RULE_FOLD: &str = "fold";
 const RULE_BORDER: &str = "border";
 const RULE_LOCKED: &str = "locked";
+const RULE_SEAM: &str = "seam";
 
 /// Whether rule `name` is on in this build.
 #[inline(always)]
@@ -121,7 +126,7 @@ pub(super) const fn on(name: &str) -> bool {
 /// this pass has touched, and its price.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn alternative<I: Index, L: Index, Q: Quadrics>(
+fn alternative<I: Index, L: Index, Q: Quadrics, const W: bool>(
     frame: &Frame<'_>,
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
@@ -136,6 +141,7 @@ fn alternative<I: Index, L: Index, Q: Quadrics>(
     } else {
         NONE
     };
+    let seam = W && flags_of(flags, a) & flag::SEAM != 0;
     let pa = frame.at(a);
     let mut best: Option<(usize, f32)> = None;
     for (_, tr, k) in fan(tris, adj, flags, a) {
@@ -146,6 +152,9 @@ fn alternative<I: Index, L: Index, Q: Quadrics>(
         for w in [x, y] {
             let fw = flags_of(flags, w);
             if w == b || fw & flag::PASS != 0 || fw & flag::KIND == flag::GONE {
+                continue;
+            }
+            if seam && !super::pick::along(flags, w) {
                 continue;
             }
             if border
@@ -167,9 +176,9 @@ fn alternative<I: Index, L: Index, Q: Quadrics>(
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
+pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
     frame: &Frame<'_>,
-    tris: &mut [[I; 3]],
+    (tris, corners): (&mut [[I; 3]], &mut [[I; 3]]),
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
@@ -238,42 +247,46 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics>(
             stats.over_limit += 1;
             continue;
         }
-        let (b, dying) = match check(frame, tris, adj, flags, target, a, b) {
-            Ok(n) => (b, n),
-            Err(r) => {
-                stats.rejected.count(r);
-                edge_goal += 1;
-                // a's next cheapest target, at once: a vertex keeps one candidate, so one
-                // whose cheapest collapse stays illegal would otherwise never move.
-                let qa = qa(&*flags, &*tris);
-                let Some((x, cx)) = alternative(
-                    frame,
-                    tris,
-                    adj,
-                    (&*flags, &*border_next),
-                    (quadrics, &qa, price),
-                    a,
-                    b,
-                ) else {
-                    continue;
-                };
-                let ex = if limit.is_finite() {
-                    price.error(&qa, cx)
-                } else {
-                    0.0
-                };
-                if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
-                    continue;
-                }
-                match check(frame, tris, adj, flags, target, a, x) {
-                    Ok(n) => (x, n),
-                    Err(r) => {
-                        stats.rejected.count(r);
+        let (b, dying) =
+            match check::<I, L, W>(frame, (&*tris, &*corners), adj, flags, target, a, b) {
+                Ok(n) => (b, n),
+                Err(r) => {
+                    stats.rejected.count(r);
+                    edge_goal += 1;
+                    // a's next cheapest target, at once: a vertex keeps one candidate, so one
+                    // whose cheapest collapse stays illegal would otherwise never move.
+                    let qa = qa(&*flags, &*tris);
+                    let Some((x, cx)) = alternative::<I, L, Q, W>(
+                        frame,
+                        tris,
+                        adj,
+                        (&*flags, &*border_next),
+                        (quadrics, &qa, price),
+                        a,
+                        b,
+                    ) else {
+                        continue;
+                    };
+                    let ex = if limit.is_finite() {
+                        price.error(&qa, cx)
+                    } else {
+                        0.0
+                    };
+                    if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
                         continue;
                     }
+                    match check::<I, L, W>(frame, (&*tris, &*corners), adj, flags, target, a, x) {
+                        Ok(n) => (x, n),
+                        Err(r) => {
+                            stats.rejected.count(r);
+                            continue;
+                        }
+                    }
                 }
-            }
-        };
+            };
+        if W {
+            move_wedges((&*tris, &mut *corners), adj, flags, (a, b));
+        }
         collapse(tris, adj, flags, border_next, (a, b));
         // The live triangles on a-b, which check counted, die.
         removed += dying;
@@ -320,9 +333,9 @@ const MAX_FAN: usize = 32;
 /// Every rule for `a → b` on the current mesh (module documentation, in that order); `Ok` gives
 /// the triangles the collapse removes (the live ones on a-b).
 #[inline(never)]
-fn check<I: Index, L: Index>(
+fn check<I: Index, L: Index, const W: bool>(
     frame: &Frame<'_>,
-    tris: &[[I; 3]],
+    (tris, corners): (&[[I; 3]], &[[I; 3]]),
     adj: (&[L], &[L]),
     flags: &mut [u8],
     target: &[L],
@@ -345,6 +358,8 @@ fn check<I: Index, L: Index>(
     // Not zeroed: a fan rarely fills it.
     let mut fan_a = heapless::Vec::<Survivor, MAX_FAN>::new();
     let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
+    // With wedges: the removed triangles' (a wedge, b wedge), on the o1 and o2 sides.
+    let mut sides = [(NONE, NONE); 2];
     for (t, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
@@ -354,11 +369,17 @@ fn check<I: Index, L: Index>(
         if x == b {
             o1 = y;
             n_ab += 1;
+            if W {
+                sides[0] = wedge_pair(corners, t, k, (k + 1) % 3);
+            }
             continue;
         }
         if y == b {
             o2 = x;
             n_ab += 1;
+            if W {
+                sides[1] = wedge_pair(corners, t, k, (k + 2) % 3);
+            }
             continue;
         }
         let (px, py) = (frame.at(x), frame.at(y));
@@ -402,6 +423,9 @@ fn check<I: Index, L: Index>(
         } else {
             Reject::Link
         });
+    }
+    if W && const { on(RULE_SEAM) } && !along_seam(corners, tris, fan_a, a, sides) {
+        return Err(Reject::Seam);
     }
 
     // 3. Link condition by marks; duplicates; b's triangles across b-o1 and b-o2.
@@ -543,6 +567,88 @@ fn check<I: Index, L: Index>(
         }
     }
     Ok(n_ab)
+}
+
+/// Triangle `t`'s wedges at slots `k` and `j`.
+#[inline]
+fn wedge_pair<I: Index>(corners: &[[I; 3]], t: usize, k: usize, j: usize) -> (usize, usize) {
+    match corners.get(t) {
+        Some(w) => (
+            w.get(k).map_or(NONE, |x| x.to_usize()),
+            w.get(j).map_or(NONE, |x| x.to_usize()),
+        ),
+        None => (NONE, NONE),
+    }
+}
+
+/// The wedge of b that a corner of a with wedge `x` takes, from the removed triangles'
+/// (a wedge, b wedge) `sides` (either may be `(NONE, NONE)` on a border): the removed
+/// triangle whose a shares the corner's wedge shares its attribute region. `NONE` when no
+/// removed triangle holds `x`, or when both hold it with different wedges of b (a seam that
+/// ends at a: its corners on each side would need a different wedge).
+#[inline]
+fn moved_wedge(x: usize, sides: [(usize, usize); 2]) -> usize {
+    let [(a1, b1), (a2, b2)] = sides;
+    match (x == a1, x == a2) {
+        (true, true) if b1 == b2 => b1,
+        (true, false) => b1,
+        (false, true) => b2,
+        _ => NONE,
+    }
+}
+
+/// The seam rule: every wedge of a's surviving corners has a wedge of b to go to
+/// ([`moved_wedge`]). One wedge: a is inside one attribute region. Two: a-b must be a spoke
+/// where the wedge changes, so that each side's removed triangle carries it across.
+fn along_seam<I: Index>(
+    corners: &[[I; 3]],
+    tris: &[[I; 3]],
+    fan_a: &[Survivor],
+    a: usize,
+    sides: [(usize, usize); 2],
+) -> bool {
+    fan_a.iter().all(|s| {
+        let t = s.t as usize;
+        let Some(k) = slot(tri(tris, t), a) else {
+            return false;
+        };
+        let x = wedge_pair(corners, t, k, k).0;
+        moved_wedge(x, sides) != NONE
+    })
+}
+
+/// With wedges, before `a → b` rewrites the positions: each of a's surviving corners takes
+/// its wedge of b ([`moved_wedge`]; the check made sure there is one).
+#[inline(never)]
+fn move_wedges<I: Index, L: Index>(
+    (tris, corners): (&[[I; 3]], &mut [[I; 3]]),
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    (a, b): (usize, usize),
+) {
+    let mut sides = [(NONE, NONE); 2];
+    for (t, tr, k) in fan(tris, adj, flags, a) {
+        if dead(tr) {
+            continue;
+        }
+        let (x, y) = others(tr, k);
+        if x == b {
+            sides[0] = wedge_pair(corners, t, k, (k + 1) % 3);
+        } else if y == b {
+            sides[1] = wedge_pair(corners, t, k, (k + 2) % 3);
+        }
+    }
+    for (t, tr, k) in fan(tris, adj, flags, a) {
+        if dead(tr) || slot(tr, b).is_some() {
+            continue;
+        }
+        if let Some(c) = corners.get_mut(t).and_then(|w| w.get_mut(k)) {
+            let w = moved_wedge(c.to_usize(), sides);
+            if w != NONE {
+                *c = I::narrow(w);
+            }
+        }
+    }
 }
 
 #[inline]

@@ -1,8 +1,9 @@
 //! pick: each vertex's cheapest collapse its kind allows, priced from its quadric (in its own
 //! frame) at the target (meshoptimizer's `pickEdgeCollapses` and `rankEdgeCollapses`, reduced to one
-//! candidate per source vertex). Kinds (meshoptimizer's `kCanCollapse` without seams): a
-//! manifold vertex may collapse onto any neighbour; a border vertex only onto a border vertex
-//! along its border edge (either direction); a locked vertex never moves.
+//! candidate per source vertex). Kinds (meshoptimizer's `kCanCollapse`): a manifold vertex
+//! may collapse onto any neighbour; a seam vertex (with wedges) only onto a seam or locked
+//! neighbour; a border vertex only onto a border vertex along its border edge (either
+//! direction); a locked vertex never moves.
 
 use super::fill::{Price, Quadrics};
 use super::sort::key;
@@ -18,7 +19,7 @@ use crate::quadric;
 /// candidate's sort key in `histogram` (the counting sort's first pass).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
+pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
@@ -44,7 +45,9 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
         let border = !free(ka) && ka == flag::BORDER;
         // Without stored quadrics, a free vertex's quadric and offers come from one walk of
         // its fan (a border vertex's offers need its open edges, found from the fan again).
-        let once = if !Q::STORES_BORDERS && ka != flag::BORDER && free(ka) {
+        // A seam vertex offers only its seam's direction (see `along`).
+        let seam = W && flags_of(flags, a) & flag::SEAM != 0;
+        let once = if !Q::STORES_BORDERS && ka != flag::BORDER && free(ka) && !seam {
             once(frame, triangles, adj, flags, a, &mut seen)
         } else {
             None
@@ -73,7 +76,9 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics>(
             for (_, tr, k) in fan(triangles, adj, flags, a) {
                 let (x, y) = others(tr, k);
                 if !border {
-                    offer(x);
+                    if !seam || along(flags, x) {
+                        offer(x);
+                    }
                     continue;
                 }
                 // An open edge has no triangle across: both directions from its one triangle.
@@ -135,6 +140,14 @@ fn once<I: Index, L: Index>(
         }
     }
     Some((to, best, q))
+}
+
+/// Whether a seam vertex may offer a collapse onto `x`: a seam or locked vertex (the spoke
+/// may be the seam; the checks refuse one across which the wedge does not change).
+#[inline]
+pub(super) fn along(flags: &[u8], x: usize) -> bool {
+    let f = flags_of(flags, x);
+    f & flag::SEAM != 0 || f & flag::KIND == flag::LOCKED
 }
 
 /// Neighbours one fan walk keeps for the lean mode's offers (a larger fan is walked twice).

@@ -821,6 +821,18 @@ fn run_fast<L: Index, I: Index, const V: usize, const T: usize>() {
         Err(e) => display(&e),
     }
     black_box(&tris);
+    // With wedges: a welded mesh's entry point, the wedges as opaque as the triangles.
+    let mut wedges: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let nw = input(7) as usize;
+    let (Some(t), Some(w)) = (tris.get_mut(..nt), wedges.get_mut(..nw)) else {
+        return;
+    };
+    match ws.simplify_with_wedges(p, t, w, &opaque_config()) {
+        Ok(r) => use_report(&r),
+        Err(e) => display(&e),
+    }
+    black_box(&tris);
+    black_box(&wedges);
 }
 
 /// The lean mode (`pipeline::LeanWorkspace`): its one entry point on opaque input.
@@ -838,6 +850,18 @@ fn run_lean<L: Index, I: Index, const V: usize, const T: usize>() {
         Err(e) => display(&e),
     }
     black_box(&tris);
+    // With wedges: a welded mesh's entry point, the wedges as opaque as the triangles.
+    let mut wedges: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
+    let nw = input(7) as usize;
+    let (Some(t), Some(w)) = (tris.get_mut(..nt), wedges.get_mut(..nw)) else {
+        return;
+    };
+    match ws.simplify_with_wedges(p, t, w, &opaque_config()) {
+        Ok(r) => use_report(&r),
+        Err(e) => display(&e),
+    }
+    black_box(&tris);
+    black_box(&wedges);
 }
 
 #[entry]
