@@ -152,6 +152,31 @@ fn shares_positions(positions: &[[f32; 3]]) -> bool {
         .any(|p| !seen.insert(p.map(|x| if x == 0.0 { 0 } else { x.to_bits() })))
 }
 
+/// Whether some triangle is another turned over, by position (the back of a double-sided
+/// surface; the exact engine keeps such backs as twins, the pipeline drops them).
+pub fn double_sided(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
+    let key = |v: u32| {
+        positions.get(v as usize).map_or([u32::MAX; 3], |p| {
+            p.map(|x| if x == 0.0 { 0 } else { x.to_bits() })
+        })
+    };
+    // Each triangle as its lowest corner first, winding kept.
+    let rotated = |t: [[u32; 3]; 3]| {
+        let k = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+        [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+    };
+    let mut seen = std::collections::HashSet::with_capacity(triangles.len());
+    triangles.iter().any(|t| {
+        let p = t.map(key);
+        let back = rotated([p[0], p[2], p[1]]);
+        if seen.contains(&back) && back != rotated(p) {
+            return true;
+        }
+        seen.insert(rotated(p));
+        false
+    })
+}
+
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
 /// prunes in (the greedy or batched schedule, no error bound).
 pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
@@ -434,6 +459,7 @@ trait PipelineWorkspace {
         &mut self,
         positions: &[[f32; 3]],
         triangles: &mut [[I; 3]],
+        wedges: Option<&mut [[I; 3]]>,
         config: &Config,
     ) -> Result<Report, tinydecimate::Error>;
 }
@@ -445,9 +471,13 @@ impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
         &mut self,
         positions: &[[f32; 3]],
         triangles: &mut [[I; 3]],
+        wedges: Option<&mut [[I; 3]]>,
         config: &Config,
     ) -> Result<Report, tinydecimate::Error> {
-        self.simplify(positions, triangles, config)
+        match wedges {
+            Some(w) => self.simplify_with_wedges(positions, triangles, w, config),
+            None => self.simplify(positions, triangles, config),
+        }
     }
 }
 
@@ -458,9 +488,13 @@ impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
         &mut self,
         positions: &[[f32; 3]],
         triangles: &mut [[I; 3]],
+        wedges: Option<&mut [[I; 3]]>,
         config: &Config,
     ) -> Result<Report, tinydecimate::Error> {
-        self.simplify(positions, triangles, config)
+        match wedges {
+            Some(w) => self.simplify_with_wedges(positions, triangles, w, config),
+            None => self.simplify(positions, triangles, config),
+        }
     }
 }
 
@@ -543,23 +577,67 @@ pub fn pipeline_run<I: tinydecimate::Index>(
     triangles: &mut [[I; 3]],
     config: &Config,
 ) -> Result<Report, tinydecimate::Error> {
+    run_on(mode, positions, triangles, None, config)
+}
+
+/// [`pipeline_run`] with `wedges` (`simplify_with_wedges`) when given.
+fn run_on<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    wedges: Option<&mut [[I; 3]]>,
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
     fn on<W: PipelineWorkspace, I: tinydecimate::Index>(
         ws: &Mutex<W>,
         positions: &[[f32; 3]],
         triangles: &mut [[I; 3]],
+        wedges: Option<&mut [[I; 3]]>,
         config: &Config,
     ) -> Result<Report, tinydecimate::Error> {
         ws.lock()
             .unwrap_or_else(|e| e.into_inner())
-            .run(positions, triangles, config)
+            .run(positions, triangles, wedges, config)
     }
     let small = positions.len() < 65_535 && triangles.len() < 65_535;
     match (mode, small) {
-        (Pipeline::Fast, true) => on(&FAST_SMALL, positions, triangles, config),
-        (Pipeline::Fast, false) => on(&FAST_LARGE, positions, triangles, config),
-        (Pipeline::Lean, true) => on(&LEAN_SMALL, positions, triangles, config),
-        (Pipeline::Lean, false) => on(&LEAN_LARGE, positions, triangles, config),
+        (Pipeline::Fast, true) => on(&FAST_SMALL, positions, triangles, wedges, config),
+        (Pipeline::Fast, false) => on(&FAST_LARGE, positions, triangles, wedges, config),
+        (Pipeline::Lean, true) => on(&LEAN_SMALL, positions, triangles, wedges, config),
+        (Pipeline::Lean, false) => on(&LEAN_LARGE, positions, triangles, wedges, config),
     }
+}
+
+/// Runs the pipeline in `mode` on `mesh` whose vertices carry attributes: seams welded by
+/// position and the wedges kept (`simplify_with_wedges`), so the output names the input's
+/// vertices and a seam moves as one. The wall time is that of the weld and the library call.
+pub fn simplify_pipeline_wedges(
+    mesh: &MeshData,
+    config: &Config,
+    mode: Pipeline,
+) -> Result<(MeshData, Report, Duration)> {
+    let mut tris = mesh.triangles.clone();
+    let mut order = vec![0u32; mesh.positions.len()];
+    let mut wedges = vec![[0u32; 3]; tris.len()];
+    let start = Instant::now();
+    let report = if shares_positions(&mesh.positions) {
+        tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
+            .map_err(library_error)?;
+        run_on(mode, &mesh.positions, &mut tris, Some(&mut wedges), config)
+    } else {
+        run_on(mode, &mesh.positions, &mut tris, None, config)
+    }
+    .map_err(library_error)?;
+    let elapsed = start.elapsed();
+    tris.truncate(report.triangles_out);
+    Ok((
+        MeshData {
+            positions: mesh.positions.clone(),
+            triangles: tris,
+        },
+        report,
+        elapsed,
+    ))
 }
 
 /// Bytes a fast-mode workspace sized exactly for `v` vertices and `t` triangles takes

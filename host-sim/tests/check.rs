@@ -98,14 +98,23 @@ fn a_cracked_output_fails_with_the_crack_named() {
     assert_eq!(j["seams"], "Weld");
 }
 
-/// Parts pruned by `simplify`'s default pass `check`'s default; with `--parts keep` the same
-/// file fails on its number of components.
+/// Parts pruned by `simplify --parts prune` (the exact engine's default) pass `check`'s
+/// default; with `--parts keep` the same file fails on its number of components.
 #[test]
 fn parts_keep_refuses_a_pruned_output() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("pr2_sensor_mount.obj");
     let out = d.path().join("o.obj");
-    let o = run(&["simplify", s(&input), s(&out), "--ratio", "0.1", "--json"]);
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&out),
+        "--ratio",
+        "0.1",
+        "--parts",
+        "prune",
+        "--json",
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let pruned = j["report"]["parts_removed"].as_u64().unwrap();

@@ -88,7 +88,7 @@ fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let input = fixture("cow.obj");
     let out = d.path().join("c.obj");
-    // Attributes: the fast and the lean mode would weld their seams away.
+    // Attributes: kept, the seams welded with their wedges (not refused).
     let textured = d.path().join("quad.obj");
     std::fs::write(
         &textured,
@@ -102,6 +102,8 @@ fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
             (&["--quadric", "stored"][..], "--quadric"),
             (&["--operator", "triangle"][..], "--operator"),
             (&["--max-error", "1%"][..], "--max-error"),
+            (&["--cost", "normal"][..], "--cost"),
+            (&["--parts", "prune"][..], "--parts prune"),
         ] {
             let mut args = vec![
                 "simplify",
@@ -128,12 +130,44 @@ fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
             "--engine",
             engine,
         ]);
-        assert_ne!(o.status.code(), Some(0), "{engine}");
-        let e = text(&o.stderr);
-        assert!(e.contains("positions only"), "{engine}: {e}");
-        assert!(e.contains(&format!("--engine {engine}")), "{engine}: {e}");
-        assert!(!out.exists(), "{engine}");
+        assert_eq!(o.status.code(), Some(0), "{engine}: {}", text(&o.stderr));
+        let written = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            written.contains("\nvt "),
+            "{engine}: texture coordinates lost"
+        );
+        std::fs::remove_file(&out).unwrap();
     }
+}
+
+/// `--engine auto` (the default) runs the fast mode, and the exact engine when an option only
+/// it takes is given or the mesh is double-sided somewhere.
+#[test]
+fn auto_picks_the_fast_mode_unless_the_run_needs_the_exact_engine() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.obj");
+    let engine = |input: &std::path::Path, extra: &[&str]| {
+        let mut args = vec!["simplify", s(input), s(&out), "--ratio", "0.5", "--json"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", text(&o.stderr));
+        let j: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+        j["engine"].as_str().unwrap().to_string()
+    };
+    let cow = fixture("cow.obj");
+    assert_eq!(engine(&cow, &[]), "Fast");
+    assert_eq!(engine(&cow, &["--parts", "keep"]), "Fast");
+    assert_eq!(engine(&cow, &["--parts", "prune"]), "Exact");
+    assert_eq!(engine(&cow, &["--schedule", "batched"]), "Exact");
+    assert_eq!(engine(&cow, &["--engine", "exact"]), "Exact");
+    // A sheet of two triangles with its back: double-sided.
+    let sheet = d.path().join("sheet.obj");
+    std::fs::write(
+        &sheet,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n",
+    )
+    .unwrap();
+    assert_eq!(engine(&sheet, &[]), "Exact");
 }
 
 /// The fandisk (a CAD model: flat and cylindrical patches) to 50 %: every collapse it needs

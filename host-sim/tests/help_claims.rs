@@ -123,6 +123,8 @@ fn error_limit_advice_names_a_larger_value() {
         "keep",
         "--error-limit",
         "5%",
+        "--engine",
+        "exact",
     ]);
     let report = text(&o.stdout);
     assert!(line(&report, "stop ").contains("ErrorLimit"), "{report}");

@@ -92,6 +92,8 @@ fn cli(name: &str, ratio: f32, dir: &Path) -> Vec<[u32; 3]> {
         &ratio.to_string(),
         "--keep-numbering",
         "--force",
+        "--engine",
+        "exact",
     ]);
     assert!(o.status.success(), "{name}: {}", text(&o.stderr));
     host_sim::io::load(&out).unwrap().triangles

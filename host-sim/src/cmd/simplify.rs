@@ -43,14 +43,21 @@ pub enum ScheduleArg {
 /// Which engine, on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum EngineArg {
+    /// The fast mode, unless an option only the exact engine takes is given (--schedule,
+    /// --cost, --quadric, --placement, --operator, --max-error, --parts prune, the feature
+    /// and legality options) or the mesh is double-sided somewhere (the fast mode keeps one
+    /// side): then the exact engine.
+    #[default]
+    Auto,
     /// The engine every other option configures: exact greedy order (or the passes of
     /// --schedule), every cost, operator, bound, seam and part policy.
-    #[default]
     Exact,
     /// The fast mode (`tinydecimate::pipeline::FastWorkspace`, meshoptimizer's pipeline in
     /// fixed memory): stored quadrics priced once per pass, collapses in sorted order, every
-    /// output valid. Positions only: seams welded by position (the output keeps the welded
-    /// numbering), no parts pruned; of the options it takes the target and --error-limit.
+    /// output valid. Without attributes seams are welded by position (the output keeps the
+    /// welded numbering); with them (glTF, OBJ with vt/vn) the wedges are kept, a seam
+    /// sliding along itself. No parts pruned; of the options it takes the target,
+    /// --error-limit and --seams.
     Fast,
     /// The lean mode (`tinydecimate::pipeline::LeanWorkspace`): the fast mode's pipeline
     /// without stored quadrics (each built from its vertex's fan whenever a pass reads it),
@@ -59,10 +66,11 @@ pub enum EngineArg {
 }
 
 impl EngineArg {
-    /// The library's pipeline mode of `fast` and `lean`; `None` for the exact engine.
+    /// The library's pipeline mode of `fast` and `lean`; `None` for the exact engine and
+    /// `auto` (resolved by [`Args::pipeline`]).
     pub fn pipeline(self) -> Option<crate::simplify::Pipeline> {
         match self {
-            EngineArg::Exact => None,
+            EngineArg::Auto | EngineArg::Exact => None,
             EngineArg::Fast => Some(crate::simplify::Pipeline::Fast),
             EngineArg::Lean => Some(crate::simplify::Pipeline::Lean),
         }
@@ -406,10 +414,11 @@ pub struct Args {
     pub hard_edges: HardEdgesArg,
     /// Parts (connected components): `prune` removes a part whole once it costs less than the
     /// collapse about to be made, and short of the target with no collapse left the smallest
-    /// parts, never the last (the default; greedy schedule without --max-error only, else
-    /// every part stays); `keep` keeps every part, as a collapse never changes topology.
-    #[arg(long, value_enum, default_value_t = PartsArg::Prune)]
-    pub parts: PartsArg,
+    /// parts, never the last (the exact engine's default; greedy schedule without
+    /// --max-error only, else every part stays); `keep` keeps every part, as a collapse never
+    /// changes topology (the fast mode's only choice).
+    #[arg(long, value_enum)]
+    pub parts: Option<PartsArg>,
     /// Target fraction of the input triangles, above 0, at most 1. Not with
     /// --target-triangles.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_ratio)]
@@ -438,9 +447,10 @@ pub struct Args {
     /// --max-error for one).
     #[arg(long, value_parser = parse_error_limit)]
     pub error_limit: Option<ErrorLimit>,
-    /// Engine: `fast` is meshoptimizer's pipeline (positions only; target and --error-limit),
-    /// `lean` the same without stored quadrics.
-    #[arg(long, value_enum, default_value_t = EngineArg::Exact)]
+    /// Engine: `fast` is meshoptimizer's pipeline (the target, --error-limit and --seams),
+    /// `lean` the same without stored quadrics, `exact` the engine every other option
+    /// configures; `auto` (the default) is `fast` unless such an option is given.
+    #[arg(long, value_enum, default_value_t = EngineArg::Auto)]
     pub engine: EngineArg,
     /// Collapse schedule.
     #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
@@ -515,6 +525,76 @@ pub struct Args {
 }
 
 impl Args {
+    /// These arguments with `--engine auto` resolved for `mesh`: `fast`, unless an option
+    /// only the exact engine takes is given ([`exact_only`](Self::exact_only)) or the mesh is
+    /// double-sided somewhere (the exact engine keeps both sides, the pipeline one): `exact`.
+    pub fn resolve(&self, mesh: &MeshData) -> Args {
+        let mut args = self.clone();
+        if args.engine == EngineArg::Auto {
+            args.engine = if args.exact_only().is_none()
+                && !crate::simplify::double_sided(&mesh.positions, &mesh.triangles)
+            {
+                EngineArg::Fast
+            } else {
+                EngineArg::Exact
+            };
+        }
+        args
+    }
+
+    /// The pipeline mode this run uses (`None`: the exact engine): `--engine`, with `auto`
+    /// resolved to the fast mode unless [`exact_only`](Self::exact_only) names an option
+    /// (runs resolve `auto` for their mesh first, [`resolve`](Self::resolve)).
+    pub fn pipeline(&self) -> Option<crate::simplify::Pipeline> {
+        match self.engine {
+            EngineArg::Auto if self.exact_only().is_none() => Some(crate::simplify::Pipeline::Fast),
+            e => e.pipeline(),
+        }
+    }
+
+    /// The first option given that only the exact engine takes (`None`: the pipeline takes
+    /// them all).
+    pub fn exact_only(&self) -> Option<&'static str> {
+        let given = [
+            (self.schedule != ScheduleArg::Greedy, "--schedule"),
+            (self.cost.is_some(), "--cost"),
+            (self.quadric != QuadricArg::Memoryless, "--quadric"),
+            (self.placement != PlacementArg::Subset, "--placement"),
+            (self.operator != OperatorArg::Edge, "--operator"),
+            (self.max_error.is_some(), "--max-error"),
+            (self.parts == Some(PartsArg::Prune), "--parts prune"),
+            (self.lambda.is_some(), "--lambda"),
+            (self.valence_normalized, "--valence-normalized"),
+            (self.no_features, "--no-features"),
+            (self.features, "--features"),
+            (self.no_feature_targets, "--no-feature-targets"),
+            (self.max_turn.is_some(), "--max-turn"),
+            (self.min_quality.is_some(), "--min-quality"),
+            (self.boundary_weight.is_some(), "--boundary-weight"),
+            (self.attribute_weights.is_some(), "--attribute-weights"),
+            (self.spring != tinydecimate::cost::Energy::KAPPA, "--spring"),
+        ];
+        given.iter().find(|(on, _)| *on).map(|&(_, name)| name)
+    }
+
+    /// Whether parts may vanish: `--parts`, else the engine's default (the exact engine
+    /// prunes, the pipeline keeps every part).
+    pub fn prunes(&self) -> bool {
+        match self.parts {
+            Some(p) => p == PartsArg::Prune,
+            None => self.pipeline().is_none(),
+        }
+    }
+
+    /// `--parts` as this run takes it.
+    pub fn parts(&self) -> PartsArg {
+        if self.prunes() {
+            PartsArg::Prune
+        } else {
+            PartsArg::Keep
+        }
+    }
+
     /// `--format` as a mesh-file format (`None`: not given, or GLB).
     pub fn mesh_format(&self) -> Option<Format> {
         self.format.and_then(OutputFormat::mesh)
@@ -587,6 +667,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
     if to_stdout && args.json {
         bail!("--json and an output of `-` would both write standard output: give an output file");
     }
+    refuse_exact_only(args)?;
     // glTF, and OBJ with texture coordinates or normals: attributes carried (textured.rs).
     if let Some(code) = textured::run_if_attributes(args)? {
         return Ok(code);
@@ -599,8 +680,9 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             args.output.display()
         );
     }
-    // 2. The run, and the file it writes.
+    // 2. The run, and the file it writes (with `--engine auto` resolved for the mesh).
     let run = simplify_file(args, out_format)?;
+    let args = &run.args;
     // 3. What was done and the memory it takes, then the check and the error.
     let say = |text: &str| {
         if to_stdout {
@@ -625,6 +707,8 @@ pub fn run(args: &Args) -> Result<ExitCode> {
 
 /// One `simplify` run: the input, the result, what was written and how.
 struct Run {
+    /// The arguments, `--engine auto` resolved for the mesh.
+    args: Args,
     mesh: MeshData,
     config: Config,
     out: MeshData,
@@ -640,6 +724,7 @@ struct Run {
 /// Loads the input, runs the library as `args` ask and writes the output file.
 fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     let mesh = crate::io::load_noting(&args.input)?;
+    let args = &args.resolve(&mesh);
     let mut config = args.config();
     if let Some(e) = args.max_error {
         config = config.with_max_error(e.distance(&mesh.positions));
@@ -655,13 +740,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
             args.input.display()
         );
     }
-    let pipeline = args.engine.pipeline();
-    if let Some(mode) = pipeline.filter(|_| args.schedule != ScheduleArg::Greedy) {
-        bail!(
-            "--engine {} has its own passes: drop --schedule",
-            mode.name()
-        );
-    }
+    let pipeline = args.pipeline();
     let stored = args.quadric == QuadricArg::Stored;
     // Optimal placement moves vertices: only their numbering says which input vertex each
     // one was (`check --placement optimal` matches by index), so it is kept, and STL has none.
@@ -685,7 +764,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         weld: args.seams == SeamsArg::Weld,
         // No attribute is carried here, so a seam corner has nothing to tear.
         lock_seam_corners: false,
-        prune: args.parts == PartsArg::Prune,
+        prune: args.prunes(),
         energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
         pipeline,
     };
@@ -697,6 +776,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     };
     crate::io::save_as(&args.output, out_format, &written)?;
     Ok(Run {
+        args: args.clone(),
         mesh,
         config,
         out,
@@ -708,6 +788,18 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         moved,
         keep_numbering,
     })
+}
+
+/// `--engine fast` or `lean` with an option only the exact engine takes: refused, naming it.
+pub(crate) fn refuse_exact_only(args: &Args) -> Result<()> {
+    if let (Some(mode), Some(option)) = (args.engine.pipeline(), args.exact_only()) {
+        bail!(
+            "--engine {} does not take {option} (the exact engine's): drop it, or give \
+             --engine exact",
+            mode.name()
+        );
+    }
+    Ok(())
 }
 
 /// The run in words: files, modes, the library's report and the memory figures.
@@ -740,13 +832,14 @@ fn run_text(args: &Args, run: &Run) -> String {
             ", unreferenced dropped"
         }
     );
-    if args.engine == EngineArg::Fast {
+    let pipeline = args.pipeline();
+    if pipeline == Some(crate::simplify::Pipeline::Fast) {
         let _ = writeln!(
             text,
             "  engine                 fast (meshoptimizer's pipeline: stored quadrics, sorted \
              passes, subset placement)"
         );
-    } else if args.engine == EngineArg::Lean {
+    } else if pipeline == Some(crate::simplify::Pipeline::Lean) {
         let _ = writeln!(
             text,
             "  engine                 lean (meshoptimizer's pipeline: quadrics from each \
@@ -800,7 +893,7 @@ fn run_text(args: &Args, run: &Run) -> String {
     );
     let (v, t) = (mesh.positions.len(), mesh.triangles.len());
     let per_tri = |b: usize| b as f64 / t.max(1) as f64;
-    if let Some(mode) = args.engine.pipeline() {
+    if let Some(mode) = pipeline {
         let need = crate::simplify::pipeline_bytes(mode, v, t);
         let _ = writeln!(
             text,
@@ -885,7 +978,11 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "output_format": format!("{:?}", run.out_format),
         "output_vertices": run.written.positions.len(),
         "keep_numbering": run.keep_numbering,
-        "engine": format!("{:?}", args.engine),
+        "engine": match args.pipeline() {
+            Some(crate::simplify::Pipeline::Fast) => "Fast",
+            Some(crate::simplify::Pipeline::Lean) => "Lean",
+            None => "Exact",
+        },
         "schedule": format!("{:?}", config.schedule),
         "cost": format!("{:?}", config.cost),
         "operator": format!("{:?}", args.operator),
@@ -896,7 +993,7 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
         "report": report_json(&run.report),
         "advice": advice_for(args, &run.report).map(|(_, a)| a),
         "library_ms": run.elapsed.as_secs_f64() * 1e3,
-        "workspace_bytes": match args.engine.pipeline() {
+        "workspace_bytes": match args.pipeline() {
             Some(mode) => crate::simplify::pipeline_bytes(mode, v, t),
             None => workspace_bytes(v, t).0,
         },
@@ -937,7 +1034,7 @@ fn measure(
     let promise = crate::check::Promise {
         moved: *moved,
         welded: args.seams == SeamsArg::Weld,
-        parts: args.parts == PartsArg::Prune,
+        parts: args.prunes(),
     };
     let (_, note, validity) = crate::check::verdict(mesh, &as_read, promise)?;
     let valid = validity.is_valid();
@@ -998,7 +1095,7 @@ fn measure(
     json["check"] = serde_json::json!({
         "against": "cleaned input",
         "seams": args.seams,
-        "parts": args.parts,
+        "parts": args.parts(),
         "validity": validity,
         "defects": validity.defects.iter().map(|d| d.to_string()).collect::<Vec<_>>(),
         "valid": valid,

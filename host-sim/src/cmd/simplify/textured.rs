@@ -32,12 +32,14 @@ fn run_library(
     args: &Args,
     attributes: Option<&crate::simplify::Attributes>,
 ) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
-    if let Some(mode) = args.engine.pipeline() {
-        bail!(
-            "--engine {} takes positions only: it would weld the seams of these attributes \
-             away; use the default engine for glTF and OBJ with vt or vn",
-            mode.name()
-        );
+    if let Some(mode) = args.pipeline() {
+        if args.seams == super::SeamsArg::Weld {
+            let (out, report, elapsed) =
+                crate::simplify::simplify_pipeline_wedges(mesh, config, mode)?;
+            return Ok((out.triangles, report, elapsed));
+        }
+        let (out, report, elapsed) = crate::simplify::simplify_pipeline(mesh, config, false, mode)?;
+        return Ok((out.triangles, report, elapsed));
     }
     let stored = args.quadric == QuadricArg::Stored;
     let placement = stored.then_some(tinydecimate::cost::Placement::Subset);
@@ -237,8 +239,13 @@ fn simplify_parts(
             uvs.as_deref(),
             normals.get(k).and_then(Option::as_deref),
         )?;
-        let (tris, report, library) = run_library(lib_mesh, &config, args, attributes.as_ref())
-            .map_err(|e| anyhow!("{label}: {e}"))?;
+        let (tris, report, library) = run_library(
+            lib_mesh,
+            &config,
+            &args.resolve(lib_mesh),
+            attributes.as_ref(),
+        )
+        .map_err(|e| anyhow!("{label}: {e}"))?;
         let t0 = Instant::now();
         let tris = match shading {
             Some(s) => s.restore(mesh, &tris),
