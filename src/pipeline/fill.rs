@@ -4,7 +4,8 @@
 //! weighted by its area, added at its three vertices; and for each border edge a plane
 //! through the edge perpendicular to its triangle, weighted by the edge's length times 10,
 //! plus the triangle's plane at 10 times its weight, added at both ends, so that borders keep
-//! their shape (meshoptimizer's `fillFaceQuadrics` and `fillEdgeQuadrics`).
+//! their shape (meshoptimizer's `fillFaceQuadrics` and `fillEdgeQuadrics`); with wedges, at
+//! each seam vertex a plane through each seam spoke on each side ([`seam_planes`]).
 //!
 //! Every quadric is in its vertex's frame, where each of its planes passes through the
 //! origin: its offset terms are zero, exactly, so a [`PointQuadric`] (the 3×3 part, 24 bytes)
@@ -162,11 +163,67 @@ fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
     Some(q)
 }
 
+/// With wedges, at seam vertex `v` for its triangle with neighbours `(x, y)` (positions `p`,
+/// `v`'s first): the plane through each spoke to a seam or locked neighbour, perpendicular to
+/// the triangle, weighted by the spoke's length times [`SEAM_WEIGHT`]. A seam spoke has a
+/// triangle on each side, so each side adds one: the seam keeps its line on the surface, as
+/// a border keeps its own (meshoptimizer's edge quadrics on its seam kind), and the texture
+/// on both sides with it.
+#[inline(never)]
+fn seam_planes(flags: &[u8], (x, y): (usize, usize), [pv, px, py]: [V3; 3], q: &mut PointQuadric) {
+    for (w, pw, po) in [(x, px, py), (y, py, px)] {
+        if !super::pick::along(flags, w) {
+            continue;
+        }
+        let e = math::sub(pw, pv);
+        let o = math::sub(po, pv);
+        let l2 = math::dot(e, e);
+        let perp = math::sub(math::scale(o, l2), math::scale(e, math::dot(o, e)));
+        let pl2 = math::dot(perp, perp);
+        if l2 > math::TINY2 && pl2 > math::TINY2 && pl2.is_finite() {
+            let n = math::scale(perp, math::rsqrt(pl2));
+            point_add(q, &point_plane(n, math::sqrt(l2) * SEAM_WEIGHT));
+        }
+    }
+}
+
+/// A seam spoke's plane weight on each of its two sides (against [`BORDER_WEIGHT`] for a
+/// border edge, which has one side): a trade between the texture's fidelity along the seam
+/// and the geometric error of the collapses the planes refuse to price low (measured in
+/// docs/attributes.md#the-fast-mode-with-attributes).
+const SEAM_WEIGHT: f32 = 0.1;
+
+/// With wedges: the seam planes ([`seam_planes`]) of every due seam vertex, from its fan.
+#[inline(never)]
+pub(super) fn seam_quadrics<I: Index, L: Index>(
+    frame: &Frame<'_>,
+    triangles: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    quadrics: &mut [PointQuadric],
+    all: bool,
+) {
+    for v in 0..flags.len() {
+        if flags_of(flags, v) & flag::SEAM == 0 || !due(flags, v, all) {
+            continue;
+        }
+        let Some(q) = quadrics.get_mut(v) else {
+            continue;
+        };
+        let pv = frame.at(v);
+        for (_, tr, k) in fan(triangles, adj, flags, v) {
+            let (x, y) = others(tr, k);
+            seam_planes(flags, (x, y), [pv, frame.at(x), frame.at(y)], q);
+        }
+    }
+}
+
 /// `v`'s quadric from its fan as it is now (the lean mode's, which stores none; the fast
-/// mode's for a vertex whose fan changed in the pass): the same planes as [`face_quadrics`]
-/// and [`border_quadrics`] give it, summed in fan order, with `quadrics`' open edges.
+/// mode's for a vertex whose fan changed in the pass): the same planes as [`face_quadrics`],
+/// [`border_quadrics`] and, with wedges (`W`), [`seam_quadrics`] give it, summed in fan order,
+/// with `quadrics`' open edges.
 #[inline]
-pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics>(
+pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics, const W: bool>(
     frame: &Frame<'_>,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
@@ -176,6 +233,7 @@ pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics>(
 ) -> PointQuadric {
     let mut q = [0.0; 6];
     let border = flags_of(flags, v) & flag::KIND == flag::BORDER;
+    let seam = W && flags_of(flags, v) & flag::SEAM != 0;
     let next = if border {
         quadrics.next(triangles, adj, flags, border_next, v)
     } else {
@@ -189,6 +247,9 @@ pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics>(
         let (x, y) = others(tr, k);
         let (px, py) = (frame.at(x), frame.at(y));
         point_add(&mut q, &triangle([pv, px, py], 1.0));
+        if seam {
+            seam_planes(flags, (x, y), [pv, px, py], &mut q);
+        }
         if border {
             border_planes(
                 (triangles, adj, flags, border_next),
@@ -357,7 +418,7 @@ pub(crate) trait Quadrics {
 
     /// Before a pass: the stored quadrics of every vertex (`all`) or of the dirty ones.
     /// Returns the triangles' area if it summed it on the way (the fast mode, with `all`).
-    fn fill<I: Index, L: Index>(
+    fn fill<I: Index, L: Index, const W: bool>(
         &mut self,
         frame: &Frame<'_>,
         triangles: &[[I; 3]],
@@ -368,7 +429,7 @@ pub(crate) trait Quadrics {
     ) -> Option<f32>;
 
     /// `v`'s quadric in this pass.
-    fn of<I: Index, L: Index>(
+    fn of<I: Index, L: Index, const W: bool>(
         &self,
         frame: &Frame<'_>,
         triangles: &[[I; 3]],
@@ -411,7 +472,7 @@ impl Quadrics for Stored<'_> {
     }
 
     #[inline(always)]
-    fn fill<I: Index, L: Index>(
+    fn fill<I: Index, L: Index, const W: bool>(
         &mut self,
         frame: &Frame<'_>,
         triangles: &[[I; 3]],
@@ -421,12 +482,15 @@ impl Quadrics for Stored<'_> {
         all: bool,
     ) -> Option<f32> {
         let area = face_quadrics(frame, triangles, flags, self.0, all);
+        if W {
+            seam_quadrics(frame, triangles, adj, flags, self.0, all);
+        }
         border_quadrics(frame, triangles, adj, flags, border_next, self.0, all);
         all.then_some(area)
     }
 
     #[inline(always)]
-    fn of<I: Index, L: Index>(
+    fn of<I: Index, L: Index, const W: bool>(
         &self,
         _: &Frame<'_>,
         _: &[[I; 3]],
@@ -471,7 +535,7 @@ impl Quadrics for Fans {
     }
 
     #[inline(always)]
-    fn fill<I: Index, L: Index>(
+    fn fill<I: Index, L: Index, const W: bool>(
         &mut self,
         _: &Frame<'_>,
         _: &[[I; 3]],
@@ -488,7 +552,7 @@ impl Quadrics for Fans {
     }
 
     #[inline(always)]
-    fn of<I: Index, L: Index>(
+    fn of<I: Index, L: Index, const W: bool>(
         &self,
         frame: &Frame<'_>,
         triangles: &[[I; 3]],
@@ -497,6 +561,6 @@ impl Quadrics for Fans {
         _: &[L],
         v: usize,
     ) -> PointQuadric {
-        vertex_quadric(frame, triangles, adj, (flags, &[]), self, v)
+        vertex_quadric::<I, L, Self, W>(frame, triangles, adj, (flags, &[]), self, v)
     }
 }

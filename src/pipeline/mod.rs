@@ -80,9 +80,11 @@
 //! workspace (one flag bit) and, as a separate instantiation, no flash to a firmware that
 //! does not call it.
 //!
-//! Neither the crate's default nor the CLI's yet: `host-sim simplify --engine fast` (or
-//! `lean`) runs it (positions only: seams welded by position before the call; with
-//! attributes, glTF or OBJ with `vt`/`vn`, with wedges). Not in it: parts, the error bound
+//! Not the crate's default ([`Config::new`]'s engine is); `host-sim simplify`'s (`--engine
+//! auto`, unless an option of the exact engine's alone is given or the mesh is double-sided;
+//! `--engine fast` or `lean` ask for it): without attributes seams welded by position before
+//! the call, with them (glTF, OBJ with `vt`/`vn`) with wedges. Not in it: parts, the error
+//! bound, double-sided twins (the back of a double-sided triangle is dropped as a duplicate)
 //! and `step(budget)`. A vertex with more than 32 triangles is locked, and a
 //! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
 //! buffers. `examples/fast_cow.rs` runs it on one mesh (`FAST_COW_LEAN=1`: the lean mode), for
@@ -710,7 +712,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         }
         let tris = triangles.get(..nt).unwrap_or(&[]);
         let adj = (&*first, lists.get(..3 * nt).unwrap_or(&[]));
-        let summed = quadrics.fill(&frame, tris, adj, flags, border_next, passes == 0);
+        let summed = quadrics.fill::<I, L, W>(&frame, tris, adj, flags, border_next, passes == 0);
         if passes == 0 {
             area = summed.unwrap_or_else(|| fill::area(&frame, tris));
         }

@@ -223,7 +223,14 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
         // from its fan as it is now (as the batched schedule prices a popped vertex again),
         // and left to the next pass if that is over the pass's error goal.
         let (c, fresh) = if flags_of(flags, a) & flag::DIRTY != 0 {
-            let q = vertex_quadric(frame, &*tris, adj, (&*flags, &*border_next), quadrics, a);
+            let q = vertex_quadric::<I, L, Q, W>(
+                frame,
+                &*tris,
+                adj,
+                (&*flags, &*border_next),
+                quadrics,
+                a,
+            );
             let c = price.of(&q, math::sub(frame.at(b), frame.at(a)));
             if c > error_goal.max(cost_of(a)) {
                 continue;
@@ -235,7 +242,7 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
         // a's quadric: read or built only when the error or a second target needs it.
         let qa = |flags: &[u8], tris: &[[I; 3]]| match fresh {
             Some(q) => q,
-            None => quadrics.of(frame, tris, adj, flags, &*border_next, a),
+            None => quadrics.of::<I, L, W>(frame, tris, adj, flags, &*border_next, a),
         };
         let e = if limit.is_finite() {
             price.error(&qa(&*flags, &*tris), c)

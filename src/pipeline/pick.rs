@@ -59,7 +59,7 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
                 to = b;
             }
         } else if free(ka) || border {
-            let q = quadrics.of(frame, triangles, adj, flags, border_next, a);
+            let q = quadrics.of::<I, L, W>(frame, triangles, adj, flags, border_next, a);
             let pa = frame.at(a);
             let mut offer = |b: usize| {
                 let e = quadric::point_error(&q, math::sub(frame.at(b), pa));
