@@ -25,7 +25,8 @@
 //!    the collapse (unit normals' dot below -0.9, as the shared checker).
 //!
 //! With wedges, after rule 1: the seam rule ([`along_seam`]), each of a's wedges must have a
-//! wedge of b to go to, from the removed triangle on its side.
+//! wedge of b to go to, from the removed triangle on its side; and with rule 2 the sliver
+//! preference ([`thinner`]), a texture's guard.
 //!
 //! A candidate over the error limit (its error, the price as a mean squared distance in the
 //! unit frame, above the limit's square) is never collapsed.
@@ -403,6 +404,9 @@ fn check<I: Index, L: Index, const W: bool>(
         if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
             return Err(Reject::NormalTurn);
         }
+        if W && thinner(abd, s, abc, [px, py, pa]) {
+            return Err(Reject::Sliver);
+        }
         let s = Survivor {
             t: t as u32,
             x: x as u32,
@@ -575,6 +579,22 @@ fn check<I: Index, L: Index, const W: bool>(
     }
     Ok(n_ab)
 }
+
+/// With wedges: whether a surviving triangle becomes a sliver, its quality (`4√3 · area /
+/// Σ edge²`) below [`MIN_QUALITY`] and lower than before. A thin triangle stretches the
+/// texture across it; the exact engine's sliver preference (`Config::min_quality`), kept to
+/// textured runs, where the positions-only bench found no gain in it.
+#[inline(never)]
+fn thinner(new: f32, s_new: f32, old: f32, [px, py, pa]: [V3; 3]) -> bool {
+    let (ex, ey, exy) = (math::sub(px, pa), math::sub(py, pa), math::sub(px, py));
+    let s_old = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
+    // quality² = 12 |n|² / s², compared without a division.
+    let limit = MIN_QUALITY * MIN_QUALITY / 12.0;
+    new < limit * s_new * s_new && new * s_old * s_old < old * s_new * s_new
+}
+
+/// See [`thinner`]: `Config::new()`'s `min_quality`.
+const MIN_QUALITY: f32 = 0.05;
 
 /// Triangle `t`'s wedges at slots `k` and `j`.
 #[inline]
