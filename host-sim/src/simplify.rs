@@ -527,25 +527,7 @@ pub fn simplify_pipeline(
     weld: bool,
     mode: Pipeline,
 ) -> Result<(MeshData, Report, Duration)> {
-    let mut tris = mesh.triangles.clone();
-    let mut order = vec![0u32; if weld { mesh.positions.len() } else { 0 }];
-    let mut wedges = vec![[0u32; 3]; if weld { tris.len() } else { 0 }];
-    let start = Instant::now();
-    if weld && shares_positions(&mesh.positions) {
-        tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
-            .map_err(library_error)?;
-    }
-    let report = pipeline_run(mode, &mesh.positions, &mut tris, config).map_err(library_error)?;
-    let elapsed = start.elapsed();
-    tris.truncate(report.triangles_out);
-    Ok((
-        MeshData {
-            positions: mesh.positions.clone(),
-            triangles: tris,
-        },
-        report,
-        elapsed,
-    ))
+    pipeline_welded(mesh, config, mode, weld, false)
 }
 
 /// The library call `FastWorkspace::simplify` on `triangles` as they are (any index type), on
@@ -616,18 +598,30 @@ pub fn simplify_pipeline_wedges(
     config: &Config,
     mode: Pipeline,
 ) -> Result<(MeshData, Report, Duration)> {
+    pipeline_welded(mesh, config, mode, true, true)
+}
+
+/// The pipeline in `mode` on `mesh`, welded by position first when `weld` and the mesh has
+/// seams, with the wedges kept (the output in the input's numbering) when `keep_wedges`, else
+/// in the welded numbering.
+fn pipeline_welded(
+    mesh: &MeshData,
+    config: &Config,
+    mode: Pipeline,
+    weld: bool,
+    keep_wedges: bool,
+) -> Result<(MeshData, Report, Duration)> {
     let mut tris = mesh.triangles.clone();
-    let mut order = vec![0u32; mesh.positions.len()];
-    let mut wedges = vec![[0u32; 3]; tris.len()];
+    let mut order = vec![0u32; if weld { mesh.positions.len() } else { 0 }];
+    let mut wedges = vec![[0u32; 3]; if weld { tris.len() } else { 0 }];
     let start = Instant::now();
-    let report = if shares_positions(&mesh.positions) {
+    let welded = weld && shares_positions(&mesh.positions);
+    if welded {
         tinydecimate::seam::weld(&mesh.positions, &mut tris, &mut wedges, &mut order)
             .map_err(library_error)?;
-        run_on(mode, &mesh.positions, &mut tris, Some(&mut wedges), config)
-    } else {
-        run_on(mode, &mesh.positions, &mut tris, None, config)
     }
-    .map_err(library_error)?;
+    let wedges = (welded && keep_wedges).then_some(wedges.as_mut_slice());
+    let report = run_on(mode, &mesh.positions, &mut tris, wedges, config).map_err(library_error)?;
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     Ok((

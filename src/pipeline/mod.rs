@@ -406,25 +406,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
-        let nv = positions.len();
-        let arrays = Arrays {
-            first: &mut self.first,
-            border_next: &mut self.border_next,
-            target: &mut self.target,
-            cost: &mut self.cost,
-            order: &mut self.order,
-            flags: &mut self.flags,
-            lists: self.lists.as_flattened_mut(),
-            histogram: &mut self.histogram,
-        };
-        let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
-        run::<I, L, _, false>(
-            positions,
-            (triangles, &mut []),
-            config,
-            arrays,
-            fill::Stored(quadrics),
-        )
+        self.run::<I, false>(positions, (triangles, &mut []), config)
     }
 
     /// [`simplify`](Self::simplify) on a welded mesh with wedges ([`crate::seam`]):
@@ -449,6 +431,17 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         wedges: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
+        self.run::<I, true>(positions, (triangles, wedges), config)
+    }
+
+    /// The pipeline on this workspace's arrays, with wedges when `W`.
+    #[inline(always)]
+    fn run<I: Index, const W: bool>(
+        &mut self,
+        positions: &[[f32; 3]],
+        buffers: (&mut [[I; 3]], &mut [[I; 3]]),
+        config: &Config,
+    ) -> Result<Report, Error> {
         let nv = positions.len();
         let arrays = Arrays {
             first: &mut self.first,
@@ -461,13 +454,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             histogram: &mut self.histogram,
         };
         let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
-        run::<I, L, _, true>(
-            positions,
-            (triangles, wedges),
-            config,
-            arrays,
-            fill::Stored(quadrics),
-        )
+        run::<I, L, _, W>(positions, buffers, config, arrays, fill::Stored(quadrics))
     }
 }
 
@@ -528,17 +515,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
-        let arrays = Arrays {
-            first: &mut self.first,
-            border_next: &mut [],
-            target: &mut self.target,
-            cost: &mut self.cost,
-            order: &mut self.order,
-            flags: &mut self.flags,
-            lists: self.lists.as_flattened_mut(),
-            histogram: &mut self.histogram,
-        };
-        run::<I, L, _, false>(positions, (triangles, &mut []), config, arrays, fill::Fans)
+        self.run::<I, false>(positions, (triangles, &mut []), config)
     }
 
     /// [`FastWorkspace::simplify_with_wedges`] in the lean mode: a welded mesh with wedges,
@@ -551,6 +528,17 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
         wedges: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
+        self.run::<I, true>(positions, (triangles, wedges), config)
+    }
+
+    /// The pipeline on this workspace's arrays, with wedges when `W`.
+    #[inline(always)]
+    fn run<I: Index, const W: bool>(
+        &mut self,
+        positions: &[[f32; 3]],
+        buffers: (&mut [[I; 3]], &mut [[I; 3]]),
+        config: &Config,
+    ) -> Result<Report, Error> {
         let arrays = Arrays {
             first: &mut self.first,
             border_next: &mut [],
@@ -561,7 +549,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
             lists: self.lists.as_flattened_mut(),
             histogram: &mut self.histogram,
         };
-        run::<I, L, _, true>(positions, (triangles, wedges), config, arrays, fill::Fans)
+        run::<I, L, _, W>(positions, buffers, config, arrays, fill::Fans)
     }
 }
 
