@@ -15,6 +15,8 @@
 //!   pipeline's `simplify_with_wedges`, both modes, on the grids above, on a chart one column
 //!   wide between two and on a seam that ends inside: the target reached with no crack, no
 //!   wedge of a kept position lost, no triangle across two charts.
+//! * `no_chart_loses_its_last_triangle`: islands of one, two and eight triangles of their own
+//!   chart inside a grid all survive, in both engines.
 #![cfg(feature = "seams")]
 
 mod common;
@@ -406,6 +408,110 @@ fn the_pipeline_keeps_seams_closed_and_charts_whole() {
 
 /// The pipeline's wedge buffer, refused before either buffer is touched: shorter than the
 /// triangles, or naming a vertex past the positions.
+/// A wavy `n` x `n` grid with islands of their own chart (a material's region, or a texture
+/// chart, inside another): one triangle, one quad (two triangles) and a 2 x 2 block of quads,
+/// each island's triangles on their own copies of its vertices. Returns the mesh and each
+/// triangle's chart (0 the grid, 1 to 3 the islands).
+fn islands(n: u32) -> (MeshData, Vec<u8>) {
+    let g = grid(n, n, 0.25);
+    let cell = |i: u32, j: u32| 2 * (j * n + i) as usize;
+    let mut island = vec![0u8; g.triangles.len()];
+    island[cell(n / 4, n / 4)] = 1;
+    island[cell(3 * n / 4, n / 4)] = 2;
+    island[cell(3 * n / 4, n / 4) + 1] = 2;
+    for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        island[cell(n / 2 + i, 3 * n / 4 + j)] = 3;
+        island[cell(n / 2 + i, 3 * n / 4 + j) + 1] = 3;
+    }
+    let mut m = MeshData {
+        positions: g.positions.clone(),
+        triangles: Vec::new(),
+    };
+    let mut copy = std::collections::HashMap::new();
+    for (t, &c) in g.triangles.iter().zip(&island) {
+        m.triangles.push(t.map(|v| {
+            if c == 0 {
+                return v;
+            }
+            *copy.entry((c, v)).or_insert_with(|| {
+                m.positions.push(g.positions[v as usize]);
+                m.positions.len() as u32 - 1
+            })
+        }));
+    }
+    (m, island)
+}
+
+/// A chart's last triangle is never collapsed away (the `seam` rule, both engines): islands of
+/// one, two and eight triangles inside a grid all keep a triangle at 25 % and 5 %, each
+/// output triangle on one chart, the output valid welded with no wedge of a kept position
+/// lost. This is what keeps every material when `host-sim simplify` joins a glTF mesh's
+/// primitives. (With the chart clause of either engine's seam rule removed, the one-triangle
+/// island goes.)
+#[test]
+fn no_chart_loses_its_last_triangle() {
+    let (m, island) = islands(24);
+    let chart_of_vertex = {
+        let mut c = vec![0u8; m.positions.len()];
+        for (t, &i) in m.triangles.iter().zip(&island) {
+            for &v in t {
+                c[v as usize] = c[v as usize].max(i);
+            }
+        }
+        c
+    };
+    let judge = |out: &MeshData, what: &str| {
+        let v = welded_verdict(&m, out);
+        v.assert_valid(what);
+        assert_eq!(v.lost_wedges, 0, "{what}: wedges of kept positions lost");
+        let mut kept = BTreeSet::new();
+        for t in &out.triangles {
+            let c: BTreeSet<u8> = t.iter().map(|&x| chart_of_vertex[x as usize]).collect();
+            // An island triangle has every corner on the island's copies.
+            let c = if c.len() == 1 { *c.first().unwrap() } else { 0 };
+            kept.insert(c);
+        }
+        for i in 1..=3 {
+            assert!(kept.contains(&i), "{what}: island {i} is gone");
+        }
+    };
+    for ratio in [0.25, 0.05] {
+        let (out, report) = simplify_welded(&m, ratio, SeamCorners::Lock);
+        judge(&out, &format!("exact engine at {ratio}: {report:?}"));
+    }
+    #[cfg(feature = "fast")]
+    {
+        use std::sync::Mutex;
+        use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+        static FAST: Mutex<FastWorkspace<u32, 4096, 4096>> = Mutex::new(FastWorkspace::new());
+        static LEAN: Mutex<LeanWorkspace<u32, 4096, 4096>> = Mutex::new(LeanWorkspace::new());
+        for lean in [false, true] {
+            for ratio in [0.25, 0.05] {
+                let mut tris = m.triangles.clone();
+                let mut wedges = vec![[0u32; 3]; tris.len()];
+                let mut order = vec![0u32; m.positions.len()];
+                seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
+                let config = Config::new().with_ratio(ratio);
+                let report = if lean {
+                    LEAN.lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+                } else {
+                    FAST.lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+                }
+                .expect("simplify");
+                let (out, report) = output(&m.positions, tris, report);
+                judge(
+                    &out,
+                    &format!("pipeline, lean {lean}, at {ratio}: {report:?}"),
+                );
+            }
+        }
+    }
+}
+
 #[cfg(feature = "fast")]
 #[test]
 fn the_pipeline_refuses_bad_wedges_untouched() {

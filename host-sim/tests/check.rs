@@ -294,10 +294,11 @@ fn two_material_obj(n: usize) -> String {
     o
 }
 
-/// `simplify` simplifies and judges a model with material groups group by group; `check`
-/// judges it the same way, so simplify's default output passes, and it says that the groups'
-/// shared border opened when judged as one surface. Before, `check` welded the groups into
-/// one surface and exited 1 on that border. A group broken on its own still fails.
+/// `simplify` simplifies a model's material groups together and judges them as one surface;
+/// `check` judges it the same way, so simplify's default output passes. With
+/// `--per-primitive` each group is simplified on its own: their shared border opens, which
+/// `check` then calls a defect, and `check --per-primitive` judges each group on its own, as
+/// that run did, saying that the border opened. A group broken on its own fails either way.
 #[test]
 fn material_groups_are_judged_as_simplify_judges_them() {
     let d = tempfile::tempdir().unwrap();
@@ -306,13 +307,31 @@ fn material_groups_are_judged_as_simplify_judges_them() {
     std::fs::write(d.path().join("m.mtl"), "newmtl a\nnewmtl b\n").unwrap();
     let out = d.path().join("out.obj");
     let o = run(&["simplify", s(&input), s(&out), "--ratio", "0.1"]);
-    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stdout));
-    assert!(
-        text(&o.stdout).contains("material a"),
-        "{}",
-        text(&o.stdout)
-    );
+    let so = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{so}");
+    assert!(so.contains("all 2 material groups"), "{so}");
+    assert!(so.contains("0 of them new"), "{so}");
     let c = run(&["check", s(&input), s(&out)]);
+    let co = text(&c.stdout);
+    assert_eq!(c.status.code(), Some(0), "{co}");
+
+    let apart = d.path().join("apart.obj");
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&apart),
+        "--ratio",
+        "0.1",
+        "--per-primitive",
+    ]);
+    let so = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{so}");
+    assert!(so.contains("material a"), "{so}");
+    assert!(so.contains("(gaps between parts)"), "{so}");
+    let c = run(&["check", s(&input), s(&apart)]);
+    let co = text(&c.stdout);
+    assert_eq!(c.status.code(), Some(1), "{co}");
+    let c = run(&["check", s(&input), s(&apart), "--per-primitive"]);
     let co = text(&c.stdout);
     assert_eq!(c.status.code(), Some(0), "{co}");
     assert!(co.contains("each of the 2 parts on its own"), "{co}");
@@ -323,12 +342,18 @@ fn material_groups_are_judged_as_simplify_judges_them() {
     assert!(co.contains("borders between parts opened"), "{co}");
 
     // Group b with a triangle repeated: that group is invalid, and so is the file.
-    let bad = d.path().join("bad.obj");
-    let written = std::fs::read_to_string(&out).unwrap();
-    let last_face = written.lines().rev().find(|l| l.starts_with("f ")).unwrap();
-    std::fs::write(&bad, format!("{written}{last_face}\n")).unwrap();
-    let c = run(&["check", s(&input), s(&bad)]);
-    let co = text(&c.stdout);
-    assert_eq!(c.status.code(), Some(1), "{co}");
-    assert!(co.contains("material b: NOT valid"), "{co}");
+    for (simplified, extra) in [(&out, None), (&apart, Some("--per-primitive"))] {
+        let bad = d.path().join("bad.obj");
+        let written = std::fs::read_to_string(simplified).unwrap();
+        let last_face = written.lines().rev().find(|l| l.starts_with("f ")).unwrap();
+        std::fs::write(&bad, format!("{written}{last_face}\n")).unwrap();
+        let mut a = vec!["check", s(&input), s(&bad)];
+        a.extend(extra);
+        let c = run(&a);
+        let co = text(&c.stdout);
+        assert_eq!(c.status.code(), Some(1), "{co}");
+        if extra.is_some() {
+            assert!(co.contains("material b: NOT valid"), "{co}");
+        }
+    }
 }

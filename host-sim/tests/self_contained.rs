@@ -56,7 +56,7 @@ fn every_fixture_mesh_has_its_source() {
     let mut meshes = 0;
     for e in std::fs::read_dir(&dir).unwrap() {
         let name = e.unwrap().file_name().to_string_lossy().into_owned();
-        if name.ends_with(".obj") {
+        if name.ends_with(".obj") || name.ends_with(".glb") {
             meshes += 1;
             assert!(
                 sources.contains(&format!("`{name}`")),

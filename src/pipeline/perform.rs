@@ -25,8 +25,9 @@
 //!    the collapse (unit normals' dot below -0.9, as the shared checker).
 //!
 //! With wedges, after rule 1: the seam rule ([`along_seam`]), each of a's wedges must have a
-//! wedge of b to go to, from the removed triangle on its side; and with rule 2 the sliver
-//! preference ([`thinner`]), a texture's guard.
+//! wedge of b to go to, from the removed triangle on its side, and neither removed triangle
+//! may be the last of its chart ([`last_of_chart`]); and with rule 2 the sliver preference
+//! ([`thinner`]), a texture's guard.
 //!
 //! A candidate over the error limit (its error, the price as a mean squared distance in the
 //! unit frame, above the limit's square) is never collapsed.
@@ -368,6 +369,7 @@ fn check<I: Index, L: Index, const W: bool>(
     let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
     // With wedges: the removed triangles' (a wedge, b wedge), on the o1 and o2 sides.
     let mut sides = [(NONE, NONE); 2];
+    let mut removed = [NONE; 2];
     for (t, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
@@ -379,6 +381,7 @@ fn check<I: Index, L: Index, const W: bool>(
             n_ab += 1;
             if W {
                 sides[0] = wedge_pair(corners, t, k, (k + 1) % 3);
+                removed[0] = t;
             }
             continue;
         }
@@ -387,6 +390,7 @@ fn check<I: Index, L: Index, const W: bool>(
             n_ab += 1;
             if W {
                 sides[1] = wedge_pair(corners, t, k, (k + 2) % 3);
+                removed[1] = t;
             }
             continue;
         }
@@ -437,6 +441,13 @@ fn check<I: Index, L: Index, const W: bool>(
     }
     if W && const { on(RULE_SEAM) } && !along_seam(corners, tris, fan_a, a, sides) {
         return Err(Reject::Seam);
+    }
+    if W && const { on(RULE_SEAM) } && flags_of(flags, a) & flag::SEAM != 0 {
+        for (t, o) in removed.into_iter().zip([o1, o2]) {
+            if t != NONE && last_of_chart(tris, corners, adj, flags, t, (a, b, o)) {
+                return Err(Reject::Seam);
+            }
+        }
     }
 
     // 3. Link condition by marks; duplicates; b's triangles across b-o1 and b-o2.
@@ -642,6 +653,38 @@ fn along_seam<I: Index>(
         let x = wedge_pair(corners, t, k, k).0;
         moved_wedge(x, sides) != NONE
     })
+}
+
+/// With wedges: whether removed triangle `t` (`a`, `b`, `o`) is the last of its chart: no
+/// live triangle across its edge b-o or a-o shares both wedges of that edge (edge a-b joins
+/// only the other removed triangle). A collapse along a seam would take the chart whole: the
+/// last piece of a texture chart, or of a material when a mesh's primitives are joined. Only
+/// a seam vertex can remove one (a vertex inside a chart has chart neighbours in its fan), and
+/// `a` and `b` have not moved in this pass, so their fan lists are whole.
+#[inline(never)]
+fn last_of_chart<I: Index, L: Index>(
+    tris: &[[I; 3]],
+    corners: &[[I; 3]],
+    adj: (&[L], &[L]),
+    flags: &[u8],
+    t: usize,
+    (a, b, o): (usize, usize, usize),
+) -> bool {
+    let wedge = |s: usize, v: usize| {
+        let k = slot(tri(tris, s), v)?;
+        corners.get(s)?.get(k).map(|x| x.to_usize())
+    };
+    let joined = [(b, o, a), (a, o, b)].into_iter().any(|(u, v, w)| {
+        fan(tris, adj, flags, u).any(|(s, tr, _)| {
+            s != t
+                && !dead(tr)
+                && slot(tr, v).is_some()
+                && slot(tr, w).is_none()
+                && wedge(s, u) == wedge(t, u)
+                && wedge(s, v) == wedge(t, v)
+        })
+    });
+    !joined
 }
 
 /// With wedges, before `a → b` rewrites the positions: each of a's surviving corners takes

@@ -239,7 +239,8 @@ pub const RULES: &[Rule] = &[
         name: "seam",
         protects: "with welded seams (crate::seam): a on a seam (its wedge changes across one \
                    or two spokes) moves only along that seam, so the seam keeps its shape and \
-                   no triangle takes corners from both sides (welded runs only)",
+                   no triangle takes corners from both sides, and never takes a chart's (a \
+                   material's) last triangle (welded runs only)",
         kind: Kind::Quality,
         source: "meshoptimizer's vertex kinds (a Seam vertex collapses along its seam)",
     },
@@ -793,9 +794,46 @@ fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> 
     // A boundary fan's wedges are one more than its changes, a disc's as many.
     let wedges = changes + usize::from(mesh.has(a, flag::BOUNDARY));
     if wedges > 2 {
-        return !mesh.lock_corners;
+        return !mesh.lock_corners && !removes_a_chart(mesh, a, b);
     }
-    wedges != 2 || onto_b
+    (wedges != 2 || onto_b) && (wedges < 2 || !removes_a_chart(mesh, a, b))
+}
+
+/// Welded seams: whether a triangle the collapse `a -> b` removes is the last of its chart
+/// (the triangles joined to it across edges where both ends keep their wedges): no
+/// surviving triangle across any of its edges shares both wedges of that edge. Such a
+/// triangle is the last piece of a texture chart or of a material (a material boundary is a
+/// seam, `host-sim simplify` joins a mesh's primitives), and a collapse along a seam would
+/// take it whole. Only a vertex with two or more wedges can remove one: inside a chart the
+/// removed triangles have chart neighbours in `a`'s fan.
+#[cfg(feature = "seams")]
+fn removes_a_chart<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
+    let wedge = |t: usize, v: usize| {
+        let k = mesh.tri(t).iter().position(|&x| x == v)?;
+        mesh.wedges.get(t)?.get(k).map(|x| x.to_usize())
+    };
+    mesh.corners(a).any(|(t, k)| {
+        let tri = mesh.tri(t);
+        let (x, y) = crate::tri::others(tri, k);
+        let o = if x == b {
+            y
+        } else if y == b {
+            x
+        } else {
+            return false;
+        };
+        // Edge a-b joins only the other removed triangle, which goes too.
+        let joined = [(b, o), (a, o)].into_iter().any(|(u, v)| {
+            mesh.corners(u).any(|(s, _)| {
+                s != t
+                    && mesh.tri(s).contains(&v)
+                    && !mesh.tri(s).contains(&if u == a { b } else { a })
+                    && wedge(s, u) == wedge(t, u)
+                    && wedge(s, v) == wedge(t, v)
+            })
+        });
+        !joined
+    })
 }
 
 /// [`check`] for `b` moved to `at` (optimal placement), then the rules on `b`'s own

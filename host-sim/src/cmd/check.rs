@@ -31,6 +31,12 @@ pub struct Args {
     /// that is gone whole; `keep` counts it as a changed number of components.
     #[arg(long, value_enum, default_value_t = PartsArg::Prune)]
     pub parts: PartsArg,
+    /// As `simplify --per-primitive`: judge each glTF primitive (each OBJ material group with
+    /// attributes) on its own, as such a run simplified them, with the whole surface's verdict
+    /// beside it. Without it the file is judged as one surface, as `simplify` simplifies the
+    /// parts of a mesh together: a border between parts that opened is a defect.
+    #[arg(long)]
+    pub per_primitive: bool,
 }
 
 /// `host-sim check`: topology of both meshes and the validity; exit code 1 if invalid.
@@ -44,10 +50,14 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
     };
     let (b, note, v) = verdict(&a, &b, promise)?;
     let (ta, tb) = (analyse(&a), analyse(&b));
-    // A file of several parts (glTF primitives, OBJ material groups with attributes) is
-    // simplified and judged part by part by `simplify`, so `check` judges it the same way; the
-    // whole surface's verdict is reported beside it, since borders between parts can open.
-    let parts = part_verdicts(&args.original, &args.simplified, promise)?;
+    // A file of several parts (glTF primitives, OBJ material groups with attributes) that
+    // `simplify --per-primitive` simplified part by part is judged the same way; the whole
+    // surface's verdict is reported beside it, since borders between parts open then.
+    let parts = if args.per_primitive {
+        part_verdicts(&args.original, &args.simplified, promise)?
+    } else {
+        None
+    };
     let valid = match &parts {
         Some(ps) => ps.iter().all(|p| p.validity.is_valid()),
         None => v.is_valid(),
@@ -87,7 +97,8 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
             None => crate::outln!("validity ({}):\n{v}", against(promise)),
             Some(ps) => {
                 crate::outln!(
-                    "validity, each of the {} parts on its own as simplify judges them ({}):",
+                    "validity, each of the {} parts on its own as simplify --per-primitive \
+                     judges them ({}):",
                     ps.len(),
                     against(promise)
                 );
@@ -106,7 +117,7 @@ pub fn run(args: &Args) -> anyhow::Result<std::process::ExitCode> {
                     "valid".to_string()
                 } else {
                     format!(
-                        "{} defects, where borders between parts opened: each part is \
+                        "{} defects, where borders between parts opened: each part was \
                          simplified on its own",
                         v.defects.len()
                     )

@@ -412,6 +412,13 @@ pub struct Args {
     /// every split vertex is its own, hard edges too.
     #[arg(long, value_enum, default_value_t = HardEdgesArg::Weld)]
     pub hard_edges: HardEdgesArg,
+    /// Simplify each glTF primitive (each OBJ material group) on its own, the target shared in
+    /// proportion to their triangles. Without it the primitives of one glTF mesh (the groups
+    /// of one OBJ) are simplified together in one run: with `--seams weld` a boundary between
+    /// two materials is a seam, both sides move together along it and each triangle keeps its
+    /// material, so no gap opens between them; the target applies to the mesh as a whole.
+    #[arg(long)]
+    pub per_primitive: bool,
     /// Parts (connected components): `prune` removes a part whole once it costs less than the
     /// collapse about to be made, and short of the target with no collapse left the smallest
     /// parts, never the last (the exact engine's default; greedy schedule without

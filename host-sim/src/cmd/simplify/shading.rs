@@ -52,6 +52,30 @@ impl Shading {
         }
     }
 
+    /// Parts' groupings side by side, each part's vertices numbered after the previous
+    /// part's (as [`super::textured`] joins the parts of one mesh): no key is shared across
+    /// parts, so a vertex is only ever renamed within its own part (its own material).
+    pub fn concat(parts: &[&Shading]) -> Shading {
+        let mut out = Shading {
+            rep: Vec::new(),
+            members: Vec::new(),
+            normals: parts.iter().all(|s| s.normals.is_some()).then(Vec::new),
+        };
+        for s in parts {
+            let offset = out.rep.len() as u32;
+            out.rep.extend(s.rep.iter().map(|&r| r + offset));
+            out.members.extend(
+                s.members
+                    .iter()
+                    .map(|m| m.iter().map(|&v| v + offset).collect()),
+            );
+            if let (Some(all), Some(n)) = (&mut out.normals, &s.normals) {
+                all.extend_from_slice(n);
+            }
+        }
+        out
+    }
+
     /// Whether any two vertices share a key (otherwise there is nothing to weld).
     pub fn welds(&self) -> bool {
         self.rep.iter().enumerate().any(|(i, &r)| r as usize != i)

@@ -2,11 +2,19 @@
 //! with `vt`/`vn` ([`crate::io::objattr`]) and PLY with vertex properties besides x, y, z
 //! ([`crate::io::plyattr`]).
 //!
-//! Each part (a glTF triangle primitive, an OBJ material group) is simplified on its own with
-//! the same configuration; `--target-triangles N` is shared among the parts in proportion to
-//! their triangles. The validity check (and with `--measure` the Metro error and the texture
-//! figures) runs per part, in the part's own coordinates (node transforms are not applied);
-//! the result is valid when every part is.
+//! The primitives of one glTF mesh (the material groups of one OBJ) are simplified together,
+//! as one mesh ([`join`]): their vertices side by side, so that with welded seams a boundary
+//! between two materials is a seam like a texture's, whose two sides move together and keep
+//! their own attributes, and each output triangle is handed back to the part its corners came
+//! from ([`split`]). `--per-primitive` simplifies each part on its own instead, with the same
+//! configuration, and a boundary between materials then moves separately on each side (the
+//! gaps meshoptimizer's and gltfpack's per-primitive runs open). `--target-triangles N` is
+//! shared among the runs in proportion to their triangles. The validity check (and with
+//! `--measure` the Metro error and the texture figures) runs per run, in the mesh's own
+//! coordinates (node transforms are not applied); the result is valid when every run's is.
+//! For each glTF mesh (OBJ file) of several parts the report gives its open edges welded by
+//! position across all its parts, the input's and the result's ([`gaps`]): a gap between
+//! materials shows there.
 //! The attributes of every kept vertex are those of an input vertex, bit for bit, because the
 //! library's subset placement only moves triangles. Optimal placement moves vertices without
 //! interpolating attributes, so `--placement optimal` is refused here.
@@ -164,7 +172,7 @@ fn run_ply(args: &Args, bytes: &[u8], extra: &[String], t0: Instant) -> Result<E
         file.mesh.triangles.len(),
         done[0].triangles.len()
     );
-    finish(args, head, &done, times)
+    finish(args, head, &done, &[], times)
 }
 
 fn refuse_optimal(args: &Args) -> Result<()> {
@@ -332,6 +340,148 @@ fn simplify_parts(
     Ok(out)
 }
 
+/// The parts of one run: indices into the file's parts, and where each part's vertices start
+/// in the joined numbering.
+struct Group {
+    members: Vec<usize>,
+    offsets: Vec<u32>,
+}
+
+/// The runs for `parts`: with `--per-primitive` (or one part) each part alone, else the parts
+/// of each key (`key_of`: a glTF primitive's mesh) together, in order of first appearance.
+fn groups(args: &Args, parts: &[Input], key_of: impl Fn(usize) -> usize) -> Vec<Group> {
+    let mut out: Vec<(usize, Group)> = Vec::new();
+    for i in 0..parts.len() {
+        let key = key_of(i);
+        let group = match out
+            .iter_mut()
+            .find(|(k, _)| !args.per_primitive && *k == key)
+        {
+            Some((_, g)) => g,
+            None => {
+                out.push((
+                    key,
+                    Group {
+                        members: Vec::new(),
+                        offsets: Vec::new(),
+                    },
+                ));
+                &mut out.last_mut().expect("just pushed").1
+            }
+        };
+        let start = group
+            .members
+            .last()
+            .zip(group.offsets.last())
+            .map_or(0, |(&m, &o)| o + parts[m].1.positions.len() as u32);
+        group.members.push(i);
+        group.offsets.push(start);
+    }
+    out.into_iter().map(|(_, g)| g).collect()
+}
+
+/// One run's input: the group's parts side by side (each part's vertices numbered after the
+/// previous part's), labelled `label`; texture coordinates, hard-edge groupings and normals
+/// when every part has them. A single part is itself.
+fn join(
+    label: String,
+    group: &Group,
+    parts: &[Input],
+    normals: &[Option<Vec<[f32; 3]>>],
+) -> (Input, Option<Vec<[f32; 3]>>) {
+    if let [k] = group.members[..] {
+        return (parts[k].clone(), normals.get(k).cloned().flatten());
+    }
+    let members: Vec<&Input> = group.members.iter().map(|&k| &parts[k]).collect();
+    let mut mesh = MeshData::default();
+    for ((_, m, _, _), &offset) in members.iter().zip(&group.offsets) {
+        mesh.positions.extend_from_slice(&m.positions);
+        mesh.triangles
+            .extend(m.triangles.iter().map(|t| t.map(|i| i + offset)));
+    }
+    let uvs = members
+        .iter()
+        .map(|(_, _, uv, _)| uv.as_ref())
+        .collect::<Option<Vec<_>>>()
+        .map(|u| u.iter().flat_map(|v| v.iter().copied()).collect());
+    let shading = members
+        .iter()
+        .map(|(_, _, _, s)| s.as_ref())
+        .collect::<Option<Vec<_>>>()
+        .map(|s| Shading::concat(&s));
+    let normals = group
+        .members
+        .iter()
+        .map(|&k| normals.get(k).and_then(Option::as_ref))
+        .collect::<Option<Vec<_>>>()
+        .map(|n| n.iter().flat_map(|v| v.iter().copied()).collect());
+    ((label, mesh, uvs, shading), normals)
+}
+
+/// A run's result handed back to its parts, each in its own numbering: a triangle goes to the
+/// part of its corners. An error if a triangle's corners come from two parts (a triangle
+/// that would take two materials, which the seam rules never make).
+fn split(group: &Group, parts: &[Input], triangles: &[[u32; 3]]) -> Result<Vec<Vec<[u32; 3]>>> {
+    let mut out = vec![Vec::new(); group.members.len()];
+    let part_of = |v: u32| group.offsets.iter().rposition(|&o| o <= v).unwrap_or(0);
+    for t in triangles {
+        let k = part_of(t[0]);
+        if part_of(t[1]) != k || part_of(t[2]) != k {
+            bail!(
+                "a result triangle {t:?} takes corners from two of {}'s parts",
+                parts[group.members[0]].0
+            );
+        }
+        out[k].push(t.map(|v| v - group.offsets[k]));
+    }
+    Ok(out)
+}
+
+/// Open edges (used by one triangle) of a mesh's parts welded by position, and how many of
+/// them the input did not have: an edge whose two ends were not both on the welded input's
+/// boundary. A gap between two materials opens such edges; simplifying a boundary the input
+/// had only shortens it.
+pub(crate) fn gaps(input: &[&MeshData], output: &[&MeshData]) -> (usize, usize, usize) {
+    use std::collections::HashMap;
+    let weld = |meshes: &[&MeshData], ids: &mut HashMap<[u32; 3], u32>| {
+        let mut edges: HashMap<(u32, u32), i32> = HashMap::new();
+        for m in meshes {
+            let id: Vec<u32> = m
+                .positions
+                .iter()
+                .map(|p| {
+                    let n = ids.len() as u32;
+                    *ids.entry(p.map(f32::to_bits)).or_insert(n)
+                })
+                .collect();
+            for t in &m.triangles {
+                let w = t.map(|v| id[v as usize]);
+                for k in 0..3 {
+                    let (a, b) = (w[k], w[(k + 1) % 3]);
+                    if a != b {
+                        *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+                    }
+                }
+            }
+        }
+        edges
+            .into_iter()
+            .filter(|&(_, n)| n == 1)
+            .map(|(e, _)| e)
+            .collect::<Vec<_>>()
+    };
+    let mut ids = HashMap::new();
+    let open_in = weld(input, &mut ids);
+    let on_border: std::collections::HashSet<u32> =
+        open_in.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let open_out = weld(output, &mut ids);
+    let new = open_out
+        .iter()
+        .filter(|(a, b)| !(on_border.contains(a) && on_border.contains(b)))
+        .count();
+    (open_in.len(), open_out.len(), new)
+}
+
 /// The texture figures ([`crate::uvstretch`]: UV stretch, texture deviation, triangles torn
 /// between charts) of the input, the result and meshoptimizer's `simplify` at the result's
 /// triangle count: on the input's vertices as the file has them, and, when `keyed` is given
@@ -450,7 +600,13 @@ impl Times {
     }
 }
 
-fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result<ExitCode> {
+fn finish(
+    args: &Args,
+    head: String,
+    parts: &[Part],
+    gaps: &[Gap],
+    mut times: Times,
+) -> Result<ExitCode> {
     for p in parts {
         times.library += p.library;
         times.welding += p.welding;
@@ -476,6 +632,12 @@ fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result
             "valid": valid,
             "fallback": fallback.as_ref().map(|f| [&f.0, &f.1]),
             "time": times.json(),
+            "welded_parts": gaps.iter().map(|g| serde_json::json!({
+                "mesh": g.mesh,
+                "open_edges_in": g.open.0,
+                "open_edges_out": g.open.1,
+                "new_open_edges": g.open.2,
+            })).collect::<Vec<_>>(),
         });
         if let [p] = parts {
             // One part: its report where the plain path puts it.
@@ -486,6 +648,16 @@ fn finish(args: &Args, head: String, parts: &[Part], mut times: Times) -> Result
         let mut text = head;
         for p in parts {
             let _ = writeln!(text, "{}", p.line);
+        }
+        for g in gaps {
+            let (i, o, new) = g.open;
+            let _ = writeln!(
+                text,
+                "  {}, its parts welded by position: {i} open edges in, {o} out, {new} of them \
+                 new{}",
+                g.mesh,
+                if new > 0 { " (gaps between parts)" } else { "" }
+            );
         }
         if !args.measure {
             let _ = writeln!(text, "  {}", super::NOT_MEASURED);
@@ -543,8 +715,15 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         .iter()
         .map(super::attributes::gltf_normals)
         .collect();
-    let done = simplify_parts(args, &parts, &normals)?;
-    let results: Vec<Vec<[u32; 3]>> = done.iter().map(|p| p.triangles.clone()).collect();
+    let mesh_of = |k: usize| file.primitives[k].mesh;
+    let (done, results) = simplify_grouped(args, &parts, &normals, mesh_of, |g| {
+        format!(
+            "mesh {} ({} primitives)",
+            mesh_of(g.members[0]),
+            g.members.len()
+        )
+    })?;
+    let gaps = gap_figures(&parts, &results, mesh_of, |m| format!("mesh {m}"));
     let t0 = Instant::now();
     let kept = if gltf_out(args) {
         if args.format == Some(super::OutputFormat::Glb) {
@@ -584,7 +763,71 @@ fn run_gltf(args: &Args) -> Result<ExitCode> {
         args.input.display(),
         args.output.display(),
     );
-    finish(args, head, &done, times)
+    finish(args, head, &done, &gaps, times)
+}
+
+/// Each part's result triangles, in its own numbering.
+type PerPart = Vec<Vec<[u32; 3]>>;
+
+/// [`simplify_parts`] on the runs [`groups`] makes of `parts` (`key_of`: the mesh a part
+/// belongs to; `label`: a joined run's name), and each part's triangles in its own numbering.
+fn simplify_grouped(
+    args: &Args,
+    parts: &[Input],
+    normals: &[Option<Vec<[f32; 3]>>],
+    key_of: impl Fn(usize) -> usize,
+    label: impl Fn(&Group) -> String,
+) -> Result<(Vec<Part>, PerPart)> {
+    let groups = groups(args, parts, key_of);
+    let (runs, run_normals): (Vec<Input>, Vec<_>) = groups
+        .iter()
+        .map(|g| join(label(g), g, parts, normals))
+        .unzip();
+    let done = simplify_parts(args, &runs, &run_normals)?;
+    let mut results = vec![Vec::new(); parts.len()];
+    for (g, d) in groups.iter().zip(&done) {
+        for (&k, tris) in g.members.iter().zip(split(g, parts, &d.triangles)?) {
+            results[k] = tris;
+        }
+    }
+    Ok((done, results))
+}
+
+/// One mesh's [`gaps`] figure: its name, open edges in, out and new.
+struct Gap {
+    mesh: String,
+    open: (usize, usize, usize),
+}
+
+/// [`gaps`] of every mesh (`key_of`) with more than one part, `name` naming it.
+fn gap_figures(
+    parts: &[Input],
+    results: &[Vec<[u32; 3]>],
+    key_of: impl Fn(usize) -> usize,
+    name: impl Fn(usize) -> String,
+) -> Vec<Gap> {
+    let mut keys: Vec<usize> = (0..parts.len()).map(&key_of).collect();
+    keys.dedup();
+    let mut out = Vec::new();
+    for key in keys {
+        let members: Vec<usize> = (0..parts.len()).filter(|&k| key_of(k) == key).collect();
+        if members.len() < 2 {
+            continue;
+        }
+        let outputs: Vec<MeshData> = members
+            .iter()
+            .map(|&k| MeshData {
+                positions: parts[k].1.positions.clone(),
+                triangles: results[k].clone(),
+            })
+            .collect();
+        let input: Vec<&MeshData> = members.iter().map(|&k| &parts[k].1).collect();
+        out.push(Gap {
+            mesh: name(key),
+            open: gaps(&input, &outputs.iter().collect::<Vec<_>>()),
+        });
+    }
+    out
 }
 
 /// The texture coordinates primitive `p`'s material reads (`TEXCOORD_n` of its
@@ -641,18 +884,28 @@ fn run_obj(args: &Args, bytes: &[u8], t0: Instant) -> Result<ExitCode> {
         .filter(|&g| !file.groups[g].triangles.is_empty())
         .map(|g| super::attributes::obj_normals(&file, g))
         .collect();
-    let done = simplify_parts(args, &parts, &normals)?;
+    // One OBJ is one mesh: all its groups in one run.
+    let (done, kept) = simplify_grouped(
+        args,
+        &parts,
+        &normals,
+        |_| 0,
+        |g| format!("all {} material groups", g.members.len()),
+    )?;
+    let gaps = gap_figures(&parts, &kept, |_| 0, |_| "the file".to_string());
     let t0 = Instant::now();
-    let mut results = Vec::new();
-    let mut k = 0;
-    for g in &file.groups {
-        if g.triangles.is_empty() {
-            results.push(Vec::new());
-        } else {
-            results.push(done[k].triangles.clone());
-            k += 1;
-        }
-    }
+    let mut kept = kept.into_iter();
+    let results: Vec<Vec<[u32; 3]>> = file
+        .groups
+        .iter()
+        .map(|g| {
+            if g.triangles.is_empty() {
+                Vec::new()
+            } else {
+                kept.next().unwrap_or_default()
+            }
+        })
+        .collect();
     let text = crate::io::objattr::write(&file, &results);
     std::fs::write(&args.output, text)
         .map_err(|e| anyhow!("{}: cannot write: {e}", args.output.display()))?;
@@ -668,5 +921,5 @@ fn run_obj(args: &Args, bytes: &[u8], t0: Instant) -> Result<ExitCode> {
         file.vn_text.len(),
         parts.len()
     );
-    finish(args, head, &done, times)
+    finish(args, head, &done, &gaps, times)
 }
