@@ -239,9 +239,10 @@ mod tests {
     fn cases_round_trip_through_the_case_file() {
         for c in load_cases(&default_dir()).unwrap() {
             let bytes = c.encode().unwrap();
-            let (h, p, t) = meshfmt::file::decode_case(&bytes).unwrap();
+            let (h, p, t, w) = meshfmt::file::decode_case(&bytes).unwrap();
             assert_eq!(p, c.positions, "{}", c.name);
             assert_eq!(t, c.triangles, "{}", c.name);
+            assert_eq!(w, c.wedges, "{}", c.name);
             assert_eq!(meshfmt::lib::config(&h), c.config, "{}", c.name);
         }
     }

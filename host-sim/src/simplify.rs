@@ -562,6 +562,17 @@ pub fn pipeline_run<I: tinydecimate::Index>(
     run_on(mode, positions, triangles, None, config)
 }
 
+/// [`pipeline_run`] on a welded mesh with its wedges (`simplify_with_wedges`): the golden
+/// reference of a wedge case.
+pub fn pipeline_run_wedges<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[f32; 3]],
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    run_on(mode, positions, triangles, Some(wedges), config)
+}
+
 /// [`pipeline_run`] with `wedges` (`simplify_with_wedges`) when given.
 fn run_on<I: tinydecimate::Index>(
     mode: Pipeline,

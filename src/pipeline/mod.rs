@@ -70,9 +70,10 @@
 //! planes' weight (the quadric's trace): a weighted mean squared distance, a distance in the
 //! input's units once its root is taken.
 //!
-//! Welded seams: [`FastWorkspace::simplify_with_wedges`] (crate feature `seams` too) takes the
-//! triangles welded by position ([`crate::seam::weld`]) with the caller's wedges, and keeps
-//! both up to date: a vertex on a seam (two wedges in its fan) slides only along it, one where
+//! Welded seams: [`FastWorkspace::simplify_with_wedges`] takes the triangles welded by
+//! position (`seam::weld`, crate feature `seams`, or welded by a host ahead of time, as the
+//! golden wedge cases on the boards are) with the caller's wedges, and keeps both up to date:
+//! a vertex on a seam (two wedges in its fan) slides only along it, one where
 //! more than two meet never moves, and a moved corner takes its new vertex's wedge on its own
 //! side (meshoptimizer's seam kind and `remap`/`wedge` pair; the exact engine's
 //! [`Simplifier::with_wedges`](crate::Simplifier::with_wedges) with
@@ -409,8 +410,8 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
         self.run::<I, false>(positions, (triangles, &mut []), config)
     }
 
-    /// [`simplify`](Self::simplify) on a welded mesh with wedges ([`crate::seam`]):
-    /// `triangles` numbered by position (as [`crate::seam::weld`] leaves them) and `wedges`
+    /// [`simplify`](Self::simplify) on a welded mesh with wedges (`crate::seam`):
+    /// `triangles` numbered by position (as `seam::weld` leaves them) and `wedges`
     /// the same triangles as the caller's vertices (one entry per triangle). The seams move
     /// as one surface: a vertex where the wedge changes across two of its spokes slides only
     /// along that seam, one where more than two wedges meet (or two on a border) never moves,
@@ -419,11 +420,11 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     /// `report.triangles_out` entries of `triangles` hold the result as wedges (the caller's
     /// vertices); `wedges` is scratch.
     ///
-    /// Crate features `fast` and `seams`. Errors, before either buffer is touched: those of
+    /// Crate feature `fast` (`seam::weld` needs `seams`; a firmware may take cases welded by
+    /// a host instead). Errors, before either buffer is touched: those of
     /// [`simplify`](Self::simplify), and
     /// [`Error::Capacity`] (triangles) if `wedges` is shorter than `triangles`,
     /// [`Error::IndexOutOfRange`] for a wedge past `positions`.
-    #[cfg(feature = "seams")]
     pub fn simplify_with_wedges<I: Index>(
         &mut self,
         positions: &[[f32; 3]],
@@ -520,7 +521,6 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
 
     /// [`FastWorkspace::simplify_with_wedges`] in the lean mode: a welded mesh with wedges,
     /// the same contract and errors.
-    #[cfg(feature = "seams")]
     pub fn simplify_with_wedges<I: Index>(
         &mut self,
         positions: &[[f32; 3]],

@@ -181,6 +181,10 @@ pub const fn capacity(it: IndexType, entry: meshfmt::Entry) -> (usize, usize) {
         meshfmt::Entry::Fast | meshfmt::Entry::Lean => {
             (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t))
         }
+        // The wedges follow the triangles in the triangle buffer.
+        meshfmt::Entry::FastWedges | meshfmt::Entry::LeanWedges => {
+            (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t / 2))
+        }
         _ => (MAX_VERTICES, t),
     }
 }
@@ -214,9 +218,9 @@ pub struct TriangleBytes(pub [u8; TRIANGLE_BYTES]);
 #[cfg(feature = "lib")]
 pub type Workspace = tinydecimate::Workspace<Link, MAX_VERTICES, MAX_TRIANGLES>;
 
-/// Whether the board runs the fast and the lean mode (`MethodCode::Fast`, `MethodCode::Lean`).
-/// Without them the firmware skips every fast and lean case and leaves their code out of the
-/// image.
+/// Whether the board runs the fast and the lean mode (`MethodCode::Fast`, `MethodCode::Lean`,
+/// and with wedges `FastWedges`, `LeanWedges`). Without them the firmware skips every fast and
+/// lean case and leaves their code out of the image.
 pub const FAST: bool = FAST_VERTICES > 0;
 
 /// The fast mode's workspace (`u16` links on every board: it holds at most 32 000 vertices).

@@ -126,7 +126,7 @@ fn run_case(
                 syst,
                 &h,
                 &mut positions[..h.vertices as usize],
-                &mut triangles[..h.triangles_len()],
+                &mut triangles[..h.triangles_len() + h.wedges_len()],
                 result,
             );
             h.entry()
@@ -182,17 +182,15 @@ fn read_case(
     let (cv, ct) = board::capacity(h.index_type, entry);
     if nv > cv
         || nt > ct
-        || (pipeline(entry) && !board::FAST)
+        || (entry.pipeline() && !board::FAST)
         || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
         || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
         || (entry == meshfmt::Entry::Bounded
             && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
                 || !board::HAS_QUADRICS))
     {
-        if entry == meshfmt::Entry::Fast && !board::FAST {
-            defmt::warn!("no fast mode on this board");
-        } else if entry == meshfmt::Entry::Lean && !board::FAST {
-            defmt::warn!("no lean mode on this board");
+        if entry.pipeline() && !board::FAST {
+            defmt::warn!("no fast or lean mode on this board");
         } else {
             defmt::warn!("the mesh does not fit this board");
         }
@@ -202,13 +200,12 @@ fn read_case(
         return Ok(Err(entry));
     }
     hostio::read_exact(&mut file, bytemuck::cast_slice_mut(&mut positions[..nv]))?;
-    hostio::read_exact(&mut file, &mut triangles[..h.triangles_len()])?;
+    // A wedge case's wedges follow its triangles (`board::capacity` leaves room for them).
+    hostio::read_exact(
+        &mut file,
+        &mut triangles[..h.triangles_len() + h.wedges_len()],
+    )?;
     Ok(Ok(h))
-}
-
-/// Whether `entry` runs on the pipeline's own workspace (the fast or the lean mode).
-fn pipeline(entry: meshfmt::Entry) -> bool {
-    matches!(entry, meshfmt::Entry::Fast | meshfmt::Entry::Lean)
 }
 
 /// Writes the result file: header, then the triangles (already in the file's byte order).
@@ -391,12 +388,14 @@ fn simplify(
     let sp = measure::paint();
     // Not counted: the exact engine's workspace is ready at boot, the fast and the lean one
     // are zeroed here.
-    if entry == meshfmt::Entry::Fast && board::FAST {
+    if matches!(entry, meshfmt::Entry::Fast | meshfmt::Entry::FastWedges) && board::FAST {
         fast_workspace(engine);
     }
-    if entry == meshfmt::Entry::Lean && board::FAST {
+    if matches!(entry, meshfmt::Entry::Lean | meshfmt::Entry::LeanWedges) && board::FAST {
         lean_workspace(engine);
     }
+    // The triangles, and after them a wedge case's wedges.
+    let (tri, wedges) = tri.split_at_mut(h.triangles_len());
     measure::start(syst);
     let outcome =
         match engine {
@@ -406,13 +405,29 @@ fn simplify(
                 IndexType::U32 => triangles_as::<u32>(tri)
                     .map(|t| run_library(ws, pos, t, &config, entry, quadrics)),
             },
-            board::Engine::Fast(ws) => match h.index_type {
+            board::Engine::Fast(ws) if wedges.is_empty() => match h.index_type {
                 IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_fast(ws, pos, t, &config)),
                 IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_fast(ws, pos, t, &config)),
             },
-            board::Engine::Lean(ws) => match h.index_type {
+            board::Engine::Fast(ws) => match h.index_type {
+                IndexType::U16 => triangles_as::<u16>(tri)
+                    .zip(triangles_as::<u16>(wedges))
+                    .map(|(t, w)| run_fast_wedges(ws, pos, t, w, &config)),
+                IndexType::U32 => triangles_as::<u32>(tri)
+                    .zip(triangles_as::<u32>(wedges))
+                    .map(|(t, w)| run_fast_wedges(ws, pos, t, w, &config)),
+            },
+            board::Engine::Lean(ws) if wedges.is_empty() => match h.index_type {
                 IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_lean(ws, pos, t, &config)),
                 IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_lean(ws, pos, t, &config)),
+            },
+            board::Engine::Lean(ws) => match h.index_type {
+                IndexType::U16 => triangles_as::<u16>(tri)
+                    .zip(triangles_as::<u16>(wedges))
+                    .map(|(t, w)| run_lean_wedges(ws, pos, t, w, &config)),
+                IndexType::U32 => triangles_as::<u32>(tri)
+                    .zip(triangles_as::<u32>(wedges))
+                    .map(|(t, w)| run_lean_wedges(ws, pos, t, w, &config)),
             },
         };
     let Some(outcome) = outcome else {
@@ -453,8 +468,8 @@ fn write_header(
     r.stack_bytes = sp.saturating_sub(low) as u32;
     r.stack_high_water = measure::depth(low) as u32;
     r.workspace_bytes = match entry {
-        meshfmt::Entry::Fast => board::FastWorkspace::BYTES as u32,
-        meshfmt::Entry::Lean => board::LeanWorkspace::BYTES as u32,
+        meshfmt::Entry::Fast | meshfmt::Entry::FastWedges => board::FastWorkspace::BYTES as u32,
+        meshfmt::Entry::Lean | meshfmt::Entry::LeanWedges => board::LeanWorkspace::BYTES as u32,
         _ => board::Workspace::BYTES as u32,
     };
     match outcome {
@@ -497,7 +512,7 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
-        Entry::Fast | Entry::Lean => true,
+        Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges => true,
         _ => !board::HAS_QUADRICS,
     };
     if left_out {
@@ -524,7 +539,9 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
         ),
         Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
         Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
-        Entry::Fast | Entry::Lean => Err(left_out_error(positions.len())),
+        Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges => {
+            Err(left_out_error(positions.len()))
+        }
     }
 }
 
@@ -555,7 +572,8 @@ fn fast_workspace(engine: &mut board::Engine) {
 }
 
 /// A fast case (`MethodCode::Fast`): `FastWorkspace::simplify`, positions read. Never inlined,
-/// for the same reason as [`run_bounded`].
+/// for the same reason as [`run_bounded`]; a board without the fast and lean modes never runs
+/// it (`read_case` skips their cases), and the constant leaves the pipeline out of its image.
 #[cfg(feature = "lib")]
 #[inline(never)]
 fn run_fast<I: tinydecimate::Index>(
@@ -564,7 +582,28 @@ fn run_fast<I: tinydecimate::Index>(
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    if !board::FAST {
+        return Err(left_out_error(positions.len()));
+    }
     ws.simplify(positions, triangles, config)
+}
+
+/// A fast case with wedges (`MethodCode::FastWedges`): `FastWorkspace::simplify_with_wedges` on
+/// the welded triangles, the wedges behind them in the triangle buffer. Its own function, so
+/// that [`run_fast`]'s image is the same with or without it.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_fast_wedges<I: tinydecimate::Index>(
+    ws: &mut board::FastWorkspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    wedges: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    if !board::FAST {
+        return Err(left_out_error(positions.len()));
+    }
+    ws.simplify_with_wedges(positions, triangles, wedges, config)
 }
 
 /// Turns the run's working memory into the lean mode's workspace (zeroed), in place, as
@@ -579,7 +618,8 @@ fn lean_workspace(engine: &mut board::Engine) {
 }
 
 /// A lean case (`MethodCode::Lean`): `LeanWorkspace::simplify`, positions read. Never inlined,
-/// for the same reason as [`run_bounded`].
+/// for the same reason as [`run_bounded`]; a board without the fast and lean modes never runs
+/// it (`read_case` skips their cases), and the constant leaves the pipeline out of its image.
 #[cfg(feature = "lib")]
 #[inline(never)]
 fn run_lean<I: tinydecimate::Index>(
@@ -588,7 +628,28 @@ fn run_lean<I: tinydecimate::Index>(
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    if !board::FAST {
+        return Err(left_out_error(positions.len()));
+    }
     ws.simplify(positions, triangles, config)
+}
+
+/// A lean case with wedges (`MethodCode::LeanWedges`): `LeanWorkspace::simplify_with_wedges` on
+/// the welded triangles, the wedges behind them in the triangle buffer. Its own function, so
+/// that [`run_lean`]'s image is the same with or without it.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_lean_wedges<I: tinydecimate::Index>(
+    ws: &mut board::LeanWorkspace,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    wedges: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    if !board::FAST {
+        return Err(left_out_error(positions.len()));
+    }
+    ws.simplify_with_wedges(positions, triangles, wedges, config)
 }
 
 /// A stored-quadric case (`StoredQuadric`). Never inlined, for the same reason as

@@ -42,6 +42,10 @@ pub const GENERATORS: &[(&str, &str)] = &[
         "strip",
         "strip T: the first T triangles of a bumpy grid about twice as wide as tall, unused vertices dropped (capacity search)",
     ),
+    (
+        "charts",
+        "charts N: grid N cut into two texture charts (or materials) along its middle column: that column's N+1 vertices doubled, the right half's triangles on the copies; the wedge cases weld it back",
+    ),
 ];
 
 /// Why [`generate`] refused a spec.
@@ -85,6 +89,7 @@ pub fn generate(spec: &str) -> Option<Result<Mesh, SpecError>> {
         "icosphere" => icosphere(n),
         "box" => creased_box(n),
         "fin" => fin(n),
+        "charts" => charts(n),
         _ => strip(n as usize),
     }))
 }
@@ -113,6 +118,31 @@ pub fn bumpy_rect(w: u32, h: u32) -> Mesh {
         positions,
         triangles,
     }
+}
+
+/// [`bumpy_grid`] cut along its middle column `n / 2` into two charts, as an exporter splits a
+/// texture seam or a material border: each vertex of that column gets a copy at the same
+/// position (appended, bottom to top), and the triangles right of the column use the copies.
+/// `(n+1)^2 + n+1` vertices, `2n^2` triangles.
+pub fn charts(n: u32) -> Mesh {
+    let mut m = bumpy_grid(n);
+    let (stride, mid) = (n + 1, n / 2);
+    let first = m.positions.len() as u32;
+    for y in 0..=n {
+        m.positions.push(m.positions[(y * stride + mid) as usize]);
+    }
+    for (t, tri) in m.triangles.iter_mut().enumerate() {
+        // Two triangles per quad, quads row by row: the quad's column.
+        let x = (t as u32 / 2) % n;
+        if x >= mid {
+            for v in tri.iter_mut() {
+                if *v % stride == mid {
+                    *v = first + *v / stride;
+                }
+            }
+        }
+    }
+    m
 }
 
 /// [`bumpy_rect`] with `w = h = n`.

@@ -162,6 +162,13 @@ pub enum MethodCode {
     /// The lean mode (`pipeline::LeanWorkspace::simplify`, positions read): the fast mode's
     /// pipeline without stored quadrics, its own workspace; the configuration as for `Fast`.
     Lean = 7,
+    /// The fast mode on a welded mesh with wedges (`FastWorkspace::simplify_with_wedges`): the
+    /// case file's triangles are welded by position (`seam::weld`) and the wedges follow them,
+    /// one triangle of the caller's vertices per triangle; the output names the wedges.
+    FastWedges = 8,
+    /// The lean mode on a welded mesh with wedges (`LeanWorkspace::simplify_with_wedges`), as
+    /// `FastWedges`.
+    LeanWedges = 9,
 }
 
 /// The library entry point a case runs: its method and whether it is bounded, decided once
@@ -184,6 +191,10 @@ pub enum Entry {
     Fast,
     /// `pipeline::LeanWorkspace::simplify`, positions read.
     Lean,
+    /// `pipeline::FastWorkspace::simplify_with_wedges`, positions read.
+    FastWedges,
+    /// `pipeline::LeanWorkspace::simplify_with_wedges`, positions read.
+    LeanWedges,
 }
 
 impl Entry {
@@ -193,6 +204,20 @@ impl Entry {
         matches!(
             self,
             Entry::StoredSubset | Entry::StoredOptimal | Entry::Energy
+        )
+    }
+
+    /// Whether the case file carries wedges after its triangles (as many, the same index
+    /// type), which the firmware reads into its triangle buffer after the triangles.
+    pub const fn wedges(self) -> bool {
+        matches!(self, Entry::FastWedges | Entry::LeanWedges)
+    }
+
+    /// Whether the run is the pipeline's (the fast or the lean mode), on its own workspace.
+    pub const fn pipeline(self) -> bool {
+        matches!(
+            self,
+            Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges
         )
     }
 }
@@ -373,6 +398,8 @@ impl CaseHeader {
             5 => MethodCode::Energy,
             6 => MethodCode::Fast,
             7 => MethodCode::Lean,
+            8 => MethodCode::FastWedges,
+            9 => MethodCode::LeanWedges,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -416,6 +443,8 @@ impl CaseHeader {
             MethodCode::Energy => Entry::Energy,
             MethodCode::Fast => Entry::Fast,
             MethodCode::Lean => Entry::Lean,
+            MethodCode::FastWedges => Entry::FastWedges,
+            MethodCode::LeanWedges => Entry::LeanWedges,
         }
     }
 
@@ -429,9 +458,18 @@ impl CaseHeader {
         self.triangles as usize * self.index_type.triangle_bytes()
     }
 
+    /// Bytes of the wedge array (after the triangles; none unless [`Entry::wedges`]).
+    pub fn wedges_len(&self) -> usize {
+        if self.entry().wedges() {
+            self.triangles_len()
+        } else {
+            0
+        }
+    }
+
     /// Whole file size.
     pub fn file_len(&self) -> usize {
-        CASE_HEADER_LEN + self.positions_len() + self.triangles_len()
+        CASE_HEADER_LEN + self.positions_len() + self.triangles_len() + self.wedges_len()
     }
 }
 
@@ -728,7 +766,9 @@ pub mod lib {
                 | MethodCode::VertexDecimation
                 | MethodCode::Energy
                 | MethodCode::Fast
-                | MethodCode::Lean => CostKind::Quadric,
+                | MethodCode::Lean
+                | MethodCode::FastWedges
+                | MethodCode::LeanWedges => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c.features = h.feature_mode != FeatureCode::Off;
@@ -897,16 +937,26 @@ pub mod file {
     use super::*;
     use std::vec::Vec;
 
-    /// Encodes a case file. Triangles are written with `header.index_type`; indices that do not
-    /// fit `u16` are an error (`FormatError::Code`).
+    /// Encodes a case file. Triangles (and the wedges of a wedge method, one per triangle,
+    /// else none) are written with `header.index_type`; indices that do not fit `u16` are an
+    /// error (`FormatError::Code`), so is a wedge count that is not the header's.
     pub fn encode_case(
         header: &CaseHeader,
         positions: &[[f32; 3]],
         triangles: &[[u32; 3]],
+        wedges: &[[u32; 3]],
     ) -> Result<Vec<u8>, FormatError> {
         let mut h = *header;
         h.vertices = narrow(positions.len());
         h.triangles = narrow(triangles.len());
+        let expected = if h.entry().wedges() {
+            triangles.len()
+        } else {
+            0
+        };
+        if wedges.len() != expected {
+            return Err(FormatError::Code);
+        }
         let mut out = Vec::with_capacity(h.file_len());
         out.extend_from_slice(&h.to_bytes());
         for p in positions {
@@ -915,14 +965,16 @@ pub mod file {
             }
         }
         push_triangles(&mut out, h.index_type, triangles)?;
+        push_triangles(&mut out, h.index_type, wedges)?;
         Ok(out)
     }
 
-    /// Decodes a case file into header, positions and (widened) triangles.
-    #[allow(clippy::type_complexity)]
-    pub fn decode_case(
-        bytes: &[u8],
-    ) -> Result<(CaseHeader, Vec<[f32; 3]>, Vec<[u32; 3]>), FormatError> {
+    /// A decoded case file: header, positions, (widened) triangles and wedges (empty unless
+    /// the method has them).
+    pub type Case = (CaseHeader, Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<[u32; 3]>);
+
+    /// Decodes a case file into header, positions, (widened) triangles and wedges.
+    pub fn decode_case(bytes: &[u8]) -> Result<Case, FormatError> {
         let head: &[u8; CASE_HEADER_LEN] = bytes
             .get(..CASE_HEADER_LEN)
             .and_then(|s| s.try_into().ok())
@@ -939,8 +991,15 @@ pub mod file {
                 [f(0), f(4), f(8)]
             })
             .collect();
-        let tri_bytes = &bytes[CASE_HEADER_LEN + h.positions_len()..h.file_len()];
-        Ok((h, positions, read_triangles(h.index_type, tri_bytes)))
+        let at = CASE_HEADER_LEN + h.positions_len();
+        let tri_bytes = &bytes[at..at + h.triangles_len()];
+        let wedge_bytes = &bytes[at + h.triangles_len()..h.file_len()];
+        Ok((
+            h,
+            positions,
+            read_triangles(h.index_type, tri_bytes),
+            read_triangles(h.index_type, wedge_bytes),
+        ))
     }
 
     /// Encodes a result file.
@@ -1039,9 +1098,10 @@ mod tests {
             let mut h = case();
             h.index_type = it;
             let tris = [[0, 1, 2], [2, 1, 0]];
-            let bytes = encode_case(&h, &pos, &tris).unwrap();
+            let bytes = encode_case(&h, &pos, &tris, &[]).unwrap();
             assert_eq!(bytes.len(), 64 + 36 + 2 * 3 * it.bytes());
-            let (h2, p2, t2) = decode_case(&bytes).unwrap();
+            let (h2, p2, t2, w2) = decode_case(&bytes).unwrap();
+            assert!(w2.is_empty());
             assert_eq!(h2.vertices, 3);
             assert_eq!(h2.triangles, 2);
             assert_eq!(h2.schedule, ScheduleCode::Passes);
@@ -1057,8 +1117,22 @@ mod tests {
             );
         }
         assert_eq!(
-            encode_case(&case(), &pos, &[[0, 1, 70000]]),
+            encode_case(&case(), &pos, &[[0, 1, 70000]], &[]),
             Err(FormatError::Code)
+        );
+        // A wedge method carries one wedge triangle per triangle, after them.
+        let mut h = case();
+        h.method = MethodCode::FastWedges;
+        h.max_error = 0.0;
+        let (tris, wedges) = ([[0, 1, 2]], [[2, 1, 0]]);
+        assert_eq!(encode_case(&h, &pos, &tris, &[]), Err(FormatError::Code));
+        let bytes = encode_case(&h, &pos, &tris, &wedges).unwrap();
+        assert_eq!(bytes.len(), 64 + 36 + 2 * 3 * 2);
+        let (_, _, t2, w2) = decode_case(&bytes).unwrap();
+        assert_eq!((t2.as_slice(), w2.as_slice()), (&tris[..], &wedges[..]));
+        assert_eq!(
+            decode_case(&bytes[..bytes.len() - 1]),
+            Err(FormatError::Truncated)
         );
     }
 
@@ -1087,6 +1161,8 @@ mod tests {
             (MethodCode::Energy, 5, Entry::Energy),
             (MethodCode::Fast, 6, Entry::Fast),
             (MethodCode::Lean, 7, Entry::Lean),
+            (MethodCode::FastWedges, 8, Entry::FastWedges),
+            (MethodCode::LeanWedges, 9, Entry::LeanWedges),
         ];
         for (method, code, entry) in cases {
             let mut h = case();
@@ -1102,12 +1178,14 @@ mod tests {
                 matches!(code, 2 | 3 | 5),
                 "{method:?}"
             );
+            assert_eq!(entry.wedges(), matches!(code, 8 | 9), "{method:?}");
+            assert_eq!(entry.pipeline(), matches!(code, 6..=9), "{method:?}");
             // The bound comes first, as the firmware has always run it.
             h.max_error = 0.25;
             assert_eq!(h.entry(), Entry::Bounded);
         }
         let mut b = case().to_bytes();
-        b[30] = 8;
+        b[30] = 10;
         assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
     }
 

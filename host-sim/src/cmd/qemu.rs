@@ -231,6 +231,7 @@ pub fn mesh_case(
         mesh: path.display().to_string(),
         positions: m.positions,
         triangles: m.triangles,
+        wedges: Vec::new(),
         index_type: if u32 { IndexType::U32 } else { IndexType::U16 },
         config,
         stored: None,

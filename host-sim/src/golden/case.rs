@@ -77,6 +77,12 @@ pub enum MethodName {
     /// The lean mode (`pipeline::LeanWorkspace::simplify`): the fast mode's pipeline without
     /// stored quadrics, its own workspace.
     Lean,
+    /// The fast mode on the mesh welded by position with its wedges
+    /// (`FastWorkspace::simplify_with_wedges`): the host welds (`seam::weld`), the case file
+    /// carries the welded triangles and the wedges.
+    FastWedges,
+    /// The lean mode with wedges (`LeanWorkspace::simplify_with_wedges`), as `FastWedges`.
+    LeanWedges,
 }
 
 impl MethodName {
@@ -87,6 +93,8 @@ impl MethodName {
             MethodName::Energy => MethodCode::Energy,
             MethodName::Fast => MethodCode::Fast,
             MethodName::Lean => MethodCode::Lean,
+            MethodName::FastWedges => MethodCode::FastWedges,
+            MethodName::LeanWedges => MethodCode::LeanWedges,
         }
     }
 }
@@ -143,9 +151,9 @@ pub struct CaseSpec {
     #[serde(default)]
     pub quadric: Option<QuadricName>,
     /// Optional: `vertex-decimation` (the operator `VertexDecimation`), `energy` (the cost
-    /// `cost::Energy`), `fast` (the fast mode, `pipeline::FastWorkspace`) or `lean` (the lean
-    /// mode, `pipeline::LeanWorkspace`); none with
-    /// `quadric` or `max_error`.
+    /// `cost::Energy`), `fast` (the fast mode, `pipeline::FastWorkspace`), `lean` (the lean
+    /// mode, `pipeline::LeanWorkspace`), or `fast-wedges` / `lean-wedges` (either on the mesh
+    /// welded by position with its wedges); none with `quadric` or `max_error`.
     #[serde(default)]
     pub method: Option<MethodName>,
     /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
@@ -232,8 +240,10 @@ pub struct Case {
     pub mesh: String,
     /// Vertex positions.
     pub positions: Vec<[f32; 3]>,
-    /// Triangles (written with `index_type`).
+    /// Triangles (written with `index_type`); welded by position for a wedge method.
     pub triangles: Vec<[u32; 3]>,
+    /// A wedge method's wedges: the mesh's own triangles, one per welded triangle (else empty).
+    pub wedges: Vec<[u32; 3]>,
     /// Width of the triangle indices the library is called with.
     pub index_type: IndexType,
     /// Simplification settings.
@@ -290,11 +300,29 @@ impl Case {
             Some(f) => spec.config().with_relative_max_error(f, &mesh.positions),
             None => spec.config(),
         };
+        // A wedge method gets the mesh welded by position, its own triangles as the wedges.
+        let mut wedges = Vec::new();
+        if matches!(
+            spec.method,
+            Some(MethodName::FastWedges | MethodName::LeanWedges)
+        ) {
+            wedges = vec![[0u32; 3]; mesh.triangles.len()];
+            let mut order = vec![0u32; mesh.positions.len()];
+            tinydecimate::seam::weld(
+                &mesh.positions,
+                &mut mesh.triangles,
+                &mut wedges,
+                &mut order,
+            )
+            .map_err(|e| anyhow!("case {name}: weld: {e}"))?;
+            let _ = write!(desc, ", welded by position with its wedges");
+        }
         Ok(Case {
             name: name.clone(),
             mesh: desc,
             positions: mesh.positions,
             triangles: mesh.triangles,
+            wedges,
             index_type: spec.index_type(),
             config,
             stored: spec.quadric.map(|q| match q {
@@ -308,7 +336,7 @@ impl Case {
     /// The case file the firmware reads.
     pub fn encode(&self) -> Result<Vec<u8>> {
         let h = self.header();
-        encode_case(&h, &self.positions, &self.triangles)
+        encode_case(&h, &self.positions, &self.triangles, &self.wedges)
             .map_err(|e| anyhow!("case {}: {e:?}", self.name))
     }
 
@@ -333,9 +361,11 @@ impl Case {
         self.header().entry().per_vertex_storage()
     }
 
-    /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles).
+    /// Bytes of RAM the firmware needs for this case's buffers (positions + triangles, and
+    /// the wedges after the triangles).
     pub fn buffer_bytes(&self) -> usize {
-        self.positions.len() * 12 + self.triangles.len() * self.index_type.triangle_bytes()
+        self.positions.len() * 12
+            + (self.triangles.len() + self.wedges.len()) * self.index_type.triangle_bytes()
     }
 }
 
@@ -412,23 +442,22 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
     let config = meshfmt::lib::config(&h);
     let entry = h.entry();
     let mut positions = case.positions.clone();
+    let narrow = |tris: &[[u32; 3]]| -> Result<Vec<[u16; 3]>> {
+        tris.iter()
+            .map(|t| t.map(|i| u16::try_from(i).map_err(|_| anyhow!("{}: index {i}", case.name))))
+            .map(|[a, b, c]| Ok([a?, b?, c?]))
+            .collect()
+    };
     let (outcome, tris): (_, Vec<[u32; 3]>) = match case.index_type {
         IndexType::U16 => {
-            let mut t: Vec<[u16; 3]> = case
-                .triangles
-                .iter()
-                .map(|t| {
-                    t.map(|i| u16::try_from(i).map_err(|_| anyhow!("{}: index {i}", case.name)))
-                })
-                .map(|[a, b, c]| Ok([a?, b?, c?]))
-                .collect::<Result<_>>()?;
-            let r = run_reference(ws, &mut positions, &mut t, &config, entry);
+            let (mut t, mut w) = (narrow(&case.triangles)?, narrow(&case.wedges)?);
+            let r = run_reference(ws, &mut positions, (&mut t, &mut w), &config, entry);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
         }
         IndexType::U32 => {
-            let mut t = case.triangles.clone();
-            let r = run_reference(ws, &mut positions, &mut t, &config, entry);
+            let (mut t, mut w) = (case.triangles.clone(), case.wedges.clone());
+            let r = run_reference(ws, &mut positions, (&mut t, &mut w), &config, entry);
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             t.truncate(n);
             (r, t)
@@ -448,7 +477,7 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
 fn run_reference<I: tinydecimate::Index>(
     ws: &mut HostWorkspace,
     positions: &mut [[f32; 3]],
-    triangles: &mut [[I; 3]],
+    (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     config: &Config,
     entry: Entry,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
@@ -510,5 +539,17 @@ fn run_reference<I: tinydecimate::Index>(
             .run(),
         Entry::Fast => crate::simplify::fast_workspace_run(positions, triangles, config)?,
         Entry::Lean => crate::simplify::lean_workspace_run(positions, triangles, config)?,
+        Entry::FastWedges => crate::simplify::pipeline_run_wedges(
+            crate::simplify::Pipeline::Fast,
+            positions,
+            (triangles, wedges),
+            config,
+        )?,
+        Entry::LeanWedges => crate::simplify::pipeline_run_wedges(
+            crate::simplify::Pipeline::Lean,
+            positions,
+            (triangles, wedges),
+            config,
+        )?,
     })
 }

@@ -148,6 +148,14 @@ impl Golden {
             Some(super::case::MethodName::Lean) => {
                 writeln!(w, "method = \"the lean mode (pipeline::LeanWorkspace)\"")?
             }
+            Some(super::case::MethodName::FastWedges) => writeln!(
+                w,
+                "method = \"the fast mode with wedges (FastWorkspace::simplify_with_wedges)\""
+            )?,
+            Some(super::case::MethodName::LeanWedges) => writeln!(
+                w,
+                "method = \"the lean mode with wedges (LeanWorkspace::simplify_with_wedges)\""
+            )?,
             None => {}
         }
         if case.config.max_error.is_finite() {

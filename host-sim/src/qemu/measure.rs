@@ -215,6 +215,7 @@ pub fn probe_case(t: usize, index_type: IndexType) -> Case {
         mesh: format!("strip {t}"),
         positions: m.positions,
         triangles: m.triangles,
+        wedges: Vec::new(),
         index_type,
         config: tinydecimate::Config::new(),
         stored: None,
