@@ -62,6 +62,20 @@
 //! along their border edge and a lone triangle is never collapsed away, so the Euler
 //! characteristic, the boundary loops and the components are kept.
 //!
+//! What each kind of vertex may still do (meshoptimizer's `kCanCollapse`, with the kinds
+//! classify gives; a collapse moves `a` onto `b`):
+//!
+//! | kind of `a` | what makes it | may move onto | and the checks add |
+//! |---|---|---|---|
+//! | manifold | its triangles form one closed disk | any neighbour | two triangles on a-b |
+//! | border | one open fan | a border neighbour along an open edge (either way) | one triangle on a-b; not a lone triangle |
+//! | seam (with wedges) | a manifold vertex whose fan holds two wedges | a seam or locked neighbour along the seam | each wedge has a wedge of `b` on its side; no chart loses its last triangle |
+//! | locked | non-manifold, pinched or inconsistently wound; more than two wedges, or two on a border; more than 32 triangles | nothing (others may move onto it) | - |
+//!
+//! Every collapse, of any kind, then passes the checks of `perform` (flip, area, link
+//! condition, duplicates, folds; listed above), which keep the output valid: a non-manifold or inconsistently wound
+//! input keeps its defects where they are, locked, and gets no new ones.
+//!
 //! Candidates are ordered by price, the default cost's (`cost::Quadric`, see `fill::Price`):
 //! the source's quadric at the target, a sum of squared distances weighted by area, so a
 //! collapse over little area goes first, times `1 + Ā/W` (`W` the fan's area, `Ā` the mean
