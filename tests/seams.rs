@@ -331,29 +331,7 @@ fn charts(m: &MeshData) -> Vec<u32> {
 #[cfg(feature = "fast")]
 #[test]
 fn the_pipeline_keeps_seams_closed_and_charts_whole() {
-    use std::sync::Mutex;
-    use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
-    static FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
-    static LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
-    let run = |m: &MeshData, ratio: f32, lean: bool| {
-        let mut tris = m.triangles.clone();
-        let mut wedges = vec![[0u32; 3]; tris.len()];
-        let mut order = vec![0u32; m.positions.len()];
-        let moved = seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
-        assert!(moved > 0, "the mesh has seams");
-        let config = Config::new().with_ratio(ratio);
-        let report = if lean {
-            LEAN.lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
-        } else {
-            FAST.lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
-        }
-        .expect("simplify");
-        output(&m.positions, tris, report)
-    };
+    let run = pipeline_welded;
     let n = 24;
     let meshes = [
         ("two charts", two_charts(n).0),
@@ -408,6 +386,33 @@ fn the_pipeline_keeps_seams_closed_and_charts_whole() {
 
 /// The pipeline's wedge buffer, refused before either buffer is touched: shorter than the
 /// triangles, or naming a vertex past the positions.
+/// The pipeline (the lean mode with `lean`) on `m` welded by position with its wedges, at
+/// `ratio`: the output in `m`'s numbering.
+#[cfg(feature = "fast")]
+fn pipeline_welded(m: &MeshData, ratio: f32, lean: bool) -> (MeshData, Report) {
+    use std::sync::Mutex;
+    use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+    static FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
+    static LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
+    let mut tris = m.triangles.clone();
+    let mut wedges = vec![[0u32; 3]; tris.len()];
+    let mut order = vec![0u32; m.positions.len()];
+    let moved = seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
+    assert!(moved > 0, "the mesh has seams");
+    let config = Config::new().with_ratio(ratio);
+    let report = if lean {
+        LEAN.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+    } else {
+        FAST.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
+    }
+    .expect("simplify");
+    output(&m.positions, tris, report)
+}
+
 /// A wavy `n` x `n` grid with islands of their own chart (a material's region, or a texture
 /// chart, inside another): one triangle, one quad (two triangles) and a 2 x 2 block of quads,
 /// each island's triangles on their own copies of its vertices. Returns the mesh and each
@@ -480,34 +485,13 @@ fn no_chart_loses_its_last_triangle() {
         judge(&out, &format!("exact engine at {ratio}: {report:?}"));
     }
     #[cfg(feature = "fast")]
-    {
-        use std::sync::Mutex;
-        use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
-        static FAST: Mutex<FastWorkspace<u32, 4096, 4096>> = Mutex::new(FastWorkspace::new());
-        static LEAN: Mutex<LeanWorkspace<u32, 4096, 4096>> = Mutex::new(LeanWorkspace::new());
-        for lean in [false, true] {
-            for ratio in [0.25, 0.05] {
-                let mut tris = m.triangles.clone();
-                let mut wedges = vec![[0u32; 3]; tris.len()];
-                let mut order = vec![0u32; m.positions.len()];
-                seam::weld(&m.positions, &mut tris, &mut wedges, &mut order).expect("weld");
-                let config = Config::new().with_ratio(ratio);
-                let report = if lean {
-                    LEAN.lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
-                } else {
-                    FAST.lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .simplify_with_wedges(&m.positions, &mut tris, &mut wedges, &config)
-                }
-                .expect("simplify");
-                let (out, report) = output(&m.positions, tris, report);
-                judge(
-                    &out,
-                    &format!("pipeline, lean {lean}, at {ratio}: {report:?}"),
-                );
-            }
+    for lean in [false, true] {
+        for ratio in [0.25, 0.05] {
+            let (out, report) = pipeline_welded(&m, ratio, lean);
+            judge(
+                &out,
+                &format!("pipeline, lean {lean}, at {ratio}: {report:?}"),
+            );
         }
     }
 }

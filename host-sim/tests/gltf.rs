@@ -985,16 +985,27 @@ fn flat_shaded_grid(n: usize) -> Vec<u8> {
     let pa = b.floats(&pos, "VEC3", 3);
     let na = b.floats(&nrm, "VEC3", 3);
     let ta = b.floats(&uv, "VEC2", 2);
-    let json = json!({
+    let primitive = json!({"attributes": {"POSITION": pa, "NORMAL": na, "TEXCOORD_0": ta}});
+    one_mesh_glb(b, vec![primitive], json!([]))
+}
+
+/// A GLB of one node with one mesh of `primitives`, `materials` (none when empty: glTF's
+/// arrays are never empty) and `b`'s accessors.
+fn one_mesh_glb(b: Builder, primitives: Vec<Value>, materials: Value) -> Vec<u8> {
+    let mut json = json!({
         "asset": {"version": "2.0"},
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": pa, "NORMAL": na, "TEXCOORD_0": ta}}]}],
+        "meshes": [{"primitives": primitives}],
+        "materials": materials,
         "accessors": b.accessors,
         "bufferViews": b.views,
         "buffers": [{"byteLength": b.bin.len()}],
     });
+    if materials.as_array().is_some_and(Vec::is_empty) {
+        json.as_object_mut().map(|o| o.remove("materials"));
+    }
     glb(&json, &b.bin)
 }
 
@@ -1469,6 +1480,36 @@ fn instanced_mesh_counts_agree_between_simplify_and_render() {
     );
 }
 
+/// A file as [`read_with_gltf_crate`] reads it.
+type Read = Vec<(Vec<Vertex>, Vec<u32>)>;
+
+/// `simplify INPUT DIR/out.glb --ratio RATIO --json EXTRA...`: the report and the output as
+/// the `gltf` crate reads it.
+fn simplify_json(
+    input: &std::path::Path,
+    dir: &std::path::Path,
+    extra: &[&str],
+    ratio: &str,
+) -> (Value, Read) {
+    let output = dir.join("out.glb");
+    let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("simplify")
+        .arg(input)
+        .arg(&output)
+        .args(["--ratio", ratio, "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    let j: Value = serde_json::from_slice(&o.stdout).unwrap_or_else(|_| {
+        panic!(
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        )
+    });
+    (j, read_with_gltf_crate(&std::fs::read(&output).unwrap()))
+}
+
 /// One mesh of three materials that share edges, as an exporter writes a car's body, window
 /// and trim: an `n`x`n` height field cut into a body, a window in its middle and a trim strip,
 /// each region a primitive with its own copies of the vertices on its boundary (positions
@@ -1528,18 +1569,8 @@ fn three_materials(n: usize) -> Vec<u8> {
             "indices": ia, "material": r
         }));
     }
-    let json = json!({
-        "asset": {"version": "2.0"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": primitives}],
-        "materials": [{"name": "body"}, {"name": "window"}, {"name": "trim"}],
-        "accessors": b.accessors,
-        "bufferViews": b.views,
-        "buffers": [{"byteLength": b.bin.len()}],
-    });
-    glb(&json, &b.bin)
+    let materials = json!([{"name": "body"}, {"name": "window"}, {"name": "trim"}]);
+    one_mesh_glb(b, primitives, materials)
 }
 
 /// The primitives of one mesh are simplified together, their shared boundaries as seams:
@@ -1556,27 +1587,7 @@ fn primitives_of_one_mesh_simplify_together_without_gaps() {
     let bytes = std::fs::read(&input).unwrap();
     let inputs = read_with_gltf_crate(&bytes);
     let total: usize = inputs.iter().map(|(_, i)| i.len() / 3).sum();
-    let run = |extra: &[&str], ratio: &str| {
-        let output = dir
-            .path()
-            .join(format!("out-{}-{ratio}.glb", extra.join("")));
-        let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
-            .arg("simplify")
-            .arg(&input)
-            .arg(&output)
-            .args(["--ratio", ratio, "--json"])
-            .args(extra)
-            .output()
-            .unwrap();
-        let j: Value = serde_json::from_slice(&o.stdout).unwrap_or_else(|_| {
-            panic!(
-                "{}{}",
-                String::from_utf8_lossy(&o.stdout),
-                String::from_utf8_lossy(&o.stderr)
-            )
-        });
-        (j, read_with_gltf_crate(&std::fs::read(&output).unwrap()))
-    };
+    let run = |extra: &[&str], ratio: &str| simplify_json(&input, dir.path(), extra, ratio);
     for ratio in ["0.25", "0.1"] {
         for engine in [
             &["--engine", "fast"][..],
@@ -1627,25 +1638,7 @@ fn the_milk_truck_keeps_its_windows_closed() {
     let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/fixtures/CesiumMilkTruck.glb");
     let dir = tempfile::tempdir().unwrap();
-    let run = |extra: &[&str], ratio: &str| {
-        let output = dir.path().join("truck.glb");
-        let o = Command::new(env!("CARGO_BIN_EXE_host-sim"))
-            .arg("simplify")
-            .arg(&input)
-            .arg(&output)
-            .args(["--ratio", ratio, "--json"])
-            .args(extra)
-            .output()
-            .unwrap();
-        let j: Value = serde_json::from_slice(&o.stdout).unwrap_or_else(|_| {
-            panic!(
-                "{}{}",
-                String::from_utf8_lossy(&o.stdout),
-                String::from_utf8_lossy(&o.stderr)
-            )
-        });
-        (j, read_with_gltf_crate(&std::fs::read(&output).unwrap()))
-    };
+    let run = |extra: &[&str], ratio: &str| simplify_json(&input, dir.path(), extra, ratio);
     for ratio in ["0.25", "0.1"] {
         for extra in [&[][..], &["--engine", "exact"]] {
             let what = format!("{extra:?} at {ratio}");

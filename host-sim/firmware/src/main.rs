@@ -405,30 +405,8 @@ fn simplify(
                 IndexType::U32 => triangles_as::<u32>(tri)
                     .map(|t| run_library(ws, pos, t, &config, entry, quadrics)),
             },
-            board::Engine::Fast(ws) if wedges.is_empty() => match h.index_type {
-                IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_fast(ws, pos, t, &config)),
-                IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_fast(ws, pos, t, &config)),
-            },
-            board::Engine::Fast(ws) => match h.index_type {
-                IndexType::U16 => triangles_as::<u16>(tri)
-                    .zip(triangles_as::<u16>(wedges))
-                    .map(|(t, w)| run_fast_wedges(ws, pos, t, w, &config)),
-                IndexType::U32 => triangles_as::<u32>(tri)
-                    .zip(triangles_as::<u32>(wedges))
-                    .map(|(t, w)| run_fast_wedges(ws, pos, t, w, &config)),
-            },
-            board::Engine::Lean(ws) if wedges.is_empty() => match h.index_type {
-                IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_lean(ws, pos, t, &config)),
-                IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_lean(ws, pos, t, &config)),
-            },
-            board::Engine::Lean(ws) => match h.index_type {
-                IndexType::U16 => triangles_as::<u16>(tri)
-                    .zip(triangles_as::<u16>(wedges))
-                    .map(|(t, w)| run_lean_wedges(ws, pos, t, w, &config)),
-                IndexType::U32 => triangles_as::<u32>(tri)
-                    .zip(triangles_as::<u32>(wedges))
-                    .map(|(t, w)| run_lean_wedges(ws, pos, t, w, &config)),
-            },
+            board::Engine::Fast(ws) => run_either(ws, h.index_type, pos, tri, wedges, &config),
+            board::Engine::Lean(ws) => run_either(ws, h.index_type, pos, tri, wedges, &config),
         };
     let Some(outcome) = outcome else {
         *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
@@ -437,6 +415,35 @@ fn simplify(
     let ticks = measure::stop(syst);
     let low = measure::lowest_touched();
     write_header(h, &outcome, pos, ticks, sp, low, r);
+}
+
+/// A fast or lean case on workspace `ws`, with wedges when `wedges` holds any, in the case's
+/// index type (`None`: the bytes are not whole triangles). Inlined into [`simplify`], as its
+/// match arms were, so that no frame of its own lies above the measured call.
+#[cfg(feature = "lib")]
+#[inline(always)]
+fn run_either<P: Pipeline>(
+    ws: &mut P,
+    index_type: IndexType,
+    pos: &[[f32; 3]],
+    tri: &mut [u8],
+    wedges: &mut [u8],
+    config: &tinydecimate::Config,
+) -> Option<Result<tinydecimate::Report, tinydecimate::Error>> {
+    match (index_type, wedges.is_empty()) {
+        (IndexType::U16, true) => {
+            triangles_as::<u16>(tri).map(|t| run_pipeline(ws, pos, t, config))
+        }
+        (IndexType::U32, true) => {
+            triangles_as::<u32>(tri).map(|t| run_pipeline(ws, pos, t, config))
+        }
+        (IndexType::U16, false) => triangles_as::<u16>(tri)
+            .zip(triangles_as::<u16>(wedges))
+            .map(|(t, w)| run_pipeline_wedges(ws, pos, t, w, config)),
+        (IndexType::U32, false) => triangles_as::<u32>(tri)
+            .zip(triangles_as::<u32>(wedges))
+            .map(|(t, w)| run_pipeline_wedges(ws, pos, t, w, config)),
+    }
 }
 
 /// The triangle bytes as triangles of `I` (`None`: misaligned or not a whole number of them).
@@ -571,13 +578,62 @@ fn fast_workspace(engine: &mut board::Engine) {
     }
 }
 
-/// A fast case (`MethodCode::Fast`): `FastWorkspace::simplify`, positions read. Never inlined,
-/// for the same reason as [`run_bounded`]; a board without the fast and lean modes never runs
-/// it (`read_case` skips their cases), and the constant leaves the pipeline out of its image.
+/// The pipeline's two workspaces (the fast and the lean mode) as the firmware calls them.
+#[cfg(feature = "lib")]
+trait Pipeline {
+    fn plain<I: tinydecimate::Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        config: &tinydecimate::Config,
+    ) -> Result<tinydecimate::Report, tinydecimate::Error>;
+    fn welded<I: tinydecimate::Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        wedges: &mut [[I; 3]],
+        config: &tinydecimate::Config,
+    ) -> Result<tinydecimate::Report, tinydecimate::Error>;
+}
+
+/// Implements [`Pipeline`] for a workspace type by its inherent methods.
+macro_rules! pipeline {
+    ($ws:ty) => {
+        #[cfg(feature = "lib")]
+        impl Pipeline for $ws {
+            #[inline(always)]
+            fn plain<I: tinydecimate::Index>(
+                &mut self,
+                positions: &[[f32; 3]],
+                triangles: &mut [[I; 3]],
+                config: &tinydecimate::Config,
+            ) -> Result<tinydecimate::Report, tinydecimate::Error> {
+                self.simplify(positions, triangles, config)
+            }
+            #[inline(always)]
+            fn welded<I: tinydecimate::Index>(
+                &mut self,
+                positions: &[[f32; 3]],
+                triangles: &mut [[I; 3]],
+                wedges: &mut [[I; 3]],
+                config: &tinydecimate::Config,
+            ) -> Result<tinydecimate::Report, tinydecimate::Error> {
+                self.simplify_with_wedges(positions, triangles, wedges, config)
+            }
+        }
+    };
+}
+pipeline!(board::FastWorkspace);
+pipeline!(board::LeanWorkspace);
+
+/// A fast or lean case (`MethodCode::Fast`, `MethodCode::Lean`): `simplify`, positions read.
+/// Never inlined, for the same reason as [`run_bounded`]; a board without the fast and lean
+/// modes never runs it (`read_case` skips their cases), and the constant leaves the pipeline
+/// out of its image.
 #[cfg(feature = "lib")]
 #[inline(never)]
-fn run_fast<I: tinydecimate::Index>(
-    ws: &mut board::FastWorkspace,
+fn run_pipeline<P: Pipeline, I: tinydecimate::Index>(
+    ws: &mut P,
     positions: &[[f32; 3]],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
@@ -585,16 +641,16 @@ fn run_fast<I: tinydecimate::Index>(
     if !board::FAST {
         return Err(left_out_error(positions.len()));
     }
-    ws.simplify(positions, triangles, config)
+    ws.plain(positions, triangles, config)
 }
 
-/// A fast case with wedges (`MethodCode::FastWedges`): `FastWorkspace::simplify_with_wedges` on
-/// the welded triangles, the wedges behind them in the triangle buffer. Its own function, so
-/// that [`run_fast`]'s image is the same with or without it.
+/// A case with wedges (`MethodCode::FastWedges`, `LeanWedges`): `simplify_with_wedges` on the
+/// welded triangles, the wedges behind them in the triangle buffer. Its own function, so that
+/// [`run_pipeline`]'s image is the same with or without it.
 #[cfg(feature = "lib")]
 #[inline(never)]
-fn run_fast_wedges<I: tinydecimate::Index>(
-    ws: &mut board::FastWorkspace,
+fn run_pipeline_wedges<P: Pipeline, I: tinydecimate::Index>(
+    ws: &mut P,
     positions: &[[f32; 3]],
     triangles: &mut [[I; 3]],
     wedges: &mut [[I; 3]],
@@ -603,7 +659,7 @@ fn run_fast_wedges<I: tinydecimate::Index>(
     if !board::FAST {
         return Err(left_out_error(positions.len()));
     }
-    ws.simplify_with_wedges(positions, triangles, wedges, config)
+    ws.welded(positions, triangles, wedges, config)
 }
 
 /// Turns the run's working memory into the lean mode's workspace (zeroed), in place, as
@@ -615,41 +671,6 @@ fn lean_workspace(engine: &mut board::Engine) {
     if !matches!(engine, board::Engine::Lean(_)) {
         *engine = board::Engine::Lean(ZEROED);
     }
-}
-
-/// A lean case (`MethodCode::Lean`): `LeanWorkspace::simplify`, positions read. Never inlined,
-/// for the same reason as [`run_bounded`]; a board without the fast and lean modes never runs
-/// it (`read_case` skips their cases), and the constant leaves the pipeline out of its image.
-#[cfg(feature = "lib")]
-#[inline(never)]
-fn run_lean<I: tinydecimate::Index>(
-    ws: &mut board::LeanWorkspace,
-    positions: &[[f32; 3]],
-    triangles: &mut [[I; 3]],
-    config: &tinydecimate::Config,
-) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    if !board::FAST {
-        return Err(left_out_error(positions.len()));
-    }
-    ws.simplify(positions, triangles, config)
-}
-
-/// A lean case with wedges (`MethodCode::LeanWedges`): `LeanWorkspace::simplify_with_wedges` on
-/// the welded triangles, the wedges behind them in the triangle buffer. Its own function, so
-/// that [`run_lean`]'s image is the same with or without it.
-#[cfg(feature = "lib")]
-#[inline(never)]
-fn run_lean_wedges<I: tinydecimate::Index>(
-    ws: &mut board::LeanWorkspace,
-    positions: &[[f32; 3]],
-    triangles: &mut [[I; 3]],
-    wedges: &mut [[I; 3]],
-    config: &tinydecimate::Config,
-) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    if !board::FAST {
-        return Err(left_out_error(positions.len()));
-    }
-    ws.simplify_with_wedges(positions, triangles, wedges, config)
 }
 
 /// A stored-quadric case (`StoredQuadric`). Never inlined, for the same reason as
