@@ -539,17 +539,13 @@ fn run_reference<I: tinydecimate::Index>(
             .run(),
         Entry::Fast => crate::simplify::fast_workspace_run(positions, triangles, config)?,
         Entry::Lean => crate::simplify::lean_workspace_run(positions, triangles, config)?,
-        Entry::FastWedges => crate::simplify::pipeline_run_wedges(
-            crate::simplify::Pipeline::Fast,
-            positions,
-            (triangles, wedges),
-            config,
-        )?,
-        Entry::LeanWedges => crate::simplify::pipeline_run_wedges(
-            crate::simplify::Pipeline::Lean,
-            positions,
-            (triangles, wedges),
-            config,
-        )?,
+        Entry::FastWedges | Entry::LeanWedges => {
+            let mode = if entry == Entry::FastWedges {
+                crate::simplify::Pipeline::Fast
+            } else {
+                crate::simplify::Pipeline::Lean
+            };
+            crate::simplify::pipeline_run_wedges(mode, positions, (triangles, wedges), config)?
+        }
     })
 }
