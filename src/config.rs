@@ -146,6 +146,14 @@ pub struct Config {
     /// normals differ by more than this many degrees, in `(0, 180)`. Boundary and non-manifold
     /// edges always are.
     pub control_angle_deg: f32,
+    /// The pipeline (`pipeline::FastWorkspace` and `LeanWorkspace`, crate feature `fast`)
+    /// removes a part
+    /// (a connected component) whole once the error made reaches its size, and, short of the
+    /// target with no collapse left, the smallest parts up to the error limit; the largest part
+    /// always stays (meshoptimizer's `meshopt_SimplifyPrune`). Off by default: a part is only
+    /// simplified. The exact engine prunes when given part links instead
+    /// (`ModelStorage::with_parts`, crate feature `parts`).
+    pub prune_parts: bool,
 }
 
 impl Config {
@@ -169,6 +177,7 @@ impl Config {
             max_error: f32::INFINITY,
             error_limit: f32::INFINITY,
             control_angle_deg: 30.0,
+            prune_parts: false,
         }
     }
 
@@ -192,6 +201,12 @@ impl Config {
         let mut c = Self::new();
         c.features = false;
         c
+    }
+
+    /// Sets [`Config::prune_parts`].
+    pub const fn with_prune_parts(mut self, prune: bool) -> Self {
+        self.prune_parts = prune;
+        self
     }
 
     /// Sets the schedule.

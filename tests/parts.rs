@@ -23,20 +23,6 @@ use tinydecimate::{
     Positions, Report, Schedule, Stop, Workspace,
 };
 
-/// A wavy 24 x 24 sheet and, beside it, ten small octahedra (8 triangles each, radius 0.01 to
-/// 0.028 of the sheet's unit width). Returns the mesh and each small part's vertex range.
-fn sheet_and_bolts() -> (MeshData, Vec<std::ops::Range<u32>>) {
-    let mut m = grid(24, 24, 0.15);
-    let mut parts = Vec::new();
-    for i in 0..10 {
-        let start = m.positions.len() as u32;
-        let r = 0.01 + 0.002 * i as f32;
-        octahedron(&mut m, [0.1 * i as f32, 1.2, 0.05], r);
-        parts.push(start..m.positions.len() as u32);
-    }
-    (m, parts)
-}
-
 /// Runs the default configuration at `ratio` on `m` (u32 links), pruning with `prune`; the
 /// output in the input's numbering.
 fn run(m: &MeshData, ratio: f32, prune: bool) -> (MeshData, Report) {
@@ -61,26 +47,6 @@ fn run(m: &MeshData, ratio: f32, prune: bool) -> (MeshData, Report) {
     };
     let report = s.run();
     output(&m.positions, tris, report)
-}
-
-/// The shared checker with parts allowed to vanish whole.
-fn parts_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
-    verdict_opts(
-        input,
-        output,
-        &meshcheck::Options {
-            parts: true,
-            ..Default::default()
-        },
-    )
-}
-
-/// How many of `part`'s input triangles the output still has.
-fn kept_of(input: &MeshData, output: &MeshData, part: &std::ops::Range<u32>) -> (usize, usize) {
-    let inside = |t: &[u32; 3]| t.iter().all(|v| part.contains(v));
-    let total = input.triangles.iter().filter(|t| inside(t)).count();
-    let kept = output.triangles.iter().filter(|t| inside(t)).count();
-    (kept, total)
 }
 
 #[test]

@@ -43,18 +43,21 @@ fn fixtures() -> Vec<String> {
 }
 
 fn run(mode: Mode, m: &MeshData, ratio: f32) -> (MeshData, Report) {
+    run_with(mode, m, &Config::new().with_ratio(ratio))
+}
+
+fn run_with(mode: Mode, m: &MeshData, config: &Config) -> (MeshData, Report) {
     let mut tris = m.triangles.clone();
-    let config = Config::new().with_ratio(ratio);
     let r = match mode {
         Mode::Fast => BIG_FAST.lock().unwrap_or_else(|e| e.into_inner()).simplify(
             &m.positions,
             &mut tris,
-            &config,
+            config,
         ),
         Mode::Lean => BIG_LEAN.lock().unwrap_or_else(|e| e.into_inner()).simplify(
             &m.positions,
             &mut tris,
-            &config,
+            config,
         ),
     }
     .expect("simplify");
@@ -333,5 +336,91 @@ fn each_rule_fires_where_it_should() {
         let tetra = tetrahedron();
         let (_, r) = run(mode, &tetra, 0.0);
         assert!(count(&r, "duplicate") > 0, "{mode:?}: {r:?}");
+    }
+}
+
+/// Pruning (`Config::prune_parts`): the sheet with ten small octahedra beside it reaches a
+/// target its parts would keep it from; each part is all there or all gone, the smallest go
+/// first, the report counts them and the output is valid with parts gone whole.
+#[test]
+fn small_parts_vanish_whole_when_pruning() {
+    let (m, parts) = sheet_and_bolts();
+    for mode in modes() {
+        let keep = Config::new().with_ratio(0.02);
+        let (out, report) = run_with(mode, &m, &keep);
+        assert_eq!(report.parts_removed, 0, "{mode:?}");
+        // Ten closed parts of at least four triangles each: 24 triangles are out of reach.
+        assert!(!report.target_reached, "{mode:?}: {report:?}");
+        for p in &parts {
+            assert!(kept_of(&m, &out, p).0 > 0, "{mode:?}: part {p:?} lost");
+        }
+        assert_valid("sheet and bolts, kept", &m, &out, &report);
+
+        let (out, report) = run_with(mode, &m, &keep.with_prune_parts(true));
+        assert!(report.target_reached, "{mode:?}: {report:?}");
+        let mut gone = 0;
+        for p in &parts {
+            let (kept, total) = kept_of(&m, &out, p);
+            assert!(
+                kept == 0 || kept == total,
+                "{mode:?}: part {p:?}: {kept} of {total}"
+            );
+            gone += usize::from(kept == 0);
+        }
+        assert!(gone > 0);
+        assert_eq!(gone, report.parts_removed, "{mode:?}: {report:?}");
+        let left: Vec<usize> = (0..parts.len())
+            .filter(|&i| kept_of(&m, &out, &parts[i]).0 > 0)
+            .collect();
+        assert!(
+            left.iter().all(|&i| i >= parts.len() - left.len()),
+            "{mode:?}: {left:?}"
+        );
+        assert!(
+            kept_of(&m, &out, &(0..25 * 25)).0 > 0,
+            "{mode:?}: the sheet went"
+        );
+        let v = parts_verdict(&m, &out);
+        v.assert_valid("sheet and bolts, pruned");
+        assert_eq!(v.parts_removed, report.parts_removed);
+    }
+}
+
+/// Pruning never empties a mesh: of five octahedra towards no triangle the largest stays;
+/// and an error limit below every part's size removes none.
+#[test]
+fn the_largest_part_stays_and_the_error_limit_holds() {
+    let mut m = MeshData::default();
+    for i in 0..5 {
+        octahedron(&mut m, [i as f32, 0.0, 0.0], 0.1 + 0.05 * i as f32);
+    }
+    for mode in modes() {
+        let config = Config::new().with_ratio(0.0).with_prune_parts(true);
+        let (out, report) = run_with(mode, &m, &config);
+        assert_eq!(report.parts_removed, 4, "{mode:?}: {report:?}");
+        let left: std::collections::BTreeSet<u32> =
+            out.triangles.iter().flatten().copied().collect();
+        assert!(
+            !left.is_empty() && left.iter().all(|&v| v >= 24),
+            "{mode:?}: {left:?}"
+        );
+        parts_verdict(&m, &out).assert_valid("octahedra");
+
+        let (out, report) = run_with(mode, &m, &config.with_error_limit(0.05));
+        assert_eq!(report.parts_removed, 0, "{mode:?}: {report:?}");
+        assert_valid("octahedra, limited", &m, &out, &report);
+    }
+}
+
+/// One part is the largest part and never goes: the cow prunes to the same bytes.
+#[test]
+fn one_part_prunes_to_the_same_bytes() {
+    let m = load_obj("cow.obj");
+    for mode in modes() {
+        let config = Config::new().with_ratio(0.1);
+        let (with, r_with) = run_with(mode, &m, &config.with_prune_parts(true));
+        let (without, _) = run_with(mode, &m, &config);
+        assert_eq!(r_with.parts_removed, 0, "{mode:?}");
+        assert_eq!(with.triangles, without.triangles, "{mode:?}");
     }
 }

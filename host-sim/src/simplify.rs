@@ -240,7 +240,8 @@ pub fn simplify_with_attributes(
                 mode.name()
             ));
         }
-        return simplify_pipeline(mesh, config, weld, mode);
+        let config = config.with_prune_parts(prune);
+        return simplify_pipeline(mesh, &config, weld, mode);
     }
     // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
     // its run is welded by position, and the output keeps the welded numbering.

@@ -98,7 +98,7 @@ fn a_cracked_output_fails_with_the_crack_named() {
     assert_eq!(j["seams"], "Weld");
 }
 
-/// Parts pruned by `simplify --parts prune` (the exact engine's default) pass `check`'s
+/// Parts pruned by `simplify --parts prune` (the default of both engines) pass `check`'s
 /// default; with `--parts keep` the same file fails on its number of components.
 #[test]
 fn parts_keep_refuses_a_pruned_output() {

@@ -103,7 +103,7 @@ fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
             (&["--operator", "triangle"][..], "--operator"),
             (&["--max-error", "1%"][..], "--max-error"),
             (&["--cost", "normal"][..], "--cost"),
-            (&["--parts", "prune"][..], "--parts prune"),
+            (&["--lambda", "1"][..], "--lambda"),
         ] {
             let mut args = vec![
                 "simplify",
@@ -157,7 +157,7 @@ fn auto_picks_the_fast_mode_unless_the_run_needs_the_exact_engine() {
     let cow = fixture("cow.obj");
     assert_eq!(engine(&cow, &[]), "Fast");
     assert_eq!(engine(&cow, &["--parts", "keep"]), "Fast");
-    assert_eq!(engine(&cow, &["--parts", "prune"]), "Exact");
+    assert_eq!(engine(&cow, &["--parts", "prune"]), "Fast");
     assert_eq!(engine(&cow, &["--schedule", "batched"]), "Exact");
     assert_eq!(engine(&cow, &["--engine", "exact"]), "Exact");
     // A sheet of two triangles with its back: double-sided.
@@ -187,6 +187,70 @@ fn collapses_within_flat_patches_cost_no_error() {
             "{engine}: Hausdorff distance {h} % of the diagonal"
         );
     }
+}
+
+/// The CAD assembly with pins to 10 %: its small closed parts hold it above the target with
+/// `--parts keep`; by default they go whole (the report counts them), the target is reached
+/// and `check` accepts the output.
+#[test]
+fn the_fast_and_lean_engines_prune_parts() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("pr2_sensor_mount.obj");
+    let out = d.path().join("p.obj");
+    for (engine, _) in ENGINES {
+        let kept = engine_json(engine, &input, &out, "0.1", &["--parts", "keep"]);
+        assert_eq!(kept["report"]["parts_removed"], 0, "{engine}");
+        assert_eq!(kept["report"]["target_reached"], false, "{engine}");
+        let pruned = engine_json(engine, &input, &out, "0.1", &[]);
+        assert!(
+            pruned["report"]["parts_removed"].as_u64().unwrap() > 0,
+            "{engine}: {}",
+            pruned["report"]
+        );
+        assert_eq!(pruned["report"]["target_reached"], true, "{engine}");
+        assert_eq!(pruned["valid"], true, "{engine}");
+        let c = run(&["check", s(&input), s(&out)]);
+        assert_eq!(c.status.code(), Some(0), "{engine}: {}", text(&c.stdout));
+    }
+}
+
+/// `--meshopt-out` writes meshoptimizer's result at the count the run reached, a mesh `check`
+/// reads; a mesh with attributes is refused, naming the option.
+#[test]
+fn meshoptimizer_s_result_is_written_beside_ours() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("cow.obj");
+    let (out, theirs) = (d.path().join("o.obj"), d.path().join("m.obj"));
+    let j = engine_json("fast", &input, &out, "0.25", &["--meshopt-out", s(&theirs)]);
+    let ours = j["report"]["triangles_out"].as_u64().unwrap();
+    let text_of = std::fs::read_to_string(&theirs).unwrap();
+    let n = text_of.lines().filter(|l| l.starts_with("f ")).count() as u64;
+    assert!(
+        n > 0 && n <= ours && n * 10 >= ours * 9,
+        "{n} against {ours}"
+    );
+    let textured = d.path().join("quad.obj");
+    std::fs::write(
+        &textured,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    let o = run(&[
+        "simplify",
+        s(&textured),
+        s(&out),
+        "--ratio",
+        "0.5",
+        "--meshopt-out",
+        s(&theirs),
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(
+        text(&o.stderr).contains("--meshopt-out"),
+        "{}",
+        text(&o.stderr)
+    );
 }
 
 /// `simplify INPUT OUT --ratio R --engine ENGINE --json EXTRA...`, which must succeed; its

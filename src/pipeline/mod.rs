@@ -34,8 +34,11 @@
 //!   pick      each vertex's cheapest collapse its kind allows, from its quadric
 //!   sort      counting sort on the cost's top 12 bits
 //!   perform   in order, to the pass's error goal: skip locked ends, check, collapse, lock both
-//!   compact   drop dead triangles, rebuild the fan lists
+//!   compact   drop dead triangles
+//!   prune     with Config::prune_parts, the parts within the error made so far
+//!   link      rebuild the fan lists
 //! }
+//! prune     short of the target with no collapse left, the smallest parts up to the limit
 //! ```
 //!
 //! The quadrics are not accumulated, as meshoptimizer's are, but filled before each pass from
@@ -98,7 +101,9 @@
 //! Not the crate's default ([`Config::new`]'s engine is); `host-sim simplify`'s (`--engine
 //! auto`, unless an option of the exact engine's alone is given or the mesh is double-sided;
 //! `--engine fast` or `lean` ask for it): without attributes seams welded by position before
-//! the call, with them (glTF, OBJ with `vt`/`vn`) with wedges. Not in it: parts, the error
+//! the call, with them (glTF, OBJ with `vt`/`vn`) with wedges, and parts pruned (`prune`,
+//! [`Config::prune_parts`]: a part goes whole once the error made reaches its size, as
+//! meshoptimizer's `meshopt_SimplifyPrune`; no memory of its own). Not in it: the error
 //! bound, double-sided twins (the back of a double-sided triangle is dropped as a duplicate)
 //! and `step(budget)`. A vertex with more than 32 triangles is locked, and a
 //! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
@@ -112,6 +117,7 @@ mod compact;
 mod fill;
 mod perform;
 mod pick;
+mod prune;
 mod sort;
 
 use crate::error::Capacity;
@@ -705,7 +711,11 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
     // The input's area (unit frame), for the price's mean triangle area.
     let mut area = 0.0f32;
     let mut pass_triangles = heapless::Vec::new();
-    let stop = loop {
+    // prune: the smallest part's size (0 until measured), the parts gone.
+    let prune = config.prune_parts;
+    let mut next_part = 0.0f32;
+    let mut parts_removed = 0usize;
+    let mut stop = loop {
         if nt <= target_triangles {
             break Stop::Target;
         }
@@ -748,11 +758,19 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
             border_next,
             (&quadrics, price),
             (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
-            (goal, limit),
+            (goal, limit, prune),
             &mut stats,
         );
         passes += 1;
         nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
+        // prune: every part within the error made so far (meshoptimizer's cutoff); the parts'
+        // labels overwrite compact's counts, so compact runs again.
+        if prune && nt > target_triangles && stats.worst >= next_part {
+            let p = prune::prune(&frame, triangles, nt, flags, (order, cost), stats.worst);
+            next_part = p.next;
+            parts_removed += p.parts;
+            nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
+        }
         let _ = pass_triangles.push(nt as u32);
         if done == 0 {
             break if stats.over_limit > refused {
@@ -767,6 +785,27 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
             compact::unlock(flags);
         }
     };
+    // No collapse left short of the target: the smallest parts, up to 1.5 times the smallest
+    // size at a time (meshoptimizer's step) and the error limit. Each round removes a part or
+    // raises the smallest size, so it ends within a round per vertex.
+    if prune && matches!(stop, Stop::ErrorLimit | Stop::NoLegalCollapse) {
+        for _ in 0..=nv {
+            if nt <= target_triangles || next_part > limit || !next_part.is_finite() {
+                break;
+            }
+            let cutoff = (next_part * 1.5).min(limit);
+            let p = prune::prune(&frame, triangles, nt, flags, (order, cost), cutoff);
+            parts_removed += p.parts;
+            if p.largest > stats.worst {
+                stats.worst = p.largest;
+            }
+            nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
+            next_part = p.next;
+        }
+        if nt <= target_triangles {
+            stop = Stop::Target;
+        }
+    }
     // With wedges the output names them.
     if W {
         for (t, w) in triangles.iter_mut().zip(wedges.iter()).take(nt) {
@@ -789,7 +828,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         stop,
         collapses: stats.collapses,
         vertices_removed: stats.collapses,
-        parts_removed: 0,
+        parts_removed,
         locked_vertices: locked,
         feature_vertices: 0,
         passes,

@@ -413,3 +413,37 @@ pub fn tetrahedron() -> MeshData {
         triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]],
     }
 }
+
+/// A wavy 24 x 24 sheet and, beside it, ten small octahedra (8 triangles each, radius 0.01 to
+/// 0.028 of the sheet's unit width). Returns the mesh and each small part's vertex range.
+pub fn sheet_and_bolts() -> (MeshData, Vec<std::ops::Range<u32>>) {
+    let mut m = grid(24, 24, 0.15);
+    let mut parts = Vec::new();
+    for i in 0..10 {
+        let start = m.positions.len() as u32;
+        let r = 0.01 + 0.002 * i as f32;
+        octahedron(&mut m, [0.1 * i as f32, 1.2, 0.05], r);
+        parts.push(start..m.positions.len() as u32);
+    }
+    (m, parts)
+}
+
+/// The shared checker with parts allowed to vanish whole.
+pub fn parts_verdict(input: &MeshData, output: &MeshData) -> meshcheck::Verdict {
+    verdict_opts(
+        input,
+        output,
+        &meshcheck::Options {
+            parts: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// How many of `part`'s input triangles the output still has.
+pub fn kept_of(input: &MeshData, output: &MeshData, part: &std::ops::Range<u32>) -> (usize, usize) {
+    let inside = |t: &[u32; 3]| t.iter().all(|v| part.contains(v));
+    let total = input.triangles.iter().filter(|t| inside(t)).count();
+    let kept = output.triangles.iter().filter(|t| inside(t)).count();
+    (kept, total)
+}

@@ -140,10 +140,12 @@ fn header(s: &mut String, r: &Results) {
         s,
         "* tinydecimate modes, each `.with_ratio(ratio)`: {}. As `host-sim simplify` runs \
          them: vertices at one position welded (`--seams weld`), the greedy modes (vertex \
-         decimation too) with the error limit of 2 % of the diagonal (`--error-limit`) and, \
-         unless the bench was given `--parts keep`, parts pruned (`--parts prune`); vertex \
-         decimation welded by position without wedges (positions only) and without part \
-         pruning (a removal has no collapse cost to weigh a part against).",
+         decimation too) with the error limit of 2 % of the diagonal (`--error-limit`); the \
+         greedy, batched, fast and lean modes, unless the bench was given `--parts keep`, \
+         with parts pruned (`--parts prune`; the fast and lean modes by \
+         `Config::prune_parts`); vertex decimation welded by position without wedges \
+         (positions only) and without part pruning (a removal has no collapse cost to weigh a \
+         part against).",
         modes.join("; ")
     );
     let ratios: Vec<String> = r.ratios.iter().map(|x| fmt_pct(*x)).collect();

@@ -44,7 +44,7 @@ pub enum ScheduleArg {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum EngineArg {
     /// The fast mode, unless an option only the exact engine takes is given (--schedule,
-    /// --cost, --quadric, --placement, --operator, --max-error, --parts prune, the feature
+    /// --cost, --quadric, --placement, --operator, --max-error, the feature
     /// and legality options) or the mesh is double-sided somewhere (the fast mode keeps one
     /// side): then the exact engine.
     #[default]
@@ -56,8 +56,8 @@ pub enum EngineArg {
     /// fixed memory): stored quadrics priced once per pass, collapses in sorted order, every
     /// output valid. Without attributes seams are welded by position (the output keeps the
     /// welded numbering); with them (glTF, OBJ with vt/vn) the wedges are kept, a seam
-    /// sliding along itself. No parts pruned; of the options it takes the target,
-    /// --error-limit and --seams.
+    /// sliding along itself. Of the options it takes the target, --error-limit, --parts
+    /// and --seams.
     Fast,
     /// The lean mode (`tinydecimate::pipeline::LeanWorkspace`): the fast mode's pipeline
     /// without stored quadrics (each built from its vertex's fan whenever a pass reads it),
@@ -419,11 +419,12 @@ pub struct Args {
     /// material, so no gap opens between them; the target applies to the mesh as a whole.
     #[arg(long)]
     pub per_primitive: bool,
-    /// Parts (connected components): `prune` removes a part whole once it costs less than the
-    /// collapse about to be made, and short of the target with no collapse left the smallest
-    /// parts, never the last (the exact engine's default; greedy schedule without
-    /// --max-error only, else every part stays); `keep` keeps every part, as a collapse never
-    /// changes topology (the fast mode's only choice).
+    /// Parts (connected components): `prune` (the default) removes a part whole once it is
+    /// within the error made (the fast and lean modes: its size within the largest collapse
+    /// error so far) or costs less than the collapse about to be made (the exact engine),
+    /// and short of the target with no collapse left the smallest parts, never the largest
+    /// (the exact engine: greedy or batched schedule without --max-error only, else every
+    /// part stays); `keep` keeps every part, as a collapse never changes topology.
     #[arg(long, value_enum)]
     pub parts: Option<PartsArg>,
     /// Target fraction of the input triangles, above 0, at most 1. Not with
@@ -526,6 +527,11 @@ pub struct Args {
     /// Print the report, the check and the Metro error as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also write meshoptimizer's `meshopt_simplify` result at the triangle count this run
+    /// reached (OBJ, PLY or STL by extension), to compare the two (`render --compare`).
+    /// Meshes without vertex attributes only.
+    #[arg(long, value_name = "FILE")]
+    pub meshopt_out: Option<PathBuf>,
     /// Allow the output to be the input file (it is overwritten).
     #[arg(long)]
     pub force: bool,
@@ -569,7 +575,6 @@ impl Args {
             (self.placement != PlacementArg::Subset, "--placement"),
             (self.operator != OperatorArg::Edge, "--operator"),
             (self.max_error.is_some(), "--max-error"),
-            (self.parts == Some(PartsArg::Prune), "--parts prune"),
             (self.lambda.is_some(), "--lambda"),
             (self.valence_normalized, "--valence-normalized"),
             (self.no_features, "--no-features"),
@@ -584,13 +589,9 @@ impl Args {
         given.iter().find(|(on, _)| *on).map(|&(_, name)| name)
     }
 
-    /// Whether parts may vanish: `--parts`, else the engine's default (the exact engine
-    /// prunes, the pipeline keeps every part).
+    /// Whether parts may vanish: `--parts`, pruning unless `keep`.
     pub fn prunes(&self) -> bool {
-        match self.parts {
-            Some(p) => p == PartsArg::Prune,
-            None => self.pipeline().is_none(),
-        }
+        self.parts != Some(PartsArg::Keep)
     }
 
     /// `--parts` as this run takes it.
@@ -687,9 +688,25 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             args.output.display()
         );
     }
+    let meshopt_format = match &args.meshopt_out {
+        Some(path) => Some(crate::io::check_writable(path, None)?),
+        None => None,
+    };
     // 2. The run, and the file it writes (with `--engine auto` resolved for the mesh).
     let run = simplify_file(args, out_format)?;
     let args = &run.args;
+    if let (Some(path), Some(format)) = (&args.meshopt_out, meshopt_format) {
+        let (theirs, _, _) =
+            crate::bench::meshopt::meshopt_simplify(&run.mesh, run.report.triangles_out);
+        let theirs = crate::io::compact(&theirs).0;
+        crate::io::save_as(path, format, &theirs)?;
+        eprintln!(
+            "meshoptimizer at {} triangles: {} triangles written to {}",
+            run.report.triangles_out,
+            theirs.triangles.len(),
+            path.display()
+        );
+    }
     // 3. What was done and the memory it takes, then the check and the error.
     let say = |text: &str| {
         if to_stdout {

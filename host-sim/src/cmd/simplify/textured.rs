@@ -41,6 +41,7 @@ fn run_library(
     attributes: Option<&crate::simplify::Attributes>,
 ) -> Result<(Vec<[u32; 3]>, Report, Duration)> {
     if let Some(mode) = args.pipeline() {
+        let config = &config.with_prune_parts(args.prunes());
         if args.seams == super::SeamsArg::Weld {
             let (out, report, elapsed) =
                 crate::simplify::simplify_pipeline_wedges(mesh, config, mode)?;
@@ -176,6 +177,14 @@ fn run_ply(args: &Args, bytes: &[u8], extra: &[String], t0: Instant) -> Result<E
 }
 
 fn refuse_optimal(args: &Args) -> Result<()> {
+    if args.meshopt_out.is_some() {
+        bail!(
+            "{}: the mesh has vertex attributes (texture coordinates, normals, ...) and \
+             --meshopt-out writes meshoptimizer's positions-only result: give a mesh without \
+             them (STL, or PLY or OBJ with positions only)",
+            args.input.display()
+        );
+    }
     if args.quadric == QuadricArg::Stored && args.placement == PlacementArg::Optimal {
         bail!(
             "{}: the mesh has vertex attributes (texture coordinates, normals, ...) and optimal \
