@@ -89,6 +89,7 @@ fn opaque_config() -> Config {
         max_error: opaque_f32(19),
         error_limit: opaque_f32(24),
         control_angle_deg: opaque_f32(20),
+        prune_parts: input(6) & 8 == 0,
     };
     // The builders too.
     let b = black_box(Config::paper())
@@ -101,6 +102,7 @@ fn opaque_config() -> Config {
         .with_max_cost(opaque_f32(14))
         .with_max_error(opaque_f32(21))
         .with_error_limit(opaque_f32(25))
+        .with_prune_parts(input(6) & 32 == 0)
         .with_cost(c.cost);
     black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
