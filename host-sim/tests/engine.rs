@@ -89,13 +89,7 @@ fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
     let input = fixture("cow.obj");
     let out = d.path().join("c.obj");
     // Attributes: kept, the seams welded with their wedges (not refused).
-    let textured = d.path().join("quad.obj");
-    std::fs::write(
-        &textured,
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
-         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
-    )
-    .unwrap();
+    let textured = textured_quad(d.path());
     for (engine, _) in ENGINES {
         for (extra, named) in [
             (&["--schedule", "passes"][..], "--schedule"),
@@ -229,13 +223,7 @@ fn meshoptimizer_s_result_is_written_beside_ours() {
         n > 0 && n <= ours && n * 10 >= ours * 9,
         "{n} against {ours}"
     );
-    let textured = d.path().join("quad.obj");
-    std::fs::write(
-        &textured,
-        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
-         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
-    )
-    .unwrap();
+    let textured = textured_quad(d.path());
     let o = run(&[
         "simplify",
         s(&textured),
@@ -251,6 +239,18 @@ fn meshoptimizer_s_result_is_written_beside_ours() {
         "{}",
         text(&o.stderr)
     );
+}
+
+/// A textured quad (two triangles with texture coordinates) as `quad.obj` in `dir`.
+fn textured_quad(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("quad.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    path
 }
 
 /// `simplify INPUT OUT --ratio R --engine ENGINE --json EXTRA...`, which must succeed; its
