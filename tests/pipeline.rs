@@ -369,6 +369,19 @@ fn small_parts_vanish_whole_when_pruning() {
         }
         assert!(gone > 0);
         assert_eq!(gone, report.parts_removed, "{mode:?}: {report:?}");
+        // A collapse removes a vertex, a part all it has left.
+        let used = |t: &[[u32; 3]]| {
+            t.iter()
+                .flatten()
+                .collect::<std::collections::BTreeSet<_>>()
+                .len()
+        };
+        assert_eq!(
+            report.vertices_removed,
+            used(&m.triangles) - used(&out.triangles),
+            "{mode:?}: {report:?}"
+        );
+        assert!(report.vertices_removed > report.collapses);
         let left: Vec<usize> = (0..parts.len())
             .filter(|&i| kept_of(&m, &out, &parts[i]).0 > 0)
             .collect();

@@ -714,7 +714,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
     // prune: the smallest part's size (0 until measured), the parts gone.
     let prune = config.prune_parts;
     let mut next_part = 0.0f32;
-    let mut parts_removed = 0usize;
+    let (mut parts_removed, mut part_vertices) = (0usize, 0usize);
     let mut stop = loop {
         if nt <= target_triangles {
             break Stop::Target;
@@ -769,6 +769,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
             let p = prune::prune(&frame, triangles, nt, flags, (order, cost), stats.worst);
             next_part = p.next;
             parts_removed += p.parts;
+            part_vertices += p.vertices;
             nt = compact_pass::<I, W>((triangles, wedges), nt, cost).0;
         }
         let _ = pass_triangles.push(nt as u32);
@@ -796,6 +797,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
             let cutoff = (next_part * 1.5).min(limit);
             let p = prune::prune(&frame, triangles, nt, flags, (order, cost), cutoff);
             parts_removed += p.parts;
+            part_vertices += p.vertices;
             if p.largest > stats.worst {
                 stats.worst = p.largest;
             }
@@ -827,7 +829,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         target_reached: nt <= target_triangles,
         stop,
         collapses: stats.collapses,
-        vertices_removed: stats.collapses,
+        vertices_removed: stats.collapses + part_vertices,
         parts_removed,
         locked_vertices: locked,
         feature_vertices: 0,

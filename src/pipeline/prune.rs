@@ -29,6 +29,8 @@ pub(super) struct Pruned {
     pub triangles: usize,
     /// Parts removed.
     pub parts: usize,
+    /// Vertices removed with them.
+    pub vertices: usize,
     /// The largest size among the parts removed (0 if none).
     pub largest: f32,
     /// The smallest size above the cutoff among the parts left, the largest part aside
@@ -125,6 +127,7 @@ pub(super) fn prune<I: Index, L: Index>(
     let mut out = Pruned {
         triangles: 0,
         parts: 0,
+        vertices: 0,
         largest: 0.0,
         next: f32::INFINITY,
     };
@@ -161,6 +164,7 @@ pub(super) fn prune<I: Index, L: Index>(
             if let Some(f) = flags.get_mut(v) {
                 *f = (*f & flag::HIGH) | flag::GONE;
             }
+            out.vertices += 1;
         }
     }
     for v in 0..nv {
@@ -169,6 +173,7 @@ pub(super) fn prune<I: Index, L: Index>(
             if let Some(f) = flags.get_mut(v) {
                 *f = (*f & flag::HIGH) | flag::GONE;
             }
+            out.vertices += 1;
         } else if root(parent, v) && live(flags, v) && v != keep && s > cutoff && s < out.next {
             out.next = s;
         }
