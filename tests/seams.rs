@@ -179,6 +179,19 @@ fn flat_box(n: u32) -> MeshData {
 
 #[test]
 fn flat_shaded_faces_simplify_whole() {
+    // Every triangle of a sphere its own three vertices, as a flat-shaded export splits them:
+    // each triangle is its own chart, and with `Move` no chart is kept.
+    let sphere = icosphere(2);
+    let mut split = MeshData::default();
+    for t in &sphere.triangles {
+        let base = split.positions.len() as u32;
+        split
+            .positions
+            .extend(t.iter().map(|&v| sphere.positions[v as usize]));
+        split.triangles.push([base, base + 1, base + 2]);
+    }
+    let (_, report) = simplify_welded(&split, 0.25, SeamCorners::Move);
+    assert_eq!(report.stop, Stop::Target, "flat-shaded sphere: {report:?}");
     let m = flat_box(6);
     for ratio in [0.5, 0.1] {
         let what = format!("flat-shaded box at {ratio}");

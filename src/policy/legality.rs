@@ -796,9 +796,12 @@ fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> 
     // A boundary fan's wedges are one more than its changes, a disc's as many.
     let wedges = changes + usize::from(mesh.has(a, flag::BOUNDARY));
     if wedges > 2 {
-        return !mesh.lock_corners && !removes_a_chart(mesh, a, b);
+        return !mesh.lock_corners;
     }
-    (wedges != 2 || onto_b) && (wedges < 2 || !removes_a_chart(mesh, a, b))
+    // Charts are kept only where the wedges carry attributes (`Lock`): with `Move` a split
+    // index buffer's wedges carry nothing, and a mesh shaded flat (every face its own chart)
+    // would not simplify at all.
+    (wedges != 2 || onto_b) && (wedges < 2 || !mesh.lock_corners || !removes_a_chart(mesh, a, b))
 }
 
 /// Welded seams: whether a triangle the collapse `a -> b` removes is the last of its chart
@@ -807,7 +810,8 @@ fn along_seam<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> 
 /// triangle is the last piece of a texture chart or of a material (a material boundary is a
 /// seam, `host-sim simplify` joins a mesh's primitives), and a collapse along a seam would
 /// take it whole. Only a vertex with two or more wedges can remove one: inside a chart the
-/// removed triangles have chart neighbours in `a`'s fan.
+/// removed triangles have chart neighbours in `a`'s fan. Asked only with
+/// [`SeamCorners::Lock`](crate::seam::SeamCorners::Lock), the wedges of real attributes.
 #[cfg(feature = "seams")]
 fn removes_a_chart<L: Index, I: Index>(mesh: &Mesh<'_, L, I>, a: usize, b: usize) -> bool {
     let wedge = |t: usize, v: usize| {
