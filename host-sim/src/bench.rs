@@ -57,11 +57,11 @@ pub const MESHOPT_CRATE_VERSION: &str = "0.7.0";
 pub const QUICK_MESHES: [&str; 2] = ["cow.obj", "plate_holes.obj"];
 /// The ratios `--quick` runs.
 pub const QUICK_RATIOS: [f32; 2] = [0.5, 0.1];
-/// The messy multi-part meshes of `tests/fixtures` (see its SOURCES.md: many open parts,
-/// non-manifold edges, pinched vertices). The summary reports their worst error ratios apart
+/// The messy multi-part meshes of `tests/fixtures` and `bench/meshes` (see their SOURCES.md:
+/// many open parts, non-manifold edges, pinched vertices). The summary reports their worst error ratios apart
 /// from the other meshes': the targets are ≤ 1.5x meshoptimizer at the same triangle count there,
 /// ≤ 0.8x mean and ≤ 1.0x max elsewhere.
-pub const MESSY_MESHES: [&str; 2] = ["wuson.obj", "pr2_sensor_mount.obj"];
+pub const MESSY_MESHES: [&str; 3] = ["wuson.obj", "pr2_sensor_mount.obj", "2CylinderEngine.obj"];
 
 /// Whether `mesh` (a file name) is one of [`MESSY_MESHES`].
 pub fn is_messy(mesh: &str) -> bool {
@@ -69,10 +69,16 @@ pub fn is_messy(mesh: &str) -> bool {
 }
 
 /// The real-world meshes of `tests/fixtures` (see its SOURCES.md, "Added for real-world
-/// content"): raw CAD exports (flat faces tessellated into long slivers) and a renderer's
-/// seam-split index buffer. Their worst error ratios are reported apart, held to ≤ 1.0x
+/// content"): raw CAD exports (flat faces tessellated into long slivers), a renderer's
+/// seam-split index buffer, and a glTF mesh of several materials (its primitives read as
+/// `simplify` reads them, positions only). Their worst error ratios are reported apart, held to ≤ 1.0x
 /// meshoptimizer (at the same triangle count where ours stops short).
-pub const REAL_WORLD_MESHES: [&str; 3] = ["pins.obj", "tray_bottom.obj", "suzanne_seams.obj"];
+pub const REAL_WORLD_MESHES: [&str; 4] = [
+    "pins.obj",
+    "tray_bottom.obj",
+    "suzanne_seams.obj",
+    "CesiumMilkTruck.glb",
+];
 
 /// Whether `mesh` (a file name) is one of [`REAL_WORLD_MESHES`].
 pub fn is_real_world(mesh: &str) -> bool {
@@ -88,12 +94,27 @@ pub fn default_meshes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures")
 }
 
+/// The bench's own meshes (`bench/meshes`, sources and licences in its SOURCES.md): messy
+/// multi-part models too large for `tests/fixtures`, whose every mesh the tests walk. A run
+/// of the default directory adds them.
+pub fn bench_meshes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/meshes")
+}
+
+/// Whether `name` is a mesh file the bench reads (by its extension).
+fn is_mesh_file(name: &str) -> bool {
+    let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
+    name.contains('.') && matches!(ext.as_str(), "obj" | "ply" | "stl" | "glb" | "gltf")
+}
+
 /// What one benchmark run does (the resolved [`Args`](crate::cmd::bench::Args)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Options {
     /// Mesh directory.
     pub meshes: PathBuf,
-    /// Only these file names from the directory (`None`: every mesh file).
+    /// A second mesh directory whose meshes run too (the default run: [`bench_meshes`]).
+    pub more: Option<PathBuf>,
+    /// Only these file names from the directories (`None`: every mesh file).
     pub only: Option<Vec<String>>,
     /// Target ratios.
     pub ratios: Vec<f32>,
@@ -556,28 +577,34 @@ fn ms(d: Duration) -> f64 {
 /// The mesh files to run: every mesh in the directory (or the named ones), loaded, smallest
 /// first.
 fn load_meshes(opts: &Options) -> Result<Vec<(String, MeshData)>> {
-    let names: Vec<String> = match &opts.only {
-        Some(names) => names.clone(),
+    let dirs: Vec<&PathBuf> = std::iter::once(&opts.meshes).chain(&opts.more).collect();
+    let mut files: Vec<(String, PathBuf)> = Vec::new();
+    match &opts.only {
+        Some(names) => {
+            for name in names {
+                let dir = dirs.iter().find(|d| d.join(name).is_file()).unwrap_or(&dirs[0]);
+                files.push((name.clone(), dir.join(name)));
+            }
+        }
         None => {
-            let mut names = Vec::new();
-            let dir = std::fs::read_dir(&opts.meshes)
-                .with_context(|| format!("{}: cannot list", opts.meshes.display()))?;
-            for entry in dir {
-                let name = entry?.file_name().to_string_lossy().into_owned();
-                let ext = name.rsplit('.').next().unwrap_or("").to_ascii_lowercase();
-                if name.contains('.') && matches!(ext.as_str(), "obj" | "ply" | "stl") {
-                    names.push(name);
+            for dir in &dirs {
+                let entries = std::fs::read_dir(dir)
+                    .with_context(|| format!("{}: cannot list", dir.display()))?;
+                for entry in entries {
+                    let name = entry?.file_name().to_string_lossy().into_owned();
+                    if is_mesh_file(&name) {
+                        files.push((name.clone(), dir.join(name)));
+                    }
                 }
             }
-            names
         }
-    };
-    if names.is_empty() {
-        bail!("{}: no .obj, .ply or .stl meshes", opts.meshes.display());
+    }
+    if files.is_empty() {
+        bail!("{}: no .obj, .ply, .stl or glTF meshes", opts.meshes.display());
     }
     let mut meshes = Vec::new();
-    for name in names {
-        let mesh = crate::io::load(opts.meshes.join(&name))?;
+    for (name, path) in files {
+        let mesh = crate::io::load(path)?;
         meshes.push((name, mesh));
     }
     meshes.sort_by(|a, b| (a.1.triangles.len(), &a.0).cmp(&(b.1.triangles.len(), &b.0)));
@@ -1055,6 +1082,49 @@ mod tests {
         );
         assert_eq!((o.ratios, o.reps), (vec![0.1], 5));
         assert_eq!((md, js), (None, None));
+        // The bench's own meshes join the default directory only.
+        assert_eq!(o.more, Some(bench_meshes()));
+        let c = Cli::try_parse_from(["x", "--meshes", "elsewhere"]).unwrap();
+        assert_eq!(c.args.options().0.more, None);
+    }
+
+    /// Both directories are listed, glTF files included and other files left out, and a name
+    /// asked for by `--only` is found in the second directory.
+    #[test]
+    fn meshes_come_from_both_directories() {
+        let (one, two) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        std::fs::write(one.path().join("a.obj"), tri).unwrap();
+        std::fs::write(one.path().join("notes.txt"), "not a mesh").unwrap();
+        std::fs::copy(
+            default_meshes().join("CesiumMilkTruck.glb"),
+            two.path().join("truck.glb"),
+        )
+        .unwrap();
+        let mut opts = Options {
+            meshes: one.path().into(),
+            more: Some(two.path().into()),
+            only: None,
+            ratios: vec![0.5],
+            reps: 1,
+            samples_per_triangle: 1.0,
+            progress: false,
+            prune: true,
+            modes: None,
+        };
+        let names = |o: &Options| {
+            load_meshes(o)
+                .unwrap()
+                .into_iter()
+                .map(|(n, m)| (n, m.triangles.len()))
+                .collect::<Vec<_>>()
+        };
+        let truck = ("truck.glb".to_string(), 2856);
+        assert_eq!(names(&opts), vec![("a.obj".to_string(), 1), truck.clone()]);
+        opts.only = Some(vec!["truck.glb".into()]);
+        assert_eq!(names(&opts), vec![truck]);
+        opts.more = None;
+        assert!(load_meshes(&opts).is_err());
     }
 
     #[test]
@@ -1196,6 +1266,7 @@ mod tests {
     fn stopped_short_is_compared_at_the_same_count() {
         let opts = Options {
             meshes: default_meshes(),
+            more: None,
             only: Some(vec!["plate_holes.obj".into()]),
             ratios: vec![0.01],
             reps: 1,

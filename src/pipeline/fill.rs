@@ -47,6 +47,13 @@ pub(super) fn triangle(p: [V3; 3], w: f32) -> PointQuadric {
     plane(p, w).0
 }
 
+/// [`triangle`], not inlined: for the fan walks off the hot path (a border edge's quadric, a
+/// stale price's quadric), where the lean mode's flash budget counts more than a call.
+#[inline(never)]
+fn triangle_call(p: [V3; 3], w: f32) -> PointQuadric {
+    plane(p, w).0
+}
+
 /// The area of the first `triangles` (unit frame).
 #[inline(never)]
 pub(super) fn area<I: Index>(frame: &Frame<'_>, triangles: &[[I; 3]]) -> f32 {
@@ -157,7 +164,7 @@ fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
         return None;
     }
     let n = math::scale(perp, math::rsqrt(pl2));
-    let face = triangle([p0, p1, p2], BORDER_WEIGHT);
+    let face = triangle_call([p0, p1, p2], BORDER_WEIGHT);
     let mut q = point_plane(n, math::sqrt(l2) * BORDER_WEIGHT);
     point_add(&mut q, &face);
     Some(q)
@@ -246,7 +253,7 @@ pub(super) fn vertex_quadric<I: Index, L: Index, Q: Quadrics, const W: bool>(
         }
         let (x, y) = others(tr, k);
         let (px, py) = (frame.at(x), frame.at(y));
-        point_add(&mut q, &triangle([pv, px, py], 1.0));
+        point_add(&mut q, &triangle_call([pv, px, py], 1.0));
         if seam {
             seam_planes(flags, (x, y), [pv, px, py], &mut q);
         }

@@ -12,8 +12,9 @@ use crate::bench::{bench, default_meshes, Options, QUICK_MESHES, QUICK_RATIOS};
 /// `host-sim bench ...`
 #[derive(Clone, Debug, clap::Args)]
 pub struct Args {
-    /// Directory of meshes (.obj, .ply, .stl); every mesh in it runs, smallest first. Default:
-    /// the repository's `tests/fixtures`.
+    /// Directory of meshes (.obj, .ply, .stl, .glb, .gltf); every mesh in it runs, smallest
+    /// first. Default: the repository's `tests/fixtures`, and `bench/meshes` (messy
+    /// multi-part models too large for the fixtures).
     #[arg(long)]
     pub meshes: Option<PathBuf>,
     /// Only these files of the mesh directory, comma separated (e.g. `--only cow.obj`).
@@ -72,8 +73,10 @@ impl Args {
                 5,
             )
         };
+        let more = self.meshes.is_none().then(crate::bench::bench_meshes);
         let opts = Options {
             meshes,
+            more,
             only: self.only.clone().or(only),
             ratios: self.ratios.clone().unwrap_or(ratios),
             reps: self.reps.unwrap_or(reps),
