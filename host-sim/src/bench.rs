@@ -542,7 +542,7 @@ pub struct Results {
     pub meshoptimizer_version: String,
     /// The `meshopt` crate version.
     pub meshopt_crate_version: String,
-    /// The mesh directory.
+    /// The mesh directories, comma separated (relative to the repository when inside it).
     pub meshes: String,
     /// Target ratios.
     pub ratios: Vec<f32>,
@@ -929,12 +929,19 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
         meshopt_crate_version: MESHOPT_CRATE_VERSION.into(),
         meshes: {
             // Relative to the repository where it is inside it: the report names no machine's path.
-            let abs = std::fs::canonicalize(&opts.meshes).unwrap_or_else(|_| opts.meshes.clone());
             let root = std::fs::canonicalize(crate::repo_root()).unwrap_or_default();
-            abs.strip_prefix(&root)
-                .unwrap_or(&abs)
-                .display()
-                .to_string()
+            let shown = |dir: &PathBuf| {
+                let abs = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+                abs.strip_prefix(&root)
+                    .unwrap_or(&abs)
+                    .display()
+                    .to_string()
+            };
+            std::iter::once(&opts.meshes)
+                .chain(&opts.more)
+                .map(shown)
+                .collect::<Vec<_>>()
+                .join(", ")
         },
         ratios: opts.ratios.clone(),
         reps: opts.reps,

@@ -153,7 +153,7 @@ fn header(s: &mut String, r: &Results) {
         s,
         "* Meshes: `{}`; ratios {}; {} repetition(s) per run, each on a fresh copy of the \
          input; Metro with {} face samples per triangle.",
-        r.meshes,
+        r.meshes.replace(", ", "`, `"),
         ratios.join(", "),
         r.reps,
         r.samples_per_triangle
