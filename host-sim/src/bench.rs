@@ -582,7 +582,10 @@ fn load_meshes(opts: &Options) -> Result<Vec<(String, MeshData)>> {
     match &opts.only {
         Some(names) => {
             for name in names {
-                let dir = dirs.iter().find(|d| d.join(name).is_file()).unwrap_or(&dirs[0]);
+                let dir = dirs
+                    .iter()
+                    .find(|d| d.join(name).is_file())
+                    .unwrap_or(&dirs[0]);
                 files.push((name.clone(), dir.join(name)));
             }
         }
@@ -600,7 +603,10 @@ fn load_meshes(opts: &Options) -> Result<Vec<(String, MeshData)>> {
         }
     }
     if files.is_empty() {
-        bail!("{}: no .obj, .ply, .stl or glTF meshes", opts.meshes.display());
+        bail!(
+            "{}: no .obj, .ply, .stl or glTF meshes",
+            opts.meshes.display()
+        );
     }
     let mut meshes = Vec::new();
     for (name, path) in files {
