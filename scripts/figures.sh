@@ -7,8 +7,8 @@ cd "$(dirname "$0")/.."
 ratio=${1:-0.1}
 shift || true
 meshes=${*:-cow fandisk camelhead stanford_bunny}
-cargo build -q --release -p host-sim
-bin=target/release/host-sim
+cargo build -q --release -p tinydecimate-cli
+bin=target/release/tinydecimate
 out=$(mktemp -d)
 echo "| mesh | schedule | triangles in → out | library time (ms) | workspace bytes / triangle | mean error (% diag) | Hausdorff (% diag) | valid | triangles after each pass |"
 echo "|---|---|---|---:|---:|---:|---:|---|---|"

@@ -3,7 +3,7 @@
 instance placed by its node's world transform (a mesh several nodes name appears once per
 node), TRIANGLES primitives only, positions welded where they are bit-identical, nothing else
 (no attributes, no materials). Used for the messy multi-part models of docs/realworld.md;
-`host-sim` itself reads each glTF mesh in its own frame (`simplify` keeps the file's
+`tinydecimate` itself reads each glTF mesh in its own frame (`simplify` keeps the file's
 structure), which is not what such an export looks like.
 
 Usage: python3 scripts/gltf_scene_to_obj.py IN.glb OUT.obj   (needs numpy)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Shows that the test suite notices the loss of each legality rule (src/policy/legality.rs).
+# Shows that the test suite notices the loss of each legality rule (src/policy/legality/mod.rs).
 #
 # Builds the library with TINYDECIMATE_RULE_OFF set to each rule of its table in turn (cargo
 # rebuilds the crate when the variable changes) and runs a fast subset of the tests, which must
@@ -12,11 +12,11 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-# The rules' names, read from their one table (`RULES` in src/policy/legality.rs: a row's
+# The rules' names, read from their one table (`RULES` in src/policy/legality/mod.rs: a row's
 # `name: "..."` line); a name the table does not hold is a build error, not a silent pass.
-read -r -a all_rules <<<"$(sed -n 's/^ *name: "\([a-z_]*\)",$/\1/p' src/policy/legality.rs | paste -sd' ' -)"
+read -r -a all_rules <<<"$(sed -n 's/^ *name: "\([a-z_]*\)",$/\1/p' src/policy/legality/mod.rs | paste -sd' ' -)"
 if [ ${#all_rules[@]} -eq 0 ]; then
-  echo "no rule names found in src/policy/legality.rs (RULES)" >&2
+  echo "no rule names found in src/policy/legality/mod.rs (RULES)" >&2
   exit 2
 fi
 rules=("$@")

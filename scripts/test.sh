@@ -27,8 +27,8 @@ bash scripts/install-qemu.sh
 command -v defmt-print >/dev/null || cargo install defmt-print --locked
 
 echo "== host tests"
-# host-sim enables the library's `fast` feature, so the fast mode's tests (tests/pipeline.rs,
-# tests/error_limit.rs) run here too.
+# The command line and host-sim enable the library's `fast` feature, so the fast mode's tests
+# (tests/pipeline.rs, tests/error_limit.rs) run here too.
 cargo test --workspace --release
 
 echo "== golden outputs on the host (libm, micromath)"

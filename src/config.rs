@@ -311,7 +311,7 @@ impl Config {
         self.with_max_error(fraction * crate::bound::bounding_diagonal(positions))
     }
 
-    /// The error limit `host-sim simplify` uses by default, as a fraction of the bounding-box
+    /// The error limit `tinydecimate simplify` uses by default, as a fraction of the bounding-box
     /// diagonal ([`Config::with_relative_error_limit`]): on clean meshes no collapse down to
     /// 10 % is over it; on raw CAD exports and multi-part assets it refuses the few collapses
     /// that cut a part or a corner.

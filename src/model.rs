@@ -1,4 +1,4 @@
-//! A model as a tool or a renderer writes it, in one call: what `host-sim simplify` does by
+//! A model as a tool or a renderer writes it, in one call: what `tinydecimate simplify` does by
 //! default, for firmware.
 //!
 //! [`Storage::simplify`] takes the index buffer as given. A model whose vertices are split on
@@ -18,7 +18,7 @@
 //! The error limit is the configuration's, as everywhere: the CLI's default is
 //! [`Config::MODEL_ERROR_LIMIT`] of the diagonal, set with
 //! [`Config::with_relative_error_limit`]. With that configuration the call gives the bytes
-//! `host-sim simplify` writes with its defaults (`--seams weld --parts prune`).
+//! `tinydecimate simplify` writes with its defaults (`--seams weld --parts prune`).
 //!
 //! ```
 //! # #[cfg(all(feature = "seams", feature = "parts"))]
@@ -57,7 +57,7 @@ use crate::operator::EdgeCollapse;
 use crate::policy::bound::NoBound;
 use crate::policy::cost::Builtin;
 use crate::seam::SeamCorners;
-use crate::workspace::{Positions, Storage};
+use crate::workspace::{Positions, Storage, Workspace};
 use crate::{Config, Error, Report};
 
 /// The caller's storage for [`Storage::simplify_model`] beyond the workspace: the wedge
@@ -101,8 +101,25 @@ impl<'m, I: Index, L: Index> ModelStorage<'m, I, L> {
     }
 }
 
+impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
+    Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
+{
+    /// [`Storage::simplify_model`] on this workspace: a model's seams welded, its small parts
+    /// pruned, as `tinydecimate simplify` does by default (crate feature `seams`).
+    pub fn simplify_model<I: Index>(
+        &mut self,
+        positions: &[[f32; 3]],
+        triangles: &mut [[I; 3]],
+        model: &mut ModelStorage<'_, I, L>,
+        config: &Config,
+    ) -> Result<Report, Error> {
+        self.as_storage()
+            .simplify_model(positions, triangles, model, config)
+    }
+}
+
 impl<L: Index> Storage<'_, L> {
-    /// Simplifies a model's `triangles` in place as `host-sim simplify` does by default:
+    /// Simplifies a model's `triangles` in place as `tinydecimate simplify` does by default:
     /// vertices at one position welded and collapsed together (no crack along a seam), each
     /// corner keeping the caller's vertex (its wedge), and with
     /// [`ModelStorage::with_parts`] small parts removed whole (see [`crate::model`]).

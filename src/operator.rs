@@ -2,7 +2,7 @@
 //! `operator` argument), so that an image carries the code of the one it uses only.
 //!
 //! Adding one: a type here with its [`Kind`] (and sealed impl), its method in a file of its
-//! own under `src/operator/` (as [`VertexDecimation`] in `operator/decimate.rs`), and an
+//! own under `src/operator/` (as [`VertexDecimation`] in `operator/decimate/`), and an
 //! engine path only if no existing [`Kind`] fits.
 //!
 //! [`Storage::start`]: crate::Storage::start

@@ -23,7 +23,7 @@
 //!
 //! Optimal placement (`start_moving`) moves the kept vertex of each collapse to a new position
 //! and does not interpolate attributes: the moved vertex keeps the attributes of the input
-//! vertex whose slot it occupies. That is why `host-sim simplify` refuses `--placement
+//! vertex whose slot it occupies. That is why `tinydecimate simplify` refuses `--placement
 //! optimal` on a mesh with attributes.
 //!
 //! Both functions are generic and hold no state: a firmware that does not call them carries

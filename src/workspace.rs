@@ -335,20 +335,6 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
         self.as_storage().simplify(positions, triangles, config)
     }
 
-    /// [`Storage::simplify_model`] on this workspace: a model's seams welded, its small parts
-    /// pruned, as `host-sim simplify` does by default (crate feature `seams`).
-    #[cfg(feature = "seams")]
-    pub fn simplify_model<I: Index>(
-        &mut self,
-        positions: &[[f32; 3]],
-        triangles: &mut [[I; 3]],
-        model: &mut crate::model::ModelStorage<'_, I, L>,
-        config: &Config,
-    ) -> Result<Report, Error> {
-        self.as_storage()
-            .simplify_model(positions, triangles, model, config)
-    }
-
     /// [`Storage::start`] on this workspace.
     pub fn start<'a, I: Index, C: Cost, B: Bound<'a, I>, O: Operator>(
         &'a mut self,

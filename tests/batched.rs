@@ -7,7 +7,7 @@
 //! * `the_error_limit_holds`: a spike the limit forbids cutting stops the run with
 //!   `Stop::ErrorLimit`, every collapse made under the limit.
 //! * `shared_meshes_stay_valid`: every shared mesh at 50 % and 10 %, the error limit of
-//!   `host-sim simplify` on, valid and at the target or stopped for a reason.
+//!   `tinydecimate simplify` on, valid and at the target or stopped for a reason.
 //! * `stored_quadrics_and_twins`: stored quadrics (both placements) and a double-sided
 //!   surface run under the batched schedule too.
 //! * `the_papers_feature_rule` and `passes_are_capped`.

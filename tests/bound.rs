@@ -333,7 +333,7 @@ fn every_schedule_and_cost_honours_the_bound() {
 
 #[test]
 fn shared_meshes_stay_within_the_bound() {
-    // The ones that run in a few seconds in release; `host-sim simplify --max-error` and the
+    // The ones that run in a few seconds in release; `tinydecimate simplify --max-error` and the
     // figures of docs/error-bound.md cover the others.
     for name in [
         "wuson.obj",

@@ -2,7 +2,7 @@
 //! the shared checker on generated meshes and a real fixture at 50, 25 and 10 %, the same
 //! result whatever the step size, the combinations the operator refuses, and no panic on bad
 //! input. The triangulation's own criterion (split plane and aspect ratio) is tested in
-//! `src/operator/decimate.rs`, the diagonal rule (`link`) in `src/policy/legality.rs`.
+//! `src/operator/decimate/`, the diagonal rule (`link`) in `src/policy/legality/fan.rs`.
 
 mod common;
 use common::*;

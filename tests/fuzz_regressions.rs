@@ -158,7 +158,7 @@ fn no_fold_when_a_stray_vertex_dwarfs_the_mesh() {
 /// found, the legality rules took the direction of exactly such a cross product, got zero
 /// vectors and never saw a fold: collapses folded (0, 2, 6) onto (0, 2, 5) and (2, 6, 7) onto
 /// (2, 5, 7). Fixed since: the rules take every normal from `legality::Shape::of`
-/// (src/policy/legality.rs), which scales the edges by a power of two before the cross product.
+/// (src/policy/legality/shape.rs), which scales the edges by a power of two before the cross product.
 #[test]
 fn no_fold_when_a_stray_vertex_is_1e30_away() {
     let positions: [[f32; 3]; 8] = [

@@ -1,4 +1,4 @@
-//! One test per legality rule (`tinydecimate::RULES`, in `src/policy/legality.rs`), each asserting a
+//! One test per legality rule (`tinydecimate::RULES`, in `src/policy/legality/mod.rs`), each asserting a
 //! property of real output that the rule exists to keep. `scripts/rules-off.sh` builds the
 //! library with each rule switched off in turn (`TINYDECIMATE_RULE_OFF`) and checks that these
 //! tests then fail. The table below has one row per rule of `RULES`, in its order, and
@@ -406,7 +406,7 @@ fn no_duplicate_triangles_on_tetrahedral_parts() {
 /// winding of the triangle it copies, so the fold rule refuses it too, and an inconsistent
 /// winding locks b. With every other rule on, the output is the same without the duplicate
 /// rule; what shows the rule at work is the report's count of the collapses it refused
-/// (`Report::rejected`, by the first rule that refuses, in the order of `src/policy/legality.rs`).
+/// (`Report::rejected`, by the first rule that refuses, in the order of `src/policy/legality/mod.rs`).
 #[test]
 fn tetrahedra_are_kept_whole_by_the_duplicate_rule() {
     let m = tetrahedra();
@@ -533,8 +533,8 @@ fn every_rule_has_a_row_and_a_test() {
     }
     let rules: Vec<&str> = RULES.iter().map(|r| r.name).collect();
     assert_eq!(names, rules, "the table's rows and RULES");
-    // scripts/rules-off.sh reads the names as the `name: "..."` lines of src/policy/legality.rs.
-    let script: Vec<&str> = include_str!("../src/policy/legality.rs")
+    // scripts/rules-off.sh reads the names as the `name: "..."` lines of src/policy/legality/mod.rs.
+    let script: Vec<&str> = include_str!("../src/policy/legality/mod.rs")
         .lines()
         .filter_map(|l| l.trim().strip_prefix("name: \"")?.strip_suffix("\","))
         .collect();

@@ -463,7 +463,7 @@ fn islands(n: u32) -> (MeshData, Vec<u8>) {
 /// A chart's last triangle is never collapsed away (the `seam` rule, both engines): islands of
 /// one, two and eight triangles inside a grid all keep a triangle at 25 % and 5 %, each
 /// output triangle on one chart, the output valid welded with no wedge of a kept position
-/// lost. This is what keeps every material when `host-sim simplify` joins a glTF mesh's
+/// lost. This is what keeps every material when `tinydecimate simplify` joins a glTF mesh's
 /// primitives. (With the chart clause of either engine's seam rule removed, the one-triangle
 /// island goes.)
 #[test]

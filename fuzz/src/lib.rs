@@ -1,5 +1,5 @@
 //! Shared code of the fuzz targets: the `simplify` case generator and its run, checked after
-//! every run with the shared validity checker (`meshcheck`, host-sim/meshcheck: written
+//! every run with the shared validity checker (`meshcheck`, meshcheck/: written
 //! independently of the library, std collections and f64 geometry).
 
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! one process and one run, written as Markdown and JSON.
 //!
 //! For every mesh and ratio `r` every simplifier of [`Method`] (or those `--modes` names) runs
-//! on the same input: our modes as `host-sim simplify` runs them (each variant's `Method` docs
+//! on the same input: our modes as `tinydecimate simplify` runs them (each variant's `Method` docs
 //! give its configuration), and the reference:
 //!
 //! * **meshopt**: `meshopt::simplify` (meshoptimizer [`MESHOPTIMIZER_VERSION`], bundled by the
@@ -45,7 +45,7 @@ use meshopt::{meshopt_simplify, meshopt_simplify_with_update};
 
 pub mod cluster;
 pub mod markdown;
-pub mod meshopt;
+pub use tinydecimate_cli::meshopt;
 
 /// The meshoptimizer version that `meshopt` [`MESHOPT_CRATE_VERSION`] bundles
 /// (`MESHOPTIMIZER_VERSION 1030` in its `vendor/src/meshoptimizer.h`).
@@ -124,7 +124,7 @@ pub struct Options {
     pub samples_per_triangle: f64,
     /// Show a progress bar (only if stderr is a terminal).
     pub progress: bool,
-    /// Our modes prune parts (`host-sim simplify --parts prune`, the default).
+    /// Our modes prune parts (`tinydecimate simplify --parts prune`, the default).
     pub prune: bool,
     /// Only these of our modes (`None`: every one); meshoptimizer always runs.
     pub modes: Option<Vec<Method>>,
@@ -159,10 +159,10 @@ pub enum Method {
     /// and rules in meshoptimizer's passes.
     Batched,
     /// tinydecimate's fast mode, `pipeline::FastWorkspace` with `Config::new()`:
-    /// meshoptimizer's pipeline with every output valid (`host-sim simplify --engine fast`).
+    /// meshoptimizer's pipeline with every output valid (`tinydecimate simplify --engine fast`).
     Fast,
     /// tinydecimate's lean mode, `pipeline::LeanWorkspace` with `Config::new()`: the fast
-    /// mode's pipeline without stored quadrics (`host-sim simplify --engine lean`).
+    /// mode's pipeline without stored quadrics (`tinydecimate simplify --engine lean`).
     Lean,
 }
 
@@ -664,7 +664,7 @@ fn run_method(
     for _ in 0..reps {
         let (out, elapsed, scratch, report) = match (method.config(), method.placement()) {
             (Some(config), placement) => {
-                // Seams welded (`host-sim simplify`'s default), when the mesh has any.
+                // Seams welded (`tinydecimate simplify`'s default), when the mesh has any.
                 let run = crate::simplify::Run {
                     operator: method.operator(),
                     placement,
@@ -721,11 +721,14 @@ fn run_method(
     })
 }
 
-/// `config` with `host-sim simplify`'s default error limit where it applies (the greedy
+/// `config` with `tinydecimate simplify`'s default error limit where it applies (the greedy
 /// schedule).
 fn with_default_limit(config: Config, mesh: &MeshData) -> Config {
     if config.schedule.is_ordered() {
-        config.with_relative_error_limit(crate::cmd::simplify::DEFAULT_ERROR_LIMIT, &mesh.positions)
+        config.with_relative_error_limit(
+            tinydecimate_cli::cmd::simplify::DEFAULT_ERROR_LIMIT,
+            &mesh.positions,
+        )
     } else {
         config
     }
@@ -843,7 +846,7 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                 let input = if ours { mesh } else { welded };
                 let run = run_method(input, method, ratio, target, opts.reps, opts.prune)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
-                // Ours welded seams: checked welded (no crack), as `host-sim simplify` does.
+                // Ours welded seams: checked welded (no crack), as `tinydecimate simplify` does.
                 // Ours may prune parts: a part gone whole is allowed, one cut in part is not.
                 let validity = crate::check::compare_parts(
                     input,

@@ -1,16 +1,11 @@
 //! The subcommands of the `host-sim` binary: each file holds one command's arguments and its
-//! `run`.
+//! `run`. The user's commands (simplify, check, render, ...) are the `tinydecimate` binary's,
+//! in `tinydecimate_cli::cmd`.
 
 pub mod bench;
 pub mod bound_table;
-pub mod check;
-pub mod cluster;
 pub mod demo;
-pub mod embed;
 pub mod golden;
-pub mod metro;
-pub mod pm;
 pub mod qemu;
-pub mod render;
 pub mod run_elf;
-pub mod simplify;
+pub mod stream;

@@ -45,6 +45,7 @@ pub mod build;
 pub mod check;
 pub mod cluster;
 pub mod defmt;
+pub mod elf;
 pub mod measure;
 pub mod run;
 

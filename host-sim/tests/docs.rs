@@ -13,12 +13,13 @@ fn read(rel: &str) -> String {
 }
 
 /// Every text file the citations and figures live in: README, docs, scripts and all `.rs`
-/// files of the library, the tests and host-sim (firmware included).
+/// files of the library, the tests, the command line and host-sim (firmware included).
 fn texts() -> Vec<(String, String)> {
     let mut out = Vec::new();
     let mut stack: Vec<PathBuf> = [
         "src",
         "tests",
+        "cli/src",
         "host-sim/src",
         "host-sim/firmware/src",
         "scripts",
@@ -89,7 +90,7 @@ fn seed_citations() {
             }
         }
     }
-    let legality = read("src/policy/legality.rs");
+    let legality = read("src/policy/legality/mod.rs");
     // The link rule's row of `RULES`: its `source` follows its `name`.
     let link = legality
         .split("name: \"link\",")
@@ -100,7 +101,7 @@ fn seed_citations() {
     let readme = read("README.md");
     assert!(readme.contains("Cheng, Pan and Shi"));
     assert!(readme.contains("§3.2(1)"));
-    assert!(read("host-sim/src/metro.rs").contains("Zhu, Wang and Meng"));
+    assert!(read("cli/src/metro.rs").contains("Zhu, Wang and Meng"));
 }
 
 /// Stale or overstated lines.
@@ -336,15 +337,50 @@ fn the_package_holds_the_library_only() {
     assert!(!stderr.contains("manifest has no"), "{stderr}");
 }
 
-/// `host-sim ARGS --help` (long help), as text.
-fn help_of(args: &[&str]) -> String {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
-        .args(args)
-        .arg("--help")
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{args:?} --help failed");
-    String::from_utf8(out.stdout).unwrap()
+/// The two command lines whose reference pages are checked against their help.
+#[derive(Clone, Copy, Debug)]
+enum Binary {
+    /// `tinydecimate` (cli/), documented in docs/cli.md.
+    Cli,
+    /// `host-sim`, documented in docs/harness.md.
+    Harness,
+}
+
+impl Binary {
+    fn page(self) -> &'static str {
+        match self {
+            Binary::Cli => "docs/cli.md",
+            Binary::Harness => "docs/harness.md",
+        }
+    }
+}
+
+/// `BINARY ARGS --help` (long help), as text: host-sim's from the built binary, the command
+/// line's from its parser (the binary belongs to another package).
+fn help_of(bin: Binary, args: &[&str]) -> String {
+    match bin {
+        Binary::Harness => {
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+                .args(args)
+                .arg("--help")
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{args:?} --help failed");
+            String::from_utf8(out.stdout).unwrap()
+        }
+        Binary::Cli => {
+            use clap::CommandFactory;
+            let argv = std::iter::once("tinydecimate")
+                .chain(args.iter().copied())
+                .chain(["--help"]);
+            let e = match tinydecimate_cli::cmd::Cli::command().try_get_matches_from(argv) {
+                Err(e) => e,
+                Ok(_) => panic!("{args:?} --help parsed as a run"),
+            };
+            assert_eq!(e.kind(), clap::error::ErrorKind::DisplayHelp, "{args:?}");
+            e.render().to_string()
+        }
+    }
 }
 
 /// What a command's `--help` lists: its subcommands, and its flags (long names, `--help` and
@@ -414,18 +450,18 @@ fn parse_help(text: &str) -> Help {
     h
 }
 
-/// Every leaf command (`simplify`, `pm encode`, ...) and its help.
-fn commands() -> Vec<(String, Help)> {
-    let top = parse_help(&help_of(&[]));
-    assert!(top.commands.len() >= 12, "{:?}", top.commands);
+/// Every leaf command (`simplify`, `pm encode`, ...) of `bin` and its help.
+fn commands(bin: Binary) -> Vec<(String, Help)> {
+    let top = parse_help(&help_of(bin, &[]));
+    assert!(top.commands.len() >= 7, "{:?}", top.commands);
     let mut out = Vec::new();
     for c in top.commands {
-        let h = parse_help(&help_of(&[&c]));
+        let h = parse_help(&help_of(bin, &[&c]));
         if h.commands.is_empty() {
             out.push((c, h));
         } else {
             for sub in &h.commands {
-                out.push((format!("{c} {sub}"), parse_help(&help_of(&[&c, sub]))));
+                out.push((format!("{c} {sub}"), parse_help(&help_of(bin, &[&c, sub]))));
             }
         }
     }
@@ -461,7 +497,7 @@ fn has_word(text: &str, word: &str) -> bool {
     })
 }
 
-/// docs/harness.md's reference section of each command: `### `cmd`` up to the next heading.
+/// A reference page's section of each command: `### `cmd`` up to the next heading.
 fn reference(doc: &str, command: &str) -> Option<String> {
     let heading = format!("### `{command}`");
     let start = doc.lines().position(|l| l.trim_end() == heading)?;
@@ -473,28 +509,42 @@ fn reference(doc: &str, command: &str) -> Option<String> {
     Some(body.join("\n"))
 }
 
-/// docs/harness.md and `--help` agree: every command has a reference section; every flag of
-/// a command's help is named there on a line that also names each of its possible values;
-/// every flag the section names is in that command's help, and every flag the page names is
-/// some command's.
+/// docs/cli.md and docs/harness.md agree with `--help`: every command has a reference
+/// section; every flag of a command's help is named there on a line that also names each of
+/// its possible values; every flag the section names is in that command's help, and every
+/// flag the page names is some command's.
 #[test]
-fn harness_reference_matches_help() {
-    let doc = read("docs/harness.md");
-    let commands = commands();
+fn reference_pages_match_help() {
+    let mut problems = Vec::new();
+    for bin in [Binary::Cli, Binary::Harness] {
+        problems.extend(reference_problems(bin));
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// What [`reference_pages_match_help`] finds wrong in `bin`'s page.
+fn reference_problems(bin: Binary) -> Vec<String> {
+    let page = bin.page();
+    let doc = read(page);
+    let commands = commands(bin);
     let mut problems = Vec::new();
     for (name, help) in &commands {
         let Some(section) = reference(&doc, name) else {
-            problems.push(format!("no section \"### `{name}`\""));
+            problems.push(format!("{page}: no section \"### `{name}`\""));
             continue;
         };
         for (flag, values) in &help.flags {
             let lines: Vec<&str> = section.lines().filter(|l| has_word(l, flag)).collect();
             if lines.is_empty() {
-                problems.push(format!("{name}: {flag} is in --help, not in the docs"));
+                problems.push(format!(
+                    "{page}: {name}: {flag} is in --help, not in the docs"
+                ));
             }
             for v in values {
                 if !lines.iter().any(|l| has_word(l, v)) {
-                    problems.push(format!("{name}: {flag} {v} is in --help, not in the docs"));
+                    problems.push(format!(
+                        "{page}: {name}: {flag} {v} is in --help, not in the docs"
+                    ));
                 }
             }
         }
@@ -502,7 +552,7 @@ fn harness_reference_matches_help() {
         for flag in flags_named(&section) {
             if !known.contains(&flag.as_str()) {
                 problems.push(format!(
-                    "{name}: the docs name {flag}, --help has no such flag"
+                    "{page}: {name}: the docs name {flag}, --help has no such flag"
                 ));
             }
         }
@@ -513,11 +563,11 @@ fn harness_reference_matches_help() {
         .flat_map(|(_, h)| h.flags.iter().map(|(f, _)| f.as_str()))
         .collect();
     // Cargo's and clap's own flags are no command's.
-    let own = ["--release", "--help", "--version"];
+    let own = ["--release", "--help", "--version", "--path", "--features"];
     for flag in flags_named(&doc) {
         if !all.contains(&flag.as_str()) && !own.contains(&flag.as_str()) {
-            problems.push(format!("docs/harness.md names {flag}, no command has it"));
+            problems.push(format!("{page} names {flag}, no command has it"));
         }
     }
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    problems
 }

@@ -1,39 +1,11 @@
-//! The quadric representative: each cell's plane quadric, then the vertex of the cell with the
-//! least error.
+//! The quadric representative's choice: the vertex of each cell with the least error under
+//! the cell's plane quadric (accumulated by the pass, `pass::add_plane`).
 
-use super::grid::Grid;
-use super::pass::{pack_q, unpack_q, Pass, OFFERED};
-use super::search::FINAL;
+use super::cache::{pack_q, unpack_q, FINAL, OFFERED};
+use super::pass::Pass;
 use super::source::{checked_position, SourcePositions};
 use super::{to_u32, ClusterError, Source, CHUNK};
 use crate::index::Index;
-use crate::math::{self, V3};
-use crate::quadric;
-
-/// Adds the area-weighted plane of the triangle `p` to the quadrics of its three cells
-/// (coordinates relative to each cell's corner, for precision).
-#[inline]
-pub(super) fn add_plane(q: &mut [[f32; 10]], grid: &Grid, s: [usize; 3], k: [u32; 3], p: [V3; 3]) {
-    let n = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
-    let l2 = math::dot(n, n);
-    if !(l2 > math::TINY2 && l2.is_finite()) {
-        return;
-    }
-    // n nᵀ / |n| = area-weighted unit-normal quadric (times 2).
-    let w = math::rsqrt(l2);
-    for j in 0..3 {
-        let (Some(&sj), Some(&kj)) = (s.get(j), k.get(j)) else {
-            continue;
-        };
-        let o = grid.corner(kj);
-        let d = -math::dot(n, math::sub(p[0], o));
-        if let Some(e) = q.get_mut(sj) {
-            for (x, y) in e.iter_mut().zip(quadric::outer(n, d)) {
-                *x += y * w;
-            }
-        }
-    }
-}
 
 /// The quadric representative's second pass with a bit per vertex: each vertex is offered
 /// to its cell once, at its first corner in the stream (a later offer of the same vertex

@@ -1,13 +1,9 @@
 //! The uniform grid of cubic cells, and the bounding-box pass that fits it.
 
-use super::pass::NO_Q;
+use super::cache::{pack_q, unpack_q, NO_Q, QBITS, QMAX};
+use super::source::{checked_position, PositionSource};
 use super::{ClusterError, Source, CHUNK, MAX_RESOLUTION};
 use crate::math::{self, V3};
-
-/// Fixed-point bits of a position inside the box (per axis, along the longest side).
-pub(super) const QBITS: u32 = 20;
-
-pub(super) const QMAX: u32 = (1 << QBITS) - 1;
 
 /// A uniform grid of cubic cells: `n` cells along the longest side of the bounding box.
 ///
@@ -225,4 +221,26 @@ pub(super) fn bbox<S: Source>(
         return Err(ClusterError::EmptyInput);
     }
     Ok((min, max, top))
+}
+
+/// The quantised coordinates of vertex `v` (a corner of triangle number `index`), from the
+/// cache when it has them (then the position was checked when they were stored), else from
+/// the checked position, stored in the cache when it has room for `v`.
+#[inline]
+pub(super) fn quantised<P: PositionSource + ?Sized>(
+    cache: &mut [u64],
+    pos: &mut P,
+    grid: &Grid,
+    v: u32,
+    index: usize,
+) -> Result<[u32; 3], ClusterError> {
+    match cache.get_mut(v as usize) {
+        Some(e) if *e >> 63 == 0 => Ok(unpack_q(*e)),
+        Some(e) => {
+            let q = grid.quantise(checked_position(pos, v, index)?);
+            *e = pack_q(q);
+            Ok(q)
+        }
+        None => Ok(grid.quantise(checked_position(pos, v, index)?)),
+    }
 }

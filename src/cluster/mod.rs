@@ -71,6 +71,7 @@
 
 use crate::index::Index;
 
+mod cache;
 mod choose;
 mod cleanup;
 mod grid;
@@ -79,15 +80,17 @@ mod search;
 mod source;
 mod then_collapse;
 
+use cache::NO_Q;
 use choose::{choose_by_vertex, choose_once};
 use cleanup::cell_normals;
 use grid::bbox;
-use pass::{finish_compact, finish_report, run, Pass, NO_Q};
+use pass::{finish_compact, finish_report, run, Pass};
 use search::final_keys;
 
+pub use cache::KEY_LANES;
 pub use grid::Grid;
 pub use pass::Stream;
-pub use search::{KEY_LANES, PROBES};
+pub use search::PROBES;
 pub use source::{PositionFn, PositionSource, SliceSource, Source};
 pub use then_collapse::{cluster_then_collapse, ThenCollapseError};
 

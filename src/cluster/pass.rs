@@ -1,10 +1,9 @@
 //! One clustering pass over the stream: cells in the hash table, representatives offered,
 //! output triangles gathered (deduplicated) in the caller's buffer; and its report.
 
-use super::choose::add_plane;
-use super::grid::{Grid, QMAX};
-use super::search::{FINAL, KEY_LANES};
-use super::source::{checked_position, corners, PositionSource, SourcePositions};
+use super::cache::{FINAL, KEY_LANES};
+use super::grid::{quantised, Grid};
+use super::source::{corners, PositionSource, SourcePositions};
 use super::{ClusterError, ClusterReport, Slot, Source, CHUNK, EMPTY};
 use crate::index::Index;
 use crate::math::{self, V3};
@@ -38,48 +37,6 @@ pub(super) struct Pass<'a, I: Index> {
     pub(super) keys: &'a mut [[u32; KEY_LANES]],
     /// A corner's vertex was beyond the cache (in a pass that reads the cache).
     pub(super) beyond: bool,
-}
-
-/// A cache entry not yet filled (valid entries have bit 63 clear).
-pub(super) const NO_Q: u64 = u64::MAX;
-
-/// In a valid cache entry: the vertex was offered in the choosing pass.
-pub(super) const OFFERED: u64 = 1 << 62;
-
-#[inline]
-pub(super) fn pack_q(q: [u32; 3]) -> u64 {
-    u64::from(q[0]) | (u64::from(q[1]) << 20) | (u64::from(q[2]) << 40)
-}
-
-#[inline]
-pub(super) fn unpack_q(e: u64) -> [u32; 3] {
-    [
-        (e & u64::from(QMAX)) as u32,
-        ((e >> 20) & u64::from(QMAX)) as u32,
-        ((e >> 40) & u64::from(QMAX)) as u32,
-    ]
-}
-
-/// The quantised coordinates of vertex `v` (a corner of triangle number `index`), from the
-/// cache when it has them (then the position was checked when they were stored), else from
-/// the checked position, stored in the cache when it has room for `v`.
-#[inline]
-pub(super) fn quantised<P: PositionSource + ?Sized>(
-    cache: &mut [u64],
-    pos: &mut P,
-    grid: &Grid,
-    v: u32,
-    index: usize,
-) -> Result<[u32; 3], ClusterError> {
-    match cache.get_mut(v as usize) {
-        Some(e) if *e >> 63 == 0 => Ok(unpack_q(*e)),
-        Some(e) => {
-            let q = grid.quantise(checked_position(pos, v, index)?);
-            *e = pack_q(q);
-            Ok(q)
-        }
-        None => Ok(grid.quantise(checked_position(pos, v, index)?)),
-    }
 }
 
 #[inline]
@@ -516,4 +473,29 @@ pub(super) fn run<S: Source, I: Index>(
         pass.push(chunk, &mut acc)?;
     }
     Ok(total)
+}
+
+/// Adds the area-weighted plane of the triangle `p` to the quadrics of its three cells
+/// (coordinates relative to each cell's corner, for precision).
+#[inline]
+pub(super) fn add_plane(q: &mut [[f32; 10]], grid: &Grid, s: [usize; 3], k: [u32; 3], p: [V3; 3]) {
+    let n = math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]));
+    let l2 = math::dot(n, n);
+    if !(l2 > math::TINY2 && l2.is_finite()) {
+        return;
+    }
+    // n nᵀ / |n| = area-weighted unit-normal quadric (times 2).
+    let w = math::rsqrt(l2);
+    for j in 0..3 {
+        let (Some(&sj), Some(&kj)) = (s.get(j), k.get(j)) else {
+            continue;
+        };
+        let o = grid.corner(kj);
+        let d = -math::dot(n, math::sub(p[0], o));
+        if let Some(e) = q.get_mut(sj) {
+            for (x, y) in e.iter_mut().zip(quadric::outer(n, d)) {
+                *x += y * w;
+            }
+        }
+    }
 }

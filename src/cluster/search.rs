@@ -1,23 +1,13 @@
 //! The grid search for a target triangle count: counting passes that probe several resolutions
 //! at once.
 
-use super::grid::{Grid, QBITS};
-use super::pass::{pack_q, quantised, unpack_q, NO_Q};
+use super::cache::{pack_q, unpack_q, FINAL, KEY_LANES, NO_Q, QBITS, STAMP};
+use super::grid::{quantised, Grid};
 use super::source::{corners, SourcePositions};
 use super::{ClusterError, Clusterer, Source, CHUNK, MAX_RESOLUTION};
 
 /// Resolutions probed per counting pass of the target search.
 pub const PROBES: usize = 6;
-
-/// Lanes of a per-vertex key entry of [`Scratch::keys`](super::Scratch::keys): the cells of the
-/// [`PROBES`] resolutions of a counting pass, padded to 8 (32 bytes, two SIMD registers).
-pub const KEY_LANES: usize = 8;
-
-/// The lane of a key entry that holds the number of the counting pass it was computed for.
-pub(super) const STAMP: usize = KEY_LANES - 1;
-
-/// The stamp of an entry computed for the final grid (counting passes are 1, 2, ...).
-pub(super) const FINAL: u32 = u32::MAX;
 
 /// Before the accumulating pass: each vertex with quantised coordinates in the cache gets
 /// its cell on the final `grid` in its key entry (the others are computed at their first

@@ -32,6 +32,7 @@ pub(crate) use crate::tri::{next3, prev3, NIL};
 mod build;
 mod collapse;
 mod replace;
+pub(crate) use replace::MAX_FAN;
 
 /// Per-vertex flag bits.
 pub(crate) mod flag {

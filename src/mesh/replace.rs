@@ -5,8 +5,9 @@ use super::{corner, Mesh};
 use crate::index::Index;
 use crate::tri::{next3, prev3, NIL};
 
-/// The most triangles a replaced fan may have (the removal operators' ring bound).
-const MAX_FAN: usize = crate::operator::MAX_RING;
+/// The most triangles a replaced fan may have: the removal operators size their ring buffers
+/// by it (`operator::MAX_RING`).
+pub(crate) const MAX_FAN: usize = 32;
 
 impl<L: Index, I: Index> Mesh<'_, L, I> {
     /// Removes `v` and its `k` triangles and writes `new` (triangles over `v`'s neighbours,

@@ -179,7 +179,7 @@ fn edge_quadric(p0: V3, p1: V3, p2: V3) -> Option<PointQuadric> {
 #[inline(never)]
 fn seam_planes(flags: &[u8], (x, y): (usize, usize), [pv, px, py]: [V3; 3], q: &mut PointQuadric) {
     for (w, pw, po) in [(x, px, py), (y, py, px)] {
-        if !super::pick::along(flags, w) {
+        if !super::along(flags, w) {
             continue;
         }
         let e = math::sub(pw, pv);

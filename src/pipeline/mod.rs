@@ -98,7 +98,7 @@
 //! workspace (one flag bit) and, as a separate instantiation, no flash to a firmware that
 //! does not call it.
 //!
-//! Not the crate's default ([`Config::new`]'s engine is); `host-sim simplify`'s (`--engine
+//! Not the crate's default ([`Config::new`]'s engine is); `tinydecimate simplify`'s (`--engine
 //! auto`, unless an option of the exact engine's alone is given or the mesh is double-sided;
 //! `--engine fast` or `lean` ask for it): without attributes seams welded by position before
 //! the call, with them (glTF, OBJ with `vt`/`vn`) with wedges, and parts pruned (`prune`,
@@ -278,6 +278,36 @@ pub(crate) fn set_link<L: Index>(s: &mut [L], i: usize, v: usize) {
 #[inline]
 pub(crate) fn flags_of(f: &[u8], v: usize) -> u8 {
     f.get(v).copied().unwrap_or(flag::GONE)
+}
+
+/// Whether a seam vertex may offer a collapse onto `x`: a seam or locked vertex (the spoke
+/// may be the seam; the checks refuse one across which the wedge does not change).
+#[inline]
+pub(super) fn along(flags: &[u8], x: usize) -> bool {
+    let f = flags_of(flags, x);
+    f & flag::SEAM != 0 || f & flag::KIND == flag::LOCKED
+}
+
+/// Whether rule `name` is on in this build (`PIPELINE_RULE_OFF=<name>` at build time switches
+/// one off; the rules' names are in `perform.rs`).
+#[inline(always)]
+pub(super) const fn on(name: &str) -> bool {
+    let off = match option_env!("PIPELINE_RULE_OFF") {
+        Some(s) => s.as_bytes(),
+        None => b"",
+    };
+    let name = name.as_bytes();
+    if off.len() != name.len() {
+        return true;
+    }
+    let mut i = 0;
+    while i < off.len() {
+        if off[i] != name[i] {
+            return true;
+        }
+        i += 1;
+    }
+    false
 }
 
 /// Bits of the link type `L`.

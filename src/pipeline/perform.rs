@@ -40,7 +40,7 @@
 use super::fill::{vertex_quadric, Price, Quadrics};
 use super::sort::key;
 use super::{
-    dead, fan, flag, flags_of, link, list, others, set_link, slot, tri, Frame, Stats, NONE,
+    dead, fan, flag, flags_of, link, list, on, others, set_link, slot, tri, Frame, Stats, NONE,
 };
 use crate::index::Index;
 use crate::legality::Reject;
@@ -106,27 +106,6 @@ const RULE_BORDER: &str = "border";
 const RULE_LOCKED: &str = "locked";
 const RULE_SEAM: &str = "seam";
 
-/// Whether rule `name` is on in this build.
-#[inline(always)]
-pub(super) const fn on(name: &str) -> bool {
-    let off = match option_env!("PIPELINE_RULE_OFF") {
-        Some(s) => s.as_bytes(),
-        None => b"",
-    };
-    let name = name.as_bytes();
-    if off.len() != name.len() {
-        return true;
-    }
-    let mut i = 0;
-    while i < off.len() {
-        if off[i] != name[i] {
-            return true;
-        }
-        i += 1;
-    }
-    false
-}
-
 /// a's cheapest target other than `b` that its kind allows (pick's rules) and no collapse of
 /// this pass has touched, and its price.
 #[inline(never)]
@@ -159,7 +138,7 @@ fn alternative<I: Index, L: Index, Q: Quadrics, const W: bool>(
             if w == b || fw & flag::PASS != 0 || fw & flag::KIND == flag::GONE {
                 continue;
             }
-            if seam && !super::pick::along(flags, w) {
+            if seam && !super::along(flags, w) {
                 continue;
             }
             if border

@@ -7,7 +7,7 @@
 
 use super::fill::{Price, Quadrics};
 use super::sort::key;
-use super::{fan, flag, flags_of, others, Frame, BINS, NONE};
+use super::{along, fan, flag, flags_of, others, Frame, BINS, NONE};
 use crate::index::Index;
 use crate::math::{self, V3};
 use crate::quadric;
@@ -34,8 +34,8 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
     }
     let free = |k: u8| {
         k == flag::MANIFOLD
-            || (!const { super::perform::on("border") } && k == flag::BORDER)
-            || (!const { super::perform::on("locked") } && k == flag::LOCKED)
+            || (!const { super::on("border") } && k == flag::BORDER)
+            || (!const { super::on("locked") } && k == flag::LOCKED)
     };
     // The lean mode's neighbours of one fan, reused vertex to vertex.
     let mut seen = [(0u32, [0.0f32; 3]); FAN];
@@ -140,14 +140,6 @@ fn once<I: Index, L: Index>(
         }
     }
     Some((to, best, q))
-}
-
-/// Whether a seam vertex may offer a collapse onto `x`: a seam or locked vertex (the spoke
-/// may be the seam; the checks refuse one across which the wedge does not change).
-#[inline]
-pub(super) fn along(flags: &[u8], x: usize) -> bool {
-    let f = flags_of(flags, x);
-    f & flag::SEAM != 0 || f & flag::KIND == flag::LOCKED
 }
 
 /// Neighbours one fan walk keeps for the lean mode's offers (a larger fan is walked twice).

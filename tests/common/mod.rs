@@ -267,7 +267,7 @@ pub fn cube(n: u32) -> MeshData {
 }
 
 // ---- invariants ------------------------------------------------------------------------
-// The checker is the `meshcheck` crate (host-sim/meshcheck), shared with the fuzz targets and
+// The checker is the `meshcheck` crate (meshcheck/), shared with the fuzz targets and
 // host-sim: written independently of the library, f64 geometry.
 
 #[allow(unused_imports)]

@@ -1,5 +1,5 @@
 //! A complete firmware for a Cortex-M4F board: simplifies a mesh kept in flash (`src/cow.rs`,
-//! written from an OBJ file by `host-sim embed`) with a `static` workspace and logs the report
+//! written from an OBJ file by `tinydecimate embed`) with a `static` workspace and logs the report
 //! through defmt.
 //!
 //! In QEMU (mps2-an386), from this folder, with `qemu-system-arm` installed:

@@ -3,6 +3,6 @@
 #![no_std]
 
 /// The cow of the tinydecimate repository's `tests/fixtures/cow.obj`, written by
-/// `host-sim embed` (the command that regenerates it heads the file). For a mesh of your own,
+/// `tinydecimate embed` (the command that regenerates it heads the file). For a mesh of your own,
 /// run the same command on your OBJ, PLY, STL or glTF file and replace `src/cow.rs`.
 pub mod cow;

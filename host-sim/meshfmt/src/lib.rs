@@ -732,7 +732,7 @@ pub fn narrow(v: usize) -> u32 {
 
 /// Conversions to and from the library's types: the one place where the file fields meet
 /// `Config` and `Report`, shared by the firmware and the host's reference run.
-/// The progressive-stream run of the firmware and the host (`host-sim pm stream`, golden
+/// The progressive-stream run of the firmware and the host (`host-sim stream`, golden
 /// cases `pm-*`).
 #[cfg(feature = "tinydecimate")]
 pub mod pm;

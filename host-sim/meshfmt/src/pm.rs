@@ -2,7 +2,7 @@
 //! stream fed in pieces of varying size, record the mesh as it refines, then slide it down to
 //! the base mesh and back up. The firmware runs [`run`] on each board, the host runs the same
 //! function in memory, and the two outputs must be byte for byte the same (golden cases of
-//! `host-sim golden` / `host-sim qemu --check`; the streaming demo of `host-sim pm stream`).
+//! `host-sim golden` / `host-sim qemu --check`; the streaming demo of `host-sim stream`).
 //!
 //! # Output file (device → host)
 //!

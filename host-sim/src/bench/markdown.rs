@@ -138,7 +138,7 @@ fn header(s: &mut String, r: &Results) {
         .collect();
     let _ = writeln!(
         s,
-        "* tinydecimate modes, each `.with_ratio(ratio)`: {}. As `host-sim simplify` runs \
+        "* tinydecimate modes, each `.with_ratio(ratio)`: {}. As `tinydecimate simplify` runs \
          them: vertices at one position welded (`--seams weld`), the greedy modes (vertex \
          decimation too) with the error limit of 2 % of the diagonal (`--error-limit`); the \
          greedy, batched, fast and lean modes, unless the bench was given `--parts keep`, \
@@ -356,7 +356,7 @@ fn per_mesh(s: &mut String, r: &Results) {
          Metro symmetric mean and Hausdorff distance in % of the input's bbox diagonal, each \
          followed by its ratio to meshoptimizer's († at the same triangle count: see the \
          *meshoptimizer at N* row below it); **valid** the shared checker's verdict \
-         (`host-sim check`; NM new non-manifold edges, dup duplicate and deg degenerate \
+         (`tinydecimate check`; NM new non-manifold edges, dup duplicate and deg degenerate \
          triangles, fold new folded pairs, loops boundary loops and χ Euler characteristic \
          before→after); **stop** the library's `Report::stop`."
     );

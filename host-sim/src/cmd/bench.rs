@@ -43,10 +43,10 @@ pub struct Args {
     /// meshoptimizer's `simplifySloppy` instead (table to --out only; default ratios 0.2,0.05).
     #[arg(long)]
     pub cluster: bool,
-    /// Parts in our modes, as `host-sim simplify --parts`: `prune` (the default) lets a part
+    /// Parts in our modes, as `tinydecimate simplify --parts`: `prune` (the default) lets a part
     /// cheaper than the next collapse vanish whole, `keep` keeps every part.
-    #[arg(long, value_enum, default_value_t = super::simplify::PartsArg::Prune)]
-    pub parts: super::simplify::PartsArg,
+    #[arg(long, value_enum, default_value_t = tinydecimate_cli::cmd::simplify::PartsArg::Prune)]
+    pub parts: tinydecimate_cli::cmd::simplify::PartsArg,
     /// Only these of our modes, comma separated (default: every one); meshoptimizer always
     /// runs, as the reference (simplifyWithUpdate too with stored-optimal).
     #[arg(long, value_enum, value_delimiter = ',')]
@@ -82,7 +82,7 @@ impl Args {
             reps: self.reps.unwrap_or(reps),
             samples_per_triangle: self.samples_per_triangle,
             progress: true,
-            prune: self.parts == super::simplify::PartsArg::Prune,
+            prune: self.parts == tinydecimate_cli::cmd::simplify::PartsArg::Prune,
             modes: self.modes.clone(),
         };
         let partial = self.quick || self.only.is_some();

@@ -7,7 +7,7 @@ use std::process::{Command, ExitCode, Stdio};
 
 use anyhow::{bail, Context, Result};
 
-use super::measure::elf_sizes;
+use super::elf::elf_sizes;
 use super::{Board, Qemu};
 use crate::backend::Backend;
 

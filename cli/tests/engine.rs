@@ -1,0 +1,279 @@
+//! `tinydecimate simplify --engine fast` and `--engine lean`: the fast and the lean mode
+//! (`tinydecimate::pipeline`) from the command line. Their outputs pass the shared check with
+//! `check`'s defaults (seams welded, parts may vanish whole), the error limit stops them as it
+//! stops the exact engine, and what they cannot run is refused with the option named. Each
+//! test runs the built binary, once per engine.
+
+mod common;
+use common::{fixture, run, s, text};
+
+/// The pipeline's engines and their name in the JSON (`engine`).
+const ENGINES: [(&str, &str); 2] = [("fast", "Fast"), ("lean", "Lean")];
+
+/// A clean scan, a seam-split asset (welded by position), a raw CAD export and a multi-part
+/// model at 10 %: `simplify` says VALID, `check` agrees, and the JSON names the engine.
+#[test]
+fn fast_and_lean_outputs_pass_check() {
+    let d = tempfile::tempdir().unwrap();
+    let mut failed = Vec::new();
+    for (engine, json_name) in ENGINES {
+        for mesh in [
+            "stanford_bunny.obj",
+            "suzanne_seams.obj",
+            "pins.obj",
+            "wuson.obj",
+        ] {
+            let input = fixture(mesh);
+            let out = d.path().join(format!("{engine}-{mesh}"));
+            let o = run(&[
+                "simplify",
+                s(&input),
+                s(&out),
+                "--ratio",
+                "0.1",
+                "--engine",
+                engine,
+                "--json",
+            ]);
+            let so = text(&o.stdout);
+            assert_eq!(o.status.code(), Some(0), "{engine} {mesh}: {so}");
+            let j: serde_json::Value = serde_json::from_str(&so).unwrap();
+            assert_eq!(j["engine"], json_name, "{engine} {mesh}");
+            assert_eq!(j["valid"], true, "{engine} {mesh}");
+            let c = run(&["check", s(&input), s(&out)]);
+            if c.status.code() != Some(0) {
+                failed.push(format!("{engine} {mesh}:\n{}", text(&c.stdout)));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// The bunny to 1 % with a limit of 0.05 % of the diagonal stops on the limit, short of the
+/// target, with every collapse made under it; without a limit it reaches the count.
+#[test]
+fn the_error_limit_stops_the_fast_and_lean_engines() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("stanford_bunny.obj");
+    let out = d.path().join("b.obj");
+    for (engine, _) in ENGINES {
+        let report = |limit: &str| {
+            engine_json(engine, &input, &out, "0.01", &["--error-limit", limit])["report"].clone()
+        };
+        let free = report("none");
+        assert_eq!(free["stop"], "Target", "{engine}: {free}");
+        let limited = report("0.05%");
+        assert_eq!(limited["stop"], "ErrorLimit", "{engine}: {limited}");
+        assert!(
+            limited["over_limit"].as_u64().unwrap() > 0,
+            "{engine}: {limited}"
+        );
+        assert!(
+            limited["triangles_out"].as_u64().unwrap()
+                > 2 * free["triangles_out"].as_u64().unwrap(),
+            "{engine}: {limited}"
+        );
+        // 0.05 % of the bunny's diagonal (about 0.25 units): every collapse under it.
+        let diagonal = 0.2502f64;
+        assert!(
+            limited["collapse_error"].as_f64().unwrap() <= 0.0005 * diagonal * 1.001,
+            "{engine}: {limited}"
+        );
+    }
+}
+
+/// What the fast and the lean mode do not run is refused before any work, the option named.
+#[test]
+fn what_the_fast_and_lean_engines_cannot_run_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("cow.obj");
+    let out = d.path().join("c.obj");
+    // Attributes: kept, the seams welded with their wedges (not refused).
+    let textured = textured_quad(d.path());
+    for (engine, _) in ENGINES {
+        for (extra, named) in [
+            (&["--schedule", "passes"][..], "--schedule"),
+            (&["--quadric", "stored"][..], "--quadric"),
+            (&["--operator", "triangle"][..], "--operator"),
+            (&["--max-error", "1%"][..], "--max-error"),
+            (&["--cost", "normal"][..], "--cost"),
+            (&["--lambda", "1"][..], "--lambda"),
+        ] {
+            let mut args = vec![
+                "simplify",
+                s(&input),
+                s(&out),
+                "--ratio",
+                "0.5",
+                "--engine",
+                engine,
+            ];
+            args.extend_from_slice(extra);
+            let o = run(&args);
+            assert_ne!(o.status.code(), Some(0), "{engine} {extra:?}");
+            let e = text(&o.stderr);
+            assert!(e.contains(named), "{engine} {extra:?}: {e}");
+            assert!(!out.exists(), "{engine} {extra:?}: an output was written");
+        }
+        let o = run(&[
+            "simplify",
+            s(&textured),
+            s(&out),
+            "--ratio",
+            "0.5",
+            "--engine",
+            engine,
+        ]);
+        assert_eq!(o.status.code(), Some(0), "{engine}: {}", text(&o.stderr));
+        let written = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            written.contains("\nvt "),
+            "{engine}: texture coordinates lost"
+        );
+        std::fs::remove_file(&out).unwrap();
+    }
+}
+
+/// `--engine auto` (the default) runs the fast mode, and the exact engine when an option only
+/// it takes is given or the mesh is double-sided somewhere.
+#[test]
+fn auto_picks_the_fast_mode_unless_the_run_needs_the_exact_engine() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o.obj");
+    let engine = |input: &std::path::Path, extra: &[&str]| {
+        let mut args = vec!["simplify", s(input), s(&out), "--ratio", "0.5", "--json"];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(0), "{extra:?}: {}", text(&o.stderr));
+        let j: serde_json::Value = serde_json::from_str(&text(&o.stdout)).unwrap();
+        j["engine"].as_str().unwrap().to_string()
+    };
+    let cow = fixture("cow.obj");
+    assert_eq!(engine(&cow, &[]), "Fast");
+    assert_eq!(engine(&cow, &["--parts", "keep"]), "Fast");
+    assert_eq!(engine(&cow, &["--parts", "prune"]), "Fast");
+    assert_eq!(engine(&cow, &["--schedule", "batched"]), "Exact");
+    assert_eq!(engine(&cow, &["--engine", "exact"]), "Exact");
+    // A sheet of two triangles with its back: double-sided.
+    let sheet = d.path().join("sheet.obj");
+    std::fs::write(
+        &sheet,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n",
+    )
+    .unwrap();
+    assert_eq!(engine(&sheet, &[]), "Exact");
+}
+
+/// The fandisk (a CAD model: flat and cylindrical patches) to 50 %: every collapse it needs
+/// lies in a patch, so the result stays within 0.005 % of the diagonal of the input (Metro,
+/// both directions). Quadrics evaluated in a global frame in `f32` lose such errors to
+/// rounding; the vertex-centred ones do not.
+#[test]
+fn collapses_within_flat_patches_cost_no_error() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("fandisk.obj");
+    let out = d.path().join("f.obj");
+    for (engine, _) in ENGINES {
+        let j = engine_json(engine, &input, &out, "0.5", &["--measure"]);
+        let h = j["metro"]["hausdorff_pct"].as_f64().unwrap();
+        assert!(
+            h < 0.005,
+            "{engine}: Hausdorff distance {h} % of the diagonal"
+        );
+    }
+}
+
+/// The CAD assembly with pins to 10 %: its small closed parts hold it above the target with
+/// `--parts keep`; by default they go whole (the report counts them), the target is reached
+/// and `check` accepts the output.
+#[test]
+fn the_fast_and_lean_engines_prune_parts() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("pr2_sensor_mount.obj");
+    let out = d.path().join("p.obj");
+    for (engine, _) in ENGINES {
+        let kept = engine_json(engine, &input, &out, "0.1", &["--parts", "keep"]);
+        assert_eq!(kept["report"]["parts_removed"], 0, "{engine}");
+        assert_eq!(kept["report"]["target_reached"], false, "{engine}");
+        let pruned = engine_json(engine, &input, &out, "0.1", &[]);
+        assert!(
+            pruned["report"]["parts_removed"].as_u64().unwrap() > 0,
+            "{engine}: {}",
+            pruned["report"]
+        );
+        assert_eq!(pruned["report"]["target_reached"], true, "{engine}");
+        assert_eq!(pruned["valid"], true, "{engine}");
+        let c = run(&["check", s(&input), s(&out)]);
+        assert_eq!(c.status.code(), Some(0), "{engine}: {}", text(&c.stdout));
+    }
+}
+
+/// `--meshopt-out` writes meshoptimizer's result at the count the run reached, a mesh `check`
+/// reads; a mesh with attributes is refused, naming the option.
+#[test]
+fn meshoptimizer_s_result_is_written_beside_ours() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("cow.obj");
+    let (out, theirs) = (d.path().join("o.obj"), d.path().join("m.obj"));
+    let j = engine_json("fast", &input, &out, "0.25", &["--meshopt-out", s(&theirs)]);
+    let ours = j["report"]["triangles_out"].as_u64().unwrap();
+    let text_of = std::fs::read_to_string(&theirs).unwrap();
+    let n = text_of.lines().filter(|l| l.starts_with("f ")).count() as u64;
+    assert!(
+        n > 0 && n <= ours && n * 10 >= ours * 9,
+        "{n} against {ours}"
+    );
+    let textured = textured_quad(d.path());
+    let o = run(&[
+        "simplify",
+        s(&textured),
+        s(&out),
+        "--ratio",
+        "0.5",
+        "--meshopt-out",
+        s(&theirs),
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(
+        text(&o.stderr).contains("--meshopt-out"),
+        "{}",
+        text(&o.stderr)
+    );
+}
+
+/// A textured quad (two triangles with texture coordinates) as `quad.obj` in `dir`.
+fn textured_quad(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("quad.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+         f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+    )
+    .unwrap();
+    path
+}
+
+/// `simplify INPUT OUT --ratio R --engine ENGINE --json EXTRA...`, which must succeed; its
+/// JSON.
+fn engine_json(
+    engine: &str,
+    input: &std::path::Path,
+    out: &std::path::Path,
+    ratio: &str,
+    extra: &[&str],
+) -> serde_json::Value {
+    let mut args = vec![
+        "simplify",
+        s(input),
+        s(out),
+        "--ratio",
+        ratio,
+        "--engine",
+        engine,
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    serde_json::from_str(&text(&o.stdout)).unwrap()
+}
