@@ -27,7 +27,7 @@ flags_for() {
 }
 mkdir -p campaign
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-if ! git diff --quiet HEAD -- ../src ../host-sim src fuzz_targets 2>/dev/null; then
+if ! git diff --quiet HEAD -- ../src ../cli ../host-sim src fuzz_targets 2>/dev/null; then
     commit="$commit+changes"
 fi
 for t in "${targets[@]}"; do

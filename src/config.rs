@@ -86,51 +86,123 @@ pub enum FeatureMode {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
+    pub(crate) schedule: Schedule,
+    pub(crate) cost: CostKind,
+    pub(crate) target: Target,
+    pub(crate) max_cost: f32,
+    pub(crate) max_passes: u32,
+    pub(crate) lambda: f32,
+    pub(crate) features: bool,
+    pub(crate) feature_mode: FeatureMode,
+    pub(crate) feature_targets: bool,
+    pub(crate) max_normal_turn_deg: f32,
+    pub(crate) min_quality: f32,
+    pub(crate) boundary_weight: f32,
+    pub(crate) max_error: f32,
+    pub(crate) error_limit: f32,
+    pub(crate) control_angle_deg: f32,
+    pub(crate) prune_parts: bool,
+}
+
+/// What a configuration says: one getter per setting, named as its `with_*` builder.
+impl Config {
     /// Collapse order.
-    pub schedule: Schedule,
+    #[inline]
+    pub const fn schedule(&self) -> Schedule {
+        self.schedule
+    }
+
     /// What a collapse costs: the built-in cost of [`Storage::simplify`](crate::Storage::simplify)
     /// and [`Builtin`](crate::cost::Builtin); a cost given to
     /// [`Storage::start`](crate::Storage::start) must agree with it (stored quadrics are a
     /// [`CostKind::Quadric`]).
-    pub cost: CostKind,
+    #[inline]
+    pub const fn cost(&self) -> CostKind {
+        self.cost
+    }
+
     /// Stop at or below this many triangles.
-    pub target: Target,
+    #[inline]
+    pub const fn target(&self) -> Target {
+        self.target
+    }
+
     /// Never perform a collapse whose cost exceeds this (in the schedule's cost units): the
     /// other stop, before the target if the remaining collapses all cost more.
-    pub max_cost: f32,
+    #[inline]
+    pub const fn max_cost(&self) -> f32 {
+        self.max_cost
+    }
+
     /// Stop after this many passes (for [`Schedule::Greedy`]: rounds of the queue; for
     /// [`Schedule::Batched`]: its batches); at least 1.
-    pub max_passes: u32,
+    #[inline]
+    pub const fn max_passes(&self) -> u32 {
+        self.max_passes
+    }
+
     /// A vertex is a feature iff `D > lambda * mean(D)`. The paper uses 1; the default is 2,
     /// chosen by measured error (see docs/algorithm.md). Negative or non-finite values are rejected
     /// (use [`Config::features`] = `false` to turn features off).
-    pub lambda: f32,
+    #[inline]
+    pub const fn lambda(&self) -> f32 {
+        self.lambda
+    }
+
     /// Detect and keep feature vertices at all.
-    pub features: bool,
+    #[inline]
+    pub const fn features(&self) -> bool {
+        self.features
+    }
+
     /// How D is normalised before the feature test.
-    pub feature_mode: FeatureMode,
+    #[inline]
+    pub const fn feature_mode(&self) -> FeatureMode {
+        self.feature_mode
+    }
+
     /// Feature vertices may be the kept endpoint of a collapse ([`Schedule::Greedy`] and
     /// [`Schedule::Batched`] only; they
     /// are never removed either way). The paper says no: they take no part in any collapse, and
     /// [`Schedule::Passes`] always follows the paper here.
-    pub feature_targets: bool,
+    #[inline]
+    pub const fn feature_targets(&self) -> bool {
+        self.feature_targets
+    }
+
     /// Reject a collapse that turns a remaining triangle's normal by more than this many degrees,
     /// in `(0, 180)`.
-    pub max_normal_turn_deg: f32,
+    #[inline]
+    pub const fn max_normal_turn_deg(&self) -> f32 {
+        self.max_normal_turn_deg
+    }
+
     /// Reject a collapse that leaves a triangle with quality (`4√3·area / Σ edge²`, 1 for an
     /// equilateral triangle) below this, unless the triangle was already worse or stays in its
     /// plane (within about 1°: a flat face stays flat, so the sliver costs no error). In
     /// `[0, 1)`.
-    pub min_quality: f32,
+    #[inline]
+    pub const fn min_quality(&self) -> f32 {
+        self.min_quality
+    }
+
     /// Weight of the boundary retreat (squared distance of a removed boundary vertex to the new
     /// boundary edge) against the normal variation. Non-negative.
-    pub boundary_weight: f32,
+    #[inline]
+    pub const fn boundary_weight(&self) -> f32 {
+        self.boundary_weight
+    }
+
     /// The guaranteed error bound `d_hold` (Zhu, Wang and Meng 2007 §2-§3), in the input's units:
     /// no control point (original triangle centroid or feature-edge vertex) ends farther than this
     /// from the result. Infinite (the default): no bound. A finite value needs
     /// [`Controls`](crate::bound::Controls); with [`NoBound`](crate::bound::NoBound) it is
     /// [`Error::InvalidConfig`](crate::Error::InvalidConfig) for `MaxError`. Non-negative.
-    pub max_error: f32,
+    #[inline]
+    pub const fn max_error(&self) -> f32 {
+        self.max_error
+    }
+
     /// The error limit, in the input's units: the greedy edge collapse refuses a collapse whose
     /// own error ([`Cost::error2`](crate::cost::Cost::error2): for the quadric costs the
     /// area-weighted RMS distance from the kept vertex to the planes it replaces, plus how far
@@ -140,12 +212,20 @@ pub struct Config {
     /// Infinite (the default): no limit. Costs without a distance (normal variation) are never
     /// limited. Not a guarantee: for a guaranteed bound see [`Config::max_error`].
     /// Non-negative; a finite limit needs the greedy schedule and edge collapse.
-    pub error_limit: f32,
+    #[inline]
+    pub const fn error_limit(&self) -> f32 {
+        self.error_limit
+    }
+
     /// With an error bound: an original edge is a feature edge (its vertices are control
     /// points of the second kind, Zhu, Wang and Meng 2007 §2 fig. 2) when its two triangles'
     /// normals differ by more than this many degrees, in `(0, 180)`. Boundary and non-manifold
     /// edges always are.
-    pub control_angle_deg: f32,
+    #[inline]
+    pub const fn control_angle_deg(&self) -> f32 {
+        self.control_angle_deg
+    }
+
     /// The pipeline (`pipeline::FastWorkspace` and `LeanWorkspace`, crate feature `fast`)
     /// removes a part
     /// (a connected component) whole once the error made reaches its size, and, short of the
@@ -153,7 +233,10 @@ pub struct Config {
     /// always stays (meshoptimizer's `meshopt_SimplifyPrune`). Off by default: a part is only
     /// simplified. The exact engine prunes when given part links instead
     /// (`ModelStorage::with_parts`, crate feature `parts`).
-    pub prune_parts: bool,
+    #[inline]
+    pub const fn prune_parts(&self) -> bool {
+        self.prune_parts
+    }
 }
 
 impl Config {

@@ -48,7 +48,7 @@
 //! # fn main() {}
 //! ```
 //!
-//! Extra memory beyond the [`Workspace`](crate::Workspace): the wedges, one triangle per
+//! Extra memory beyond the [`Workspace`]: the wedges, one triangle per
 //! triangle (6 B with `u16` indices), and with pruning one pair of links per vertex (4 B with
 //! `u16` links).
 

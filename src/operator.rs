@@ -95,7 +95,7 @@ impl Operator for EdgeCollapse {
 /// indexed heap (no per-triangle storage: the extra RAM is the bound's alone). At a pop the
 /// vertex's triangles are tried in `W` order; if all are refused its key is multiplied by the
 /// penalty `p = 5` (the paper's value) and it goes back in the queue, at most
-/// [`MAX_PENALTIES`] times before it is dropped until its fan changes (which bounds the pops
+/// three times before it is dropped until its fan changes (which bounds the pops
 /// between two collapses).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -119,8 +119,8 @@ impl Operator for VertexDecimation {
 }
 
 /// The penalty factor `p > 1` for a refused triangle (Zhu, Wang and Meng 2007 §3: `p = 5`).
-pub const PENALTY: f32 = 5.0;
+pub(crate) const PENALTY: f32 = 5.0;
 
 /// How many times in a row a vertex's key is multiplied by [`PENALTY`] before it is dropped
 /// from the queue until its fan changes.
-pub const MAX_PENALTIES: u32 = 3;
+pub(crate) const MAX_PENALTIES: u32 = 3;

@@ -247,7 +247,7 @@ fn check_with<O: Operator>(
     let mut counts = Vec::new();
     for &f in fractions {
         let config = base.with_relative_max_error(f, &m.positions);
-        let bound = config.max_error as f64;
+        let bound = config.max_error() as f64;
         assert!(
             (bound - f as f64 * diag).abs() <= 1e-5 * diag,
             "{name}: diagonal"
@@ -255,7 +255,12 @@ fn check_with<O: Operator>(
         let (out, r) = bounded_with(m, &config, operator);
         common::assert_valid(name, m, &out, &r);
         let tol = 1e-5 * diag;
-        let worst = max_distance(m, &out, config.control_angle_deg as f64, bound + 2.0 * tol);
+        let worst = max_distance(
+            m,
+            &out,
+            config.control_angle_deg() as f64,
+            bound + 2.0 * tol,
+        );
         let (emax, emean) = (r.max_error.expect("E_max"), r.mean_error.expect("E_mean"));
         eprintln!(
             "{name}: bound {f} of the diagonal = {bound:.6}: {} -> {} triangles, \
@@ -647,7 +652,7 @@ mod property {
             let m = mesh(kind, n, seed);
             let base = if passes && !triangle { Config::paper() } else { Config::new() };
             let base = base.with_ratio(ratio);
-            prop_assume!(base.schedule == Schedule::Greedy || !triangle);
+            prop_assume!(base.schedule() == Schedule::Greedy || !triangle);
             if triangle {
                 check_with("property", &m, &[fraction], base, TriangleCollapse);
             } else {

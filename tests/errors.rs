@@ -109,10 +109,7 @@ fn bad_configuration_is_refused() {
             ConfigField::ErrorLimit,
         ),
         (
-            Config {
-                max_normal_turn_deg: 0.0,
-                ..Config::new()
-            },
+            Config::new().with_max_normal_turn(0.0),
             ConfigField::MaxNormalTurn,
         ),
     ];

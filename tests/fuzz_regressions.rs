@@ -189,7 +189,7 @@ fn no_fold_when_a_stray_vertex_is_1e30_away() {
     let mut tris = input;
     let mut ws = Workspace::<u32, 512, 1024>::new();
     let mut config = Config::new().with_ratio(0.0);
-    config.features = false;
+    config = config.with_features(false);
     let r = ws.simplify(&positions, &mut tris, &config).unwrap();
     let out = &tris[..r.triangles_out];
     let new: Vec<_> = folded(&positions, out)

@@ -56,11 +56,11 @@ fn config() -> impl Strategy<Value = Config> {
                 } else {
                     FeatureMode::Paper
                 });
-            c.feature_targets = targets;
+            c = c.with_feature_targets(targets);
             if loose {
                 // Geometry barely constrains: the topological rules must hold on their own.
-                c.max_normal_turn_deg = 179.0;
-                c.min_quality = 0.0;
+                c = c.with_max_normal_turn(179.0);
+                c = c.with_min_quality(0.0);
             }
             c
         })
@@ -102,7 +102,7 @@ proptest! {
         // ratio, or the triangle count if higher), and whether the triangles actually handed
         // back reach it: neither is read off the report it is checked against.
         let valid_in = report.triangles_in - report.degenerate_dropped - report.duplicates_dropped;
-        let target = match config.target {
+        let target = match config.target() {
             Target::Ratio(r) => (r * valid_in as f32) as usize,
             Target::Triangles(n) => n,
         };
@@ -131,7 +131,7 @@ proptest! {
             for (t, (old, new)) in before.iter().zip(s.buffer()).enumerate() {
                 if new[0] != new[1] && old != new {
                     let a = angle_deg(&input, *old, *new);
-                    prop_assert!(a <= config.max_normal_turn_deg as f64 + 0.5,
+                    prop_assert!(a <= config.max_normal_turn_deg() as f64 + 0.5,
                         "triangle {} turned {:.1} degrees", t, a);
                 }
             }

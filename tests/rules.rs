@@ -65,8 +65,8 @@ fn step_by_step(m: &MeshData, config: &Config) -> (MeshData, Report, Steps) {
         .expect("start");
     let mut steps = Steps::default();
     let nv = m.positions.len();
-    let limit = config.max_normal_turn_deg as f64 + 0.5;
-    let min_q = config.min_quality as f64 * (1.0 - 1e-3);
+    let limit = config.max_normal_turn_deg() as f64 + 0.5;
+    let min_q = config.min_quality() as f64 * (1.0 - 1e-3);
     loop {
         let before: Vec<[u32; 3]> = s.buffer().to_vec();
         let features: Vec<usize> = (0..nv)
@@ -319,8 +319,8 @@ fn boundaries_keep_loops_vertices_and_length() {
 /// Geometry barely constrains: the topological rules must hold on their own.
 fn loose(config: Config) -> Config {
     let mut c = config;
-    c.max_normal_turn_deg = 179.0;
-    c.min_quality = 0.0;
+    c = c.with_max_normal_turn(179.0);
+    c = c.with_min_quality(0.0);
     c
 }
 
@@ -413,7 +413,7 @@ fn tetrahedra_are_kept_whole_by_the_duplicate_rule() {
     for schedule in [Schedule::Greedy, Schedule::Passes] {
         // Features off: on a regular shape they would refuse every collapse first.
         let mut config = loose(Config::new().with_schedule(schedule).with_ratio(0.0));
-        config.features = false;
+        config = config.with_features(false);
         let what = format!("tetrahedra {schedule:?} loose");
         let (out, report) = simplify(&m, &config);
         assert_valid(&what, &m, &out, &report);
@@ -468,7 +468,7 @@ fn no_operation_turns_a_triangle_too_far() {
                 steps.turned.is_empty(),
                 "{what}: {} triangles turned beyond {}°, first (operation, slot, degrees) {:?}",
                 steps.turned.len(),
-                config.max_normal_turn_deg,
+                config.max_normal_turn_deg(),
                 &steps.turned[..steps.turned.len().min(5)]
             );
             assert_valid(&what, &m, &out, &report);

@@ -164,7 +164,10 @@ fn both_placements_give_valid_simplifications() {
             let config = base.with_ratio(ratio);
             for placement in [Placement::Subset, Placement::Optimal] {
                 let (out, r) = stored(&m, &config, placement);
-                let label = format!("{name} {ratio} {placement:?} features {}", config.features);
+                let label = format!(
+                    "{name} {ratio} {placement:?} features {}",
+                    config.features()
+                );
                 assert_eq!(r.triangles_out, out.triangles.len(), "{label}");
                 assert!(
                     r.triangles_out < m.triangles.len(),

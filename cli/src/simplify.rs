@@ -180,7 +180,7 @@ pub fn double_sided(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
 /// Whether a run prunes parts (`Simplifier::with_parts`): asked for, and a run the library
 /// prunes in (the greedy or batched schedule, no error bound).
 pub fn prunes(prune: bool, config: &Config, bounded: bool) -> bool {
-    prune && !bounded && config.schedule.is_ordered()
+    prune && !bounded && config.schedule().is_ordered()
 }
 
 /// Vertex attributes for the attribute-aware stored quadric

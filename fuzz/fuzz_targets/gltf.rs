@@ -1,4 +1,4 @@
-//! host-sim's glTF reader and writer (`host_sim::gltf`): no panic and no allocation beyond the
+//! The command line's glTF reader and writer (`tinydecimate_cli::gltf`): no panic and no allocation beyond the
 //! input's size on any bytes (GLB or JSON); what it reads has indices in range and one element
 //! per vertex in every attribute; writing it back (triangles unchanged) gives a file it reads
 //! again with the same triangles and the same attribute bytes per corner.
@@ -7,7 +7,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(file) = host_sim::gltf::parse(data, None) else {
+    let Ok(file) = tinydecimate_cli::gltf::parse(data, None) else {
         return;
     };
     for p in &file.primitives {
@@ -18,8 +18,8 @@ fuzz_target!(|data: &[u8]| {
         }
     }
     let results: Vec<Vec<[u32; 3]>> = file.primitives.iter().map(|p| p.triangles.clone()).collect();
-    let (out, _) = host_sim::gltf::write(&file, &results, true, "").expect("writes what it read");
-    let again = host_sim::gltf::parse(&out, None).expect("reads what it wrote");
+    let (out, _) = tinydecimate_cli::gltf::write(&file, &results, true, "").expect("writes what it read");
+    let again = tinydecimate_cli::gltf::parse(&out, None).expect("reads what it wrote");
     assert_eq!(again.primitives.len(), file.primitives.len());
     for (a, b) in file.primitives.iter().zip(&again.primitives) {
         assert_eq!(a.triangles.len(), b.triangles.len());

@@ -6,7 +6,7 @@
 //! must be the input's (bit for bit with f32, within half a quantisation step otherwise).
 #![no_main]
 
-use host_sim::pm::Store;
+use tinydecimate_cli::pm::Store;
 use libfuzzer_sys::fuzz_target;
 use tinydecimate::stream::{self, Decoder};
 use tinydecimate::{EdgeCollapse, Progressive, Workspace};

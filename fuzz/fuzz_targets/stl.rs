@@ -5,7 +5,7 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(m) = host_sim::io::parse_bytes(data, "stl") {
+    if let Ok(m) = tinydecimate_cli::io::parse_bytes(data, "stl") {
         tinydecimate_fuzz::check_mesh_data(&m);
     }
 });

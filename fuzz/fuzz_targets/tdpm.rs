@@ -1,4 +1,4 @@
-//! host-sim's progressive-stream file reader (`pm::extent` and `pm::decode_with`, what `pm
+//! The command line's progressive-stream file reader (`pm::extent` and `pm::decode_with`, what `pm
 //! decode` and `pm levels` run, on complete and partial files): no panic; storage bounded by
 //! the file's size whatever its header claims (every vertex it decodes costs at least 6 bytes
 //! of the file); a decoded level uses only decoded vertices.
@@ -11,7 +11,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let piece = usize::from(cut) % 97 + 1;
-    if let Ok(e) = host_sim::pm::extent(bytes) {
+    if let Ok(e) = tinydecimate_cli::pm::extent(bytes) {
         assert!(e.bytes <= bytes.len());
         assert!(
             6 * (e.positions + e.splits) <= bytes.len(),
@@ -19,7 +19,7 @@ fuzz_target!(|data: &[u8]| {
             bytes.len()
         );
     }
-    if let Ok(d) = host_sim::pm::decode_with(bytes, piece, None, &[0.1, 0.5]) {
+    if let Ok(d) = tinydecimate_cli::pm::decode_with(bytes, piece, None, &[0.1, 0.5]) {
         let n = d.positions.len();
         assert!(6 * n <= bytes.len(), "{n} vertices from {} bytes", bytes.len());
         let levels = d.levels.iter().flat_map(|(_, l)| l);

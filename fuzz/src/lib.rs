@@ -123,38 +123,38 @@ fn index(u: &mut Unstructured, n: usize) -> Result<u32> {
 
 fn config(u: &mut Unstructured) -> Result<Config> {
     let mut c = Config::new();
-    c.schedule = if u.arbitrary()? {
+    c = c.with_schedule(if u.arbitrary()? {
         Schedule::Passes
     } else {
         Schedule::Greedy
-    };
-    c.target = match u.int_in_range(0..=3u8)? {
+    });
+    c = c.with_target(match u.int_in_range(0..=3u8)? {
         0 => Target::Ratio(float(u, 0.0, 1.0)?),
         1 | 2 => Target::Triangles(u.int_in_range(0..=1200)?),
         _ => Target::Triangles(u.arbitrary::<u64>()? as usize),
-    };
-    c.max_cost = match u.int_in_range(0..=3u8)? {
+    });
+    c = c.with_max_cost(match u.int_in_range(0..=3u8)? {
         0 | 1 => f32::INFINITY,
         2 => float(u, 0.0, 0.05)?,
         _ => float(u, 0.0, 10.0)?,
-    };
-    c.max_passes = match u.int_in_range(0..=7u8)? {
+    });
+    c = c.with_max_passes(match u.int_in_range(0..=7u8)? {
         0 => u.arbitrary()?,
         _ => u.int_in_range(1..=40)?,
-    };
-    c.lambda = float(u, 0.0, 4.0)?;
-    c.features = u.arbitrary()?;
-    c.feature_mode = if u.arbitrary()? {
+    });
+    c = c.with_lambda(float(u, 0.0, 4.0)?);
+    c = c.with_features(u.arbitrary()?);
+    c = c.with_feature_mode(if u.arbitrary()? {
         FeatureMode::ValenceNormalized
     } else {
         FeatureMode::Paper
-    };
-    c.feature_targets = u.arbitrary()?;
-    c.max_normal_turn_deg = float(u, 0.0, 180.0)?;
-    c.min_quality = float(u, 0.0, 1.0)?;
-    c.boundary_weight = float(u, 0.0, 10.0)?;
+    });
+    c = c.with_feature_targets(u.arbitrary()?);
+    c = c.with_max_normal_turn(float(u, 0.0, 180.0)?);
+    c = c.with_min_quality(float(u, 0.0, 1.0)?);
+    c = c.with_boundary_weight(float(u, 0.0, 10.0)?);
     // Read by the pipeline only; the exact engine prunes when given part links.
-    c.prune_parts = u.arbitrary()?;
+    c = c.with_prune_parts(u.arbitrary()?);
     Ok(c)
 }
 
@@ -424,14 +424,14 @@ impl Case {
         let cost = match u.int_in_range(0..=5u8)? {
             0..=3 => CostKind::Default,
             4 => {
-                config.cost = tinydecimate::CostKind::Quadric;
-                config.boundary_weight = float(u, 0.0, 10.0)?;
+                config = config.with_cost(tinydecimate::CostKind::Quadric);
+                config = config.with_boundary_weight(float(u, 0.0, 10.0)?);
                 CostKind::Plane
             }
             _ => {
                 let _length_weighted: bool = u.arbitrary()?;
-                config.cost = tinydecimate::CostKind::NormalVariation;
-                config.boundary_weight = float(u, 0.0, 10.0)?;
+                config = config.with_cost(tinydecimate::CostKind::NormalVariation);
+                config = config.with_boundary_weight(float(u, 0.0, 10.0)?);
                 CostKind::Normal
             }
         };
@@ -950,7 +950,7 @@ fn check_output<I: Idx>(
         allow_moved: false,
         welded: false,
         // The pipeline's runs (`what` names its mode) may remove parts whole.
-        parts: case.config.prune_parts && (what.starts_with("fast") || what.starts_with("lean")),
+        parts: case.config.prune_parts() && (what.starts_with("fast") || what.starts_with("lean")),
     };
     let mesh = |triangles| meshcheck::MeshRef {
         positions: pos,
@@ -987,10 +987,10 @@ pub fn engine_view(pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// What `host_sim::io` promises of a loaded mesh: triangles, indices in range, and finite
+/// What `tinydecimate_cli::io` promises of a loaded mesh: triangles, indices in range, and finite
 /// coordinates in every vertex a triangle uses (an unused vertex may hold anything, as the
 /// library ignores it).
-pub fn check_mesh_data(m: &host_sim::io::MeshData) {
+pub fn check_mesh_data(m: &tinydecimate_cli::io::MeshData) {
     assert!(!m.triangles.is_empty(), "loaded a mesh without triangles");
     for t in &m.triangles {
         for &i in t {

@@ -724,7 +724,7 @@ fn run_method(
 /// `config` with `tinydecimate simplify`'s default error limit where it applies (the greedy
 /// schedule).
 fn with_default_limit(config: Config, mesh: &MeshData) -> Config {
-    if config.schedule.is_ordered() {
+    if config.schedule().is_ordered() {
         config.with_relative_error_limit(
             tinydecimate_cli::cmd::simplify::DEFAULT_ERROR_LIMIT,
             &mesh.positions,
@@ -1146,7 +1146,7 @@ mod tests {
     #[test]
     fn modes() {
         assert_eq!(Method::Default.config(), Some(Config::new()));
-        assert_eq!(Method::Default.config().unwrap().cost, CostKind::Quadric);
+        assert_eq!(Method::Default.config().unwrap().cost(), CostKind::Quadric);
         assert_eq!(
             Method::GreedyW.config(),
             Some(Config::new().with_cost(CostKind::NormalVariation))

@@ -429,8 +429,8 @@ mod tests {
                         ) && (c.positions.len() > fv
                             || c.triangles.len() > ft
                             || 2 * c.triangles.len() > fit))
-                        || (c.config.max_error.is_finite() && qv == 0)
-                        || (c.config.max_error.is_finite()
+                        || (c.config.max_error().is_finite() && qv == 0)
+                        || (c.config.max_error().is_finite()
                             && c.triangles.len() * 3 * c.index_type.bytes()
                                 + tinydecimate::bound::control_len(
                                     c.triangles.len(),

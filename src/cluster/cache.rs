@@ -32,7 +32,7 @@ pub(super) fn unpack_q(e: u64) -> [u32; 3] {
 }
 
 /// Lanes of a per-vertex key entry of [`Scratch::keys`](super::Scratch::keys): the cells of the
-/// [`PROBES`](super::PROBES) resolutions of a counting pass, padded to 8 (32 bytes, two SIMD registers).
+/// six resolutions probed by a counting pass, padded to 8 (32 bytes, two SIMD registers).
 pub const KEY_LANES: usize = 8;
 
 /// The lane of a key entry that holds the number of the counting pass it was computed for.

@@ -90,7 +90,6 @@ use search::final_keys;
 pub use cache::KEY_LANES;
 pub use grid::Grid;
 pub use pass::Stream;
-pub use search::PROBES;
 pub use source::{PositionFn, PositionSource, SliceSource, Source};
 pub use then_collapse::{cluster_then_collapse, ThenCollapseError};
 
@@ -237,7 +236,7 @@ pub struct ClusterConfig {
     pub grid: GridChoice,
     /// The bounding box `(min, max)` if known: saves the first pass.
     pub bbox: Option<([f32; 3], [f32; 3])>,
-    /// Counting passes of the search for [`GridChoice::TargetTriangles`], each probing [`PROBES`]
+    /// Counting passes of the search for [`GridChoice::TargetTriangles`], each probing six
     /// resolutions (meshoptimizer's `simplifySloppy` makes 5 passes of one each).
     pub refine_passes: u32,
     /// Use only the first `table_cells` cells of the table (0: all of it). The output depends

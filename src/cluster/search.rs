@@ -7,7 +7,7 @@ use super::source::{corners, SourcePositions};
 use super::{ClusterError, Clusterer, Source, CHUNK, MAX_RESOLUTION};
 
 /// Resolutions probed per counting pass of the target search.
-pub const PROBES: usize = 6;
+pub(crate) const PROBES: usize = 6;
 
 /// Before the accumulating pass: each vertex with quantised coordinates in the cache gets
 /// its cell on the final `grid` in its key entry (the others are computed at their first

@@ -118,12 +118,12 @@ fn encode(a: &EncodeArgs) -> Result<ExitCode> {
         None => Config::new().with_ratio(a.base_ratio),
     };
     if let Some(x) = a.max_turn {
-        config.max_normal_turn_deg = x;
+        config = config.with_max_normal_turn(x);
     }
     if let Some(x) = a.min_quality {
-        config.min_quality = x;
+        config = config.with_min_quality(x);
     }
-    config.features = !a.no_features;
+    config = config.with_features(!a.no_features);
     config
         .validate()
         .map_err(|e| anyhow!("configuration: {e}"))?;

@@ -647,22 +647,22 @@ impl Args {
             c = c.with_lambda(l);
         }
         // Stored quadrics default to `Config::stored()`: no feature rule.
-        c.features = if self.quadric == QuadricArg::Stored {
+        c = c.with_features(if self.quadric == QuadricArg::Stored {
             self.features
         } else {
             !self.no_features
-        };
+        });
         if self.no_feature_targets {
-            c.feature_targets = false;
+            c = c.with_feature_targets(false);
         }
         if let Some(x) = self.max_turn {
-            c.max_normal_turn_deg = x;
+            c = c.with_max_normal_turn(x);
         }
         if let Some(x) = self.min_quality {
-            c.min_quality = x;
+            c = c.with_min_quality(x);
         }
         if let Some(x) = self.boundary_weight {
-            c.boundary_weight = x;
+            c = c.with_boundary_weight(x);
         }
         c
     }
@@ -878,22 +878,27 @@ fn run_text(args: &Args, run: &Run) -> String {
              vertex's fan, sorted passes, subset placement)"
         );
     } else if *stored {
-        let _ = writeln!(
+        let _ =
+            writeln!(
             text,
             "  schedule, cost         {:?}, stored quadric ({:?} placement, boundary weight {})",
-            config.schedule, args.placement, config.boundary_weight
+            config.schedule(), args.placement, config.boundary_weight()
         );
     } else if args.cost == Some(CostArg::Energy) {
         let _ = writeln!(
             text,
             "  schedule, cost, op     {:?}, Hoppe's energy (κ {}), {:?} collapse",
-            config.schedule, args.spring, args.operator
+            config.schedule(),
+            args.spring,
+            args.operator
         );
     } else {
         let _ = writeln!(
             text,
             "  schedule, cost, op     {:?}, {:?}, {:?} collapse",
-            config.schedule, config.cost, args.operator
+            config.schedule(),
+            config.cost(),
+            args.operator
         );
     }
     if let Some(e) = args.max_error {
@@ -901,7 +906,8 @@ fn run_text(args: &Args, run: &Run) -> String {
             text,
             "  error bound            d_hold {e} = {:.6e} (guaranteed at the control points; \
              feature edges past {}°)",
-            config.max_error, config.control_angle_deg
+            config.max_error(),
+            config.control_angle_deg()
         );
     }
     // An error bound alone: the report's target is the bound, not a count of 0.
@@ -909,7 +915,7 @@ fn run_text(args: &Args, run: &Run) -> String {
     let target = args
         .max_error
         .filter(|_| bound_alone)
-        .map(|e| advice::bound_target(&e.to_string(), config.max_error, report));
+        .map(|e| advice::bound_target(&e.to_string(), config.max_error(), report));
     let _ = writeln!(
         text,
         "{}",
@@ -1015,13 +1021,13 @@ fn run_json(args: &Args, run: &Run) -> serde_json::Value {
             Some(crate::simplify::Pipeline::Lean) => "Lean",
             None => "Exact",
         },
-        "schedule": format!("{:?}", config.schedule),
-        "cost": format!("{:?}", config.cost),
+        "schedule": format!("{:?}", config.schedule()),
+        "cost": format!("{:?}", config.cost()),
         "operator": format!("{:?}", args.operator),
         "quadric": format!("{:?}", args.quadric),
         "placement": format!("{:?}", args.placement),
         "max_error": args.max_error.map(|e| e.to_string()),
-        "d_hold": if config.max_error.is_finite() { Some(config.max_error) } else { None },
+        "d_hold": if config.max_error().is_finite() { Some(config.max_error()) } else { None },
         "report": report_json(&run.report),
         "advice": advice_for(args, &run.report).map(|(_, a)| a),
         "library_ms": run.elapsed.as_secs_f64() * 1e3,
@@ -1108,8 +1114,8 @@ fn measure(
              \x20 d_hold                   {:.6e} = {:.5} %\n\
              \x20 E_max  (eq. 4)           {:.6e} = {:.5} %\n\
              \x20 E_mean (eq. 5)           {:.6e} = {:.5} %",
-            config.max_error,
-            pct(f64::from(config.max_error)),
+            config.max_error(),
+            pct(f64::from(config.max_error())),
             emax,
             pct(f64::from(emax)),
             emean,
@@ -1201,10 +1207,10 @@ mod tests {
     fn arguments_make_the_config() {
         let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.25"]).unwrap();
         let cfg = c.args.config();
-        assert_eq!(cfg.target, Target::Ratio(0.25));
-        assert_eq!(cfg.schedule, Schedule::Greedy);
-        assert_eq!(cfg.feature_mode, FeatureMode::Paper);
-        assert_eq!(cfg.cost, CostKind::Quadric);
+        assert_eq!(cfg.target(), Target::Ratio(0.25));
+        assert_eq!(cfg.schedule(), Schedule::Greedy);
+        assert_eq!(cfg.feature_mode(), FeatureMode::Paper);
+        assert_eq!(cfg.cost(), CostKind::Quadric);
         assert_eq!(cfg, Config::new().with_ratio(0.25));
         let c = Cli::try_parse_from(["x", "a.obj", "b.obj", "--ratio", "0.1", "--cost", "normal"])
             .unwrap();
@@ -1227,7 +1233,7 @@ mod tests {
             "quadric",
         ])
         .unwrap();
-        assert_eq!(c.args.config().cost, CostKind::Quadric);
+        assert_eq!(c.args.config().cost(), CostKind::Quadric);
         assert!(Cli::try_parse_from(["x", "a", "b", "--ratio", "0.1", "--cost", "plane"]).is_err());
         let c = Cli::try_parse_from([
             "x",
@@ -1243,10 +1249,10 @@ mod tests {
         ])
         .unwrap();
         let cfg = c.args.config();
-        assert_eq!(cfg.target, Target::Triangles(500));
-        assert_eq!(cfg.schedule, Schedule::Passes);
-        assert_eq!(cfg.lambda, 1.5);
-        assert_eq!(cfg.feature_mode, FeatureMode::ValenceNormalized);
+        assert_eq!(cfg.target(), Target::Triangles(500));
+        assert_eq!(cfg.schedule(), Schedule::Passes);
+        assert_eq!(cfg.lambda(), 1.5);
+        assert_eq!(cfg.feature_mode(), FeatureMode::ValenceNormalized);
         assert!(Cli::try_parse_from(["x", "a.obj", "b.obj"]).is_err());
         // Stored quadrics: `Config::stored()` (no feature rule) unless --features.
         let stored = |extra: &[&str]| {

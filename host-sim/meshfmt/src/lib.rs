@@ -771,16 +771,16 @@ pub mod lib {
                 | MethodCode::LeanWedges => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
-        c.features = h.feature_mode != FeatureCode::Off;
+        c = c.with_features(h.feature_mode != FeatureCode::Off);
         if h.feature_mode == FeatureCode::ValenceNormalized {
-            c.feature_mode = FeatureMode::ValenceNormalized;
+            c = c.with_feature_mode(FeatureMode::ValenceNormalized);
         } else {
-            c.feature_mode = FeatureMode::Paper;
+            c = c.with_feature_mode(FeatureMode::Paper);
         }
-        c.feature_targets = h.feature_targets;
-        c.max_normal_turn_deg = h.max_normal_turn_deg;
-        c.min_quality = h.min_quality;
-        c.boundary_weight = h.boundary_weight;
+        c = c.with_feature_targets(h.feature_targets);
+        c = c.with_max_normal_turn(h.max_normal_turn_deg);
+        c = c.with_min_quality(h.min_quality);
+        c = c.with_boundary_weight(h.boundary_weight);
         if bounded(h) {
             c = c.with_max_error(h.max_error);
         }
@@ -820,15 +820,15 @@ pub mod lib {
 
     /// A case header carrying `config` (vertex and triangle counts zero: `encode_case` sets them).
     pub fn case_header(config: &Config, index_type: IndexType) -> CaseHeader {
-        let (target_ratio, target_triangles) = target_fields(config.target);
+        let (target_ratio, target_triangles) = target_fields(config.target());
         CaseHeader {
             index_type,
-            schedule: match config.schedule {
+            schedule: match config.schedule() {
                 Schedule::Greedy => ScheduleCode::Greedy,
                 Schedule::Passes => ScheduleCode::Passes,
                 Schedule::Batched => ScheduleCode::Batched,
             },
-            method: match config.cost {
+            method: match config.cost() {
                 CostKind::Quadric => MethodCode::Quadric,
                 CostKind::NormalVariation => MethodCode::NormalVariation,
             },
@@ -836,20 +836,20 @@ pub mod lib {
             triangles: 0,
             target_ratio,
             target_triangles,
-            lambda: config.lambda,
-            feature_mode: match (config.features, config.feature_mode) {
+            lambda: config.lambda(),
+            feature_mode: match (config.features(), config.feature_mode()) {
                 (false, _) => FeatureCode::Off,
                 (true, FeatureMode::Paper) => FeatureCode::Paper,
                 (true, FeatureMode::ValenceNormalized) => FeatureCode::ValenceNormalized,
             },
-            feature_targets: config.feature_targets,
-            max_passes: config.max_passes,
-            max_cost: config.max_cost,
-            max_normal_turn_deg: config.max_normal_turn_deg,
-            min_quality: config.min_quality,
-            boundary_weight: config.boundary_weight,
-            max_error: if config.max_error.is_finite() {
-                config.max_error
+            feature_targets: config.feature_targets(),
+            max_passes: config.max_passes(),
+            max_cost: config.max_cost(),
+            max_normal_turn_deg: config.max_normal_turn_deg(),
+            min_quality: config.min_quality(),
+            boundary_weight: config.boundary_weight(),
+            max_error: if config.max_error().is_finite() {
+                config.max_error()
             } else {
                 0.0
             },

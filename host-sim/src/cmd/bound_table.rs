@@ -127,7 +127,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
         let m = metro(&mesh, &ours, &opts);
         let emax = f64::from(r.max_error.unwrap_or(f32::NAN));
         let emean = f64::from(r.mean_error.unwrap_or(f32::NAN));
-        ok &= emax <= f64::from(config.max_error);
+        ok &= emax <= f64::from(config.max_error());
         let mut row = format!(
             "| {name} | {} | {} | {:.3} % | {:.3} % | {:.3} % | {ms:.0} |",
             mesh.triangles.len(),
@@ -147,7 +147,7 @@ pub fn run(args: &Args) -> Result<ExitCode> {
             )?;
             let mt = metro(&mesh, &tri, &opts);
             let e = f64::from(rt.max_error.unwrap_or(f32::NAN));
-            ok &= e <= f64::from(config.max_error);
+            ok &= e <= f64::from(config.max_error());
             row += &format!(
                 " {} | {:.3} % | {:.3} % |",
                 rt.triangles_out,

@@ -330,9 +330,9 @@ fn side_by_side(
         } else {
             "Config::new()"
         },
-        case.config.schedule,
-        meshfmt::lib::target_fields(case.config.target).0,
-        case.config.lambda
+        case.config.schedule(),
+        meshfmt::lib::target_fields(case.config.target()).0,
+        case.config.lambda()
     );
     let host_col = format!("host ({}, std)", std::env::consts::ARCH);
     let dev_col = format!("{} ({}, QEMU)", board.name, board.core);

@@ -180,7 +180,7 @@ impl CaseSpec {
         ))
         .with_lambda(self.lambda);
         match self.features {
-            Features::Off => c.features = false,
+            Features::Off => c = c.with_features(false),
             Features::Paper => c = c.with_feature_mode(FeatureMode::Paper),
             Features::Valence => c = c.with_feature_mode(FeatureMode::ValenceNormalized),
         }

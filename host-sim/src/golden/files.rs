@@ -62,34 +62,34 @@ fn triangles_of(it: IndexType, bytes: &[u8]) -> Vec<[u32; 3]> {
 }
 
 fn config_line(c: &Config) -> String {
-    let features = match (c.features, c.feature_mode) {
+    let features = match (c.features(), c.feature_mode()) {
         (false, _) => "off",
         (true, FeatureMode::Paper) => "paper",
         (true, FeatureMode::ValenceNormalized) => "valence",
     };
-    let (ratio, target) = meshfmt::lib::target_fields(c.target);
+    let (ratio, target) = meshfmt::lib::target_fields(c.target());
     format!(
         "schedule {}, cost {}, ratio {}, target {}, lambda {}, features {features}, \
          feature_targets {}, max_passes {}, max_cost {}, max_normal_turn_deg {}, min_quality {}, \
          boundary_weight {}",
-        match c.schedule {
+        match c.schedule() {
             Schedule::Greedy => "greedy",
             Schedule::Passes => "passes",
             Schedule::Batched => "batched",
         },
-        match c.cost {
+        match c.cost() {
             tinydecimate::CostKind::Quadric => "quadric",
             tinydecimate::CostKind::NormalVariation => "normal",
         },
         ratio,
         target,
-        c.lambda,
-        c.feature_targets,
-        c.max_passes,
-        c.max_cost,
-        c.max_normal_turn_deg,
-        c.min_quality,
-        c.boundary_weight
+        c.lambda(),
+        c.feature_targets(),
+        c.max_passes(),
+        c.max_cost(),
+        c.max_normal_turn_deg(),
+        c.min_quality(),
+        c.boundary_weight()
     )
 }
 
@@ -158,11 +158,11 @@ impl Golden {
             )?,
             None => {}
         }
-        if case.config.max_error.is_finite() {
+        if case.config.max_error().is_finite() {
             writeln!(
                 w,
                 "max_error = {:e}  # the guaranteed bound, input units",
-                case.config.max_error
+                case.config.max_error()
             )?;
         }
         writeln!(w, "input_vertices = {}", case.positions.len())?;
@@ -328,7 +328,7 @@ pub fn judge(
                 " (the fast mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
             } else if case.method == Some(super::case::MethodName::Lean) {
                 " (the lean mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
-            } else if case.config.max_error.is_finite() {
+            } else if case.config.max_error().is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {
                 ""

@@ -7,7 +7,7 @@ use crate::{Config, Error};
 /// Triangles of one fan the energy keeps ([`Energy`]'s [`Cost::corner`] ring): a vertex with
 /// more is never moved (its price is infinite), as the engine prices only its first 32
 /// neighbours anyway.
-pub const RING: usize = 32;
+pub(crate) const RING: usize = 32;
 
 /// The sample points one vertex carries, as their moments about the vertex's own position:
 /// `[n, Σx, Σy, Σz, Σxx, Σxy, Σxz, Σyy, Σyz, Σzz]` (sample offsets `x − p_v`; `n` is a
@@ -76,7 +76,7 @@ pub type Samples = [f32; 10];
 /// shape it buys on a flat grid: tests/energy.rs).
 ///
 /// **Cost.** 40 bytes per vertex (the samples) instead of the memoryless quadric's none and
-/// the stored quadric's 40; [`EnergyFan`] on the stack per walked fan ([`RING`] offsets,
+/// the stored quadric's 40; [`EnergyFan`] on the stack per walked fan (32 offsets,
 /// about 400 bytes, against the quadric's 28). The spring and the new planes need `from`'s
 /// neighbours, which a fan's normals and areas do not give: the engine hands each fan
 /// triangle's two other corners ([`Cost::corner`]). Its price reads the fan, so every vertex

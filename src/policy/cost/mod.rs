@@ -27,7 +27,7 @@ mod variation;
 use crate::{Config, ConfigField, Error};
 pub use attributes::{AttributeQuadric, AttributeState};
 pub use builtin::Builtin;
-pub use energy::{Energy, EnergyFan, Samples, RING};
+pub use energy::{Energy, EnergyFan, Samples};
 pub use memoryless::{Quadric, QuadricFan};
 pub use stored::{Placement, StoredQuadric};
 pub use variation::NormalVariation;

@@ -57,53 +57,52 @@ fn opaque_f32(k: usize) -> f32 {
 }
 
 fn opaque_config() -> Config {
-    let c = Config {
-        schedule: if input(0) & 1 == 0 {
+    let c = Config::new()
+        .with_schedule(if input(0) & 1 == 0 {
             Schedule::Greedy
         } else {
             Schedule::Passes
-        },
-        cost: if input(0) & 2 == 0 {
+        })
+        .with_cost(if input(0) & 2 == 0 {
             CostKind::Quadric
         } else {
             CostKind::NormalVariation
-        },
-        target: if input(6) & 16 == 0 {
+        })
+        .with_target(if input(6) & 16 == 0 {
             Target::Ratio(opaque_f32(2))
         } else {
             Target::Triangles(input(1) as usize)
-        },
-        max_cost: opaque_f32(3),
-        max_passes: input(4),
-        lambda: opaque_f32(5),
-        features: input(6) & 1 == 0,
-        feature_mode: if input(6) & 2 == 0 {
+        })
+        .with_max_cost(opaque_f32(3))
+        .with_max_passes(input(4))
+        .with_lambda(opaque_f32(5))
+        .with_features(input(6) & 1 == 0)
+        .with_feature_mode(if input(6) & 2 == 0 {
             FeatureMode::Paper
         } else {
             FeatureMode::ValenceNormalized
-        },
-        feature_targets: input(6) & 4 == 0,
-        max_normal_turn_deg: opaque_f32(7),
-        min_quality: opaque_f32(8),
-        boundary_weight: opaque_f32(9),
-        max_error: opaque_f32(19),
-        error_limit: opaque_f32(24),
-        control_angle_deg: opaque_f32(20),
-        prune_parts: input(6) & 8 == 0,
-    };
-    // The builders too.
+        })
+        .with_feature_targets(input(6) & 4 == 0)
+        .with_max_normal_turn(opaque_f32(7))
+        .with_min_quality(opaque_f32(8))
+        .with_boundary_weight(opaque_f32(9))
+        .with_max_error(opaque_f32(19))
+        .with_error_limit(opaque_f32(24))
+        .with_control_angle(opaque_f32(20))
+        .with_prune_parts(input(6) & 8 == 0);
+    // The other constructors, and the builders again on them.
     let b = black_box(Config::paper())
-        .with_schedule(c.schedule)
+        .with_schedule(c.schedule())
         .with_ratio(opaque_f32(10))
         .with_target(Target::Triangles(input(11) as usize))
         .with_lambda(opaque_f32(12))
-        .with_feature_mode(c.feature_mode)
+        .with_feature_mode(c.feature_mode())
         .with_max_passes(input(13))
         .with_max_cost(opaque_f32(14))
         .with_max_error(opaque_f32(21))
         .with_error_limit(opaque_f32(25))
         .with_prune_parts(input(6) & 32 == 0)
-        .with_cost(c.cost);
+        .with_cost(c.cost());
     black_box(Config::new().with_relative_max_error(opaque_f32(22), &[[opaque_f32(23); 3]; 4]));
     black_box(Config::default());
     black_box(Config::new());

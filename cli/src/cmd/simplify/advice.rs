@@ -110,8 +110,8 @@ impl Outcome {
     /// The limits `config` ran with (`From<&Report>` assumes `Config::new()`'s): the advice
     /// names only values that relax them further.
     pub fn in_use(mut self, config: &tinydecimate::Config) -> Outcome {
-        self.max_turn = config.max_normal_turn_deg;
-        self.min_quality = config.min_quality;
+        self.max_turn = config.max_normal_turn_deg();
+        self.min_quality = config.min_quality();
         self
     }
 }
@@ -126,8 +126,8 @@ impl From<&Report> for Outcome {
             refused: r.rejected.iter().map(|(_, n)| n).collect(),
             feature_vertices: r.feature_vertices,
             locked_vertices: r.locked_vertices,
-            max_turn: tinydecimate::Config::new().max_normal_turn_deg,
-            min_quality: tinydecimate::Config::new().min_quality,
+            max_turn: tinydecimate::Config::new().max_normal_turn_deg(),
+            min_quality: tinydecimate::Config::new().min_quality(),
         }
     }
 }
@@ -545,11 +545,11 @@ mod tests {
         let examples = |a: &Advice| a.relax.iter().map(|r| r.example).collect::<Vec<_>>();
         assert_eq!(examples(&a), ["--max-turn 120", "--min-quality 0"]);
         let mut c = Config::new();
-        c.max_normal_turn_deg = 120.0;
-        c.min_quality = 0.0;
+        c = c.with_max_normal_turn(120.0);
+        c = c.with_min_quality(0.0);
         let a = advise(&o.clone().in_use(&c), "a", "b").unwrap();
         assert_eq!(examples(&a), ["--max-turn 179"]);
-        c.max_normal_turn_deg = 179.0;
+        c = c.with_max_normal_turn(179.0);
         let a = advise(&o.in_use(&c), "a", "b").unwrap();
         assert!(a.relax.is_empty(), "{:?}", a.relax);
     }
@@ -589,7 +589,7 @@ mod tests {
             triangles,
         };
         let mut config = Config::new().with_ratio(0.05);
-        config.max_normal_turn_deg = 2.0;
+        config = config.with_max_normal_turn(2.0);
         let (_, report, _) = crate::simplify::simplify(&mesh, &config).expect("simplify");
         assert!(!report.target_reached, "{report:?}");
         let o = Outcome::from(&report);
@@ -597,7 +597,7 @@ mod tests {
         assert_eq!(a.limit, "normal_turn", "{report:?}");
         assert_eq!(a.relax[0].option, "--max-turn");
         // Relaxed, it gets there.
-        config.max_normal_turn_deg = 120.0;
+        config = config.with_max_normal_turn(120.0);
         let (_, report, _) = crate::simplify::simplify(&mesh, &config).expect("simplify");
         assert!(report.target_reached, "{report:?}");
         assert_eq!(advise(&Outcome::from(&report), "a", "b"), None);
