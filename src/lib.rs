@@ -116,6 +116,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod choice;
 pub mod cluster;
 mod config;
 mod engine;

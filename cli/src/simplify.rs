@@ -7,13 +7,12 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
 use tinydecimate::bound::Controls;
+use tinydecimate::choice::{Chosen, ChosenBound, ChosenCost, ChosenOperator};
 use tinydecimate::cost::{
     AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
-use tinydecimate::{
-    Builtin, Config, EdgeCollapse, NoBound, Positions, Report, TriangleCollapse, VertexDecimation,
-};
+use tinydecimate::{Builtin, Config, Positions, Report, VertexDecimation};
 
 use crate::io::MeshData;
 use crate::workspace::HostWorkspace;
@@ -295,134 +294,75 @@ pub fn simplify_with_attributes(
             welded = tris.clone();
         }
     }
-    let budget = if bounded { 1 << 12 } else { 1 << 14 };
-    macro_rules! drive_with {
-        ($p:expr, $cost:expr, $bound:expr, $op:expr) => {{
-            let s = ws
-                .storage()
-                .start($p, &mut tris, config, $cost, $bound, $op)
-                .map_err(library_error)?;
-            let s = if wedges.is_empty() {
-                s
-            } else {
-                let corners = if lock_seam_corners {
-                    tinydecimate::seam::SeamCorners::Lock
-                } else {
-                    tinydecimate::seam::SeamCorners::Move
-                };
-                s.with_wedges(&mut wedges, corners).map_err(library_error)?
-            };
-            let mut s = if prune {
-                s.with_parts(&mut part_links).map_err(library_error)?
-            } else {
-                s
-            };
-            let n0 = s.live_triangles();
-            while !s.step(budget) {
-                if let Some(b) = &bar {
-                    b.set((n0 - s.live_triangles().min(n0)) as u64);
-                }
-            }
-            s.finish()
-        }};
-    }
     let original = if welded.is_empty() {
         &mesh.triangles
     } else {
         &welded
     };
-    // The operator is a type: one instantiation per operator.
-    macro_rules! drive {
-        ($p:expr, $cost:expr, $bound:expr) => {{
-            match operator {
-                OperatorArg::Edge => drive_with!($p, $cost, $bound, EdgeCollapse),
-                OperatorArg::Triangle => drive_with!($p, $cost, $bound, TriangleCollapse),
-                OperatorArg::VertexDecimation => {
-                    drive_with!($p, $cost, $bound, VertexDecimation::new())
-                }
-                OperatorArg::VertexDecimationShape => {
-                    drive_with!(
-                        $p,
-                        $cost,
-                        $bound,
-                        VertexDecimation::new().with_fill(tinydecimate::Fill::Shape)
-                    )
-                }
-            }
-        }};
-    }
-    // Optimal placement writes the positions; every other run only reads them.
-    let report = if let Some(a) = attributes {
-        let cost = |q, s| {
-            AttributeQuadric::new(q, s, &a.values, a.weights)
+    // The policies as the command line chose them; the library runs the combination.
+    let operator = match operator {
+        OperatorArg::Edge => ChosenOperator::Edge,
+        OperatorArg::Triangle => ChosenOperator::Triangle,
+        OperatorArg::VertexDecimation => ChosenOperator::VertexDecimation(VertexDecimation::new()),
+        OperatorArg::VertexDecimationShape => ChosenOperator::VertexDecimation(
+            VertexDecimation::new().with_fill(tinydecimate::Fill::Shape),
+        ),
+    };
+    let bound = if bounded {
+        ChosenBound::Controls(Controls::new(original, &mut links))
+    } else {
+        ChosenBound::None
+    };
+    let cost = if let Some(a) = attributes {
+        ChosenCost::Attributes(
+            AttributeQuadric::new(&mut quadrics, &mut states, &a.values, a.weights)
                 .with_placement(placement.unwrap_or(Placement::Optimal))
                 .map_err(|e| {
                     anyhow!(
                         "{} (attribute weights need --quadric stored --placement subset)",
                         e
                     )
-                })
-        };
-        if bounded {
-            drive!(
-                Positions::Read(&positions),
-                cost(&mut quadrics, &mut states)?,
-                Controls::new(original, &mut links)
-            )
-        } else {
-            drive!(
-                Positions::Read(&positions),
-                cost(&mut quadrics, &mut states)?,
-                NoBound
-            )
-        }
+                })?,
+        )
     } else if let Some(kappa) = energy {
         if placement.is_some() {
             return Err(anyhow!("--cost energy replaces --quadric stored"));
         }
-        if bounded {
-            drive!(
-                Positions::Read(&positions),
-                Energy::new(&mut samples).with_weights(1.0, kappa),
-                Controls::new(original, &mut links)
-            )
-        } else {
-            drive!(
-                Positions::Read(&positions),
-                Energy::new(&mut samples).with_weights(1.0, kappa),
-                NoBound
-            )
-        }
+        ChosenCost::Energy(Energy::new(&mut samples).with_weights(1.0, kappa))
     } else {
-        match (placement, bounded) {
-            (None, false) => drive!(Positions::Read(&positions), Builtin::new(), NoBound),
-            (None, true) => drive!(
-                Positions::Read(&positions),
-                Builtin::new(),
-                Controls::new(original, &mut links)
-            ),
-            (Some(Placement::Subset), false) => drive!(
-                Positions::Read(&positions),
-                StoredQuadric::new(&mut quadrics, Placement::Subset),
-                NoBound
-            ),
-            (Some(Placement::Subset), true) => drive!(
-                Positions::Read(&positions),
-                StoredQuadric::new(&mut quadrics, Placement::Subset),
-                Controls::new(original, &mut links)
-            ),
-            (Some(Placement::Optimal), false) => drive!(
-                Positions::Write(&mut positions),
-                StoredQuadric::new(&mut quadrics, Placement::Optimal),
-                NoBound
-            ),
-            (Some(Placement::Optimal), true) => drive!(
-                Positions::Write(&mut positions),
-                StoredQuadric::new(&mut quadrics, Placement::Optimal),
-                Controls::new(original, &mut links)
-            ),
+        match placement {
+            None => ChosenCost::Builtin(Builtin::new()),
+            Some(p) => ChosenCost::Stored(StoredQuadric::new(&mut quadrics, p)),
         }
     };
+    let mut chosen =
+        Chosen::new(cost, bound, operator).with_budget(if bounded { 1 << 12 } else { 1 << 14 });
+    if !wedges.is_empty() {
+        let corners = if lock_seam_corners {
+            tinydecimate::seam::SeamCorners::Lock
+        } else {
+            tinydecimate::seam::SeamCorners::Move
+        };
+        chosen = chosen.with_wedges(&mut wedges, corners);
+    }
+    if prune {
+        chosen = chosen.with_parts(&mut part_links);
+    }
+    // Optimal placement writes the positions; every other run only reads them.
+    let positions_arg = if placement == Some(Placement::Optimal) && attributes.is_none() {
+        Positions::Write(&mut positions)
+    } else {
+        Positions::Read(&positions)
+    };
+    let n0 = tris.len();
+    let report = ws
+        .storage()
+        .run_chosen(positions_arg, &mut tris, config, chosen, |removed| {
+            if let Some(b) = &bar {
+                b.set(removed.min(n0) as u64);
+            }
+        })
+        .map_err(library_error)?;
     let elapsed = start.elapsed();
     if let Some(b) = bar {
         b.finish();

@@ -609,7 +609,9 @@ fn declared_names() -> (BTreeSet<String>, BTreeSet<String>) {
                     i
                 });
                 // Only visibility and qualifiers before it (not `what: &'static str`).
-                let lead = ["pub", "crate", "super", "const", "unsafe", "async", "extern"];
+                let lead = [
+                    "pub", "crate", "super", "const", "unsafe", "async", "extern",
+                ];
                 if let Some(i) = keyword.filter(|&i| words[..i].iter().all(|w| lead.contains(w))) {
                     if let Some(name) = words.get(i + 1) {
                         let public =
