@@ -3,12 +3,12 @@
 //! A half-edge collapse `a -> b` (a moves onto b, b stays where it is, or moves to the cost's
 //! placement) is refused when any rule fails. Each rule is one row of [`RULES`]: the
 //! [`Reject`] it is counted under, its name (the report's label and its build-time switch),
-//! what it protects, its [`Kind`] and its source. The report's counts
+//! what it protects, its [`Purpose`] and its source. The report's counts
 //! ([`Rejections`](crate::Rejections)), the host tools' reports, the QEMU result files, the
 //! golden files, `tests/rules.rs` and `scripts/rules-off.sh` all read this table; none of them
 //! lists the rules again.
 //!
-//! # Kinds
+//! # Purposes
 //!
 //! - **validity** (`locked`, `boundary`, `link`, `duplicate`, `fold`): without the rule the
 //!   output can stop being a valid mesh of the same topology (a non-manifold edge, a pinched
@@ -140,7 +140,7 @@ impl Reject {
 
 /// What a rule is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
+pub enum Purpose {
     /// A hard rule: without it the output can stop being a valid mesh of the same topology.
     Validity,
     /// A validity part and a preference: zero area is always refused, a quality below the
@@ -163,7 +163,7 @@ pub struct Rule {
     /// When it refuses a collapse, and so what it protects.
     pub protects: &'static str,
     /// Hard validity rule, quality preference or guarantee.
-    pub kind: Kind,
+    pub purpose: Purpose,
     /// Where the rule comes from (empty: this library's own).
     pub source: &'static str,
 }
@@ -178,7 +178,7 @@ pub const RULES: &[Rule] = &[
                    edge, or b is and a is on the boundary or b's edge to o1 or o2 is \
                    non-manifold: irregular vertices never move (an interior vertex may move \
                    onto one)",
-        kind: Kind::Validity,
+        purpose: Purpose::Validity,
         source: "Cheng, Pan and Shi §3.1 (irregular vertices)",
     },
     Rule {
@@ -186,7 +186,7 @@ pub const RULES: &[Rule] = &[
         name: "feature",
         protects: "a is a feature vertex, or b is one and feature targets are not allowed: \
                    features survive",
-        kind: Kind::Quality,
+        purpose: Purpose::Quality,
         source: "Lin Mouguang 2007 §3.3",
     },
     Rule {
@@ -194,7 +194,7 @@ pub const RULES: &[Rule] = &[
         name: "boundary",
         protects: "a is on the boundary and a-b is not a boundary edge, or the boundary loop \
                    through a-b has only three edges: boundaries only shrink along themselves",
-        kind: Kind::Validity,
+        purpose: Purpose::Validity,
         source: "Cheng, Pan and Shi §3.2(1), second and third conditions",
     },
     Rule {
@@ -202,14 +202,14 @@ pub const RULES: &[Rule] = &[
         name: "link",
         protects: "a vertex adjacent to both a and b is not opposite a-b: the surface would \
                    pinch or gain a non-manifold edge",
-        kind: Kind::Validity,
+        purpose: Purpose::Validity,
         source: "Cheng, Pan and Shi §3.2(1), first condition (the link condition)",
     },
     Rule {
         reject: Reject::Duplicate,
         name: "duplicate",
         protects: "a triangle of a would become a copy of one of b's",
-        kind: Kind::Validity,
+        purpose: Purpose::Validity,
         source: "",
     },
     Rule {
@@ -217,7 +217,7 @@ pub const RULES: &[Rule] = &[
         name: "normal_turn",
         protects: "a surviving triangle's normal turns by more than \
                    Config::max_normal_turn_deg",
-        kind: Kind::Quality,
+        purpose: Purpose::Quality,
         source: "Cheng, Pan and Shi §3.2(2), the dihedral threshold",
     },
     Rule {
@@ -226,7 +226,7 @@ pub const RULES: &[Rule] = &[
         protects: "a surviving triangle gets zero area or a normal that rounding decides \
                    (validity), or leaves its plane with a quality below Config::min_quality \
                    that is also worse than before (preference)",
-        kind: Kind::ValidityAndQuality,
+        purpose: Purpose::ValidityAndQuality,
         source: "",
     },
     Rule {
@@ -234,7 +234,7 @@ pub const RULES: &[Rule] = &[
         name: "fold",
         protects: "a surviving triangle and a neighbour across any of its edges end up with \
                    nearly opposite normals (more than about 154° apart)",
-        kind: Kind::Validity,
+        purpose: Purpose::Validity,
         source: "Cheng, Pan and Shi §3.2(2)",
     },
     Rule {
@@ -242,7 +242,7 @@ pub const RULES: &[Rule] = &[
         name: "bound",
         protects: "a control point would end farther than Config::max_error from every \
                    triangle of the new fan (bounded entry points only)",
-        kind: Kind::Guarantee,
+        purpose: Purpose::Guarantee,
         source: "Zhu, Wang and Meng 2007 §3",
     },
     Rule {
@@ -252,7 +252,7 @@ pub const RULES: &[Rule] = &[
                    or two spokes) moves only along that seam, so the seam keeps its shape and \
                    no triangle takes corners from both sides, and never takes a chart's (a \
                    material's) last triangle (welded runs only)",
-        kind: Kind::Quality,
+        purpose: Purpose::Quality,
         source: "meshoptimizer's vertex kinds (a Seam vertex collapses along its seam)",
     },
 ];

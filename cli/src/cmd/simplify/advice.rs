@@ -383,7 +383,7 @@ impl Advice {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tinydecimate::legality::Kind;
+    use tinydecimate::legality::Purpose;
     use tinydecimate::{Config, RULES};
 
     /// An outcome that stopped short with these refusals (by rule name).
@@ -415,7 +415,7 @@ mod tests {
             assert_eq!(row.rule, rule.reject, "{}", rule.name);
             assert_eq!(
                 row.option.is_none(),
-                rule.kind == Kind::Validity,
+                rule.purpose == Purpose::Validity,
                 "{}",
                 rule.name
             );
