@@ -149,8 +149,8 @@ pub struct Simplifier<
 }
 
 /// `n / d` (`d > 0`) by binary long division. The run's one integer division (the fronts'
-/// share of the target): a Cortex-M0 has no divider, and the library's routine for it took
-/// about 400 B of flash there.
+/// share of the target): a Cortex-M0 has no divider, and the compiler's division routine
+/// costs more flash than this loop.
 fn div_floor(n: usize, d: usize) -> usize {
     let (mut q, mut r) = (0usize, 0usize);
     for i in (0..usize::BITS).rev() {

@@ -20,8 +20,9 @@ use crate::math::{self, V3};
 pub(crate) const MAX_RING: usize = crate::mesh::MAX_FAN;
 
 /// The default smallest aspect ratio of a split (distance of the loop's nearest vertex to the
-/// split plane over the split line's length): 1/25. At 0.1 the CAD meshes (long thin fans)
-/// stopped near half their triangles; at 0.01 they reach 10 % with thin triangles.
+/// split plane over the split line's length): 1/25, between a limit that stops the CAD meshes'
+/// long thin fans short of their target and one that lets them reach it with thin triangles
+/// (docs/decimation.md).
 const MIN_ASPECT: f32 = 0.04;
 /// cos 60°: with [`Fill::Fit`], a vertex with more than two spokes sharper than this is a
 /// corner (a CAD model's corner); softer ones (a coarse organic mesh has many) may move.
