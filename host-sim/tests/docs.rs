@@ -813,3 +813,24 @@ fn readme_times_are_the_bench_results() {
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// The README's instructions per collapse on the M4F are the cow's rows of bench/DEVICES.md
+/// (written by `host-sim qemu --measure --out bench/DEVICES.md`).
+#[test]
+fn readme_instructions_are_the_device_tables() {
+    let tables = read("bench/DEVICES.md");
+    let per_collapse = |case: &str| -> String {
+        let row = tables
+            .lines()
+            .find(|l| l.starts_with(&format!("| mps2-an386 | {case} |")))
+            .unwrap_or_else(|| panic!("bench/DEVICES.md has no mps2-an386 row for {case}"));
+        row.split('|').nth(6).unwrap().trim().to_string()
+    };
+    let (exact, fast) = (per_collapse("cow-new-u16"), per_collapse("cow-fast-u16"));
+    let readme = read("README.md");
+    let said = format!("{exact} emulated instructions on the M4F for the cow ({fast} in the");
+    assert!(
+        readme.replace('\n', " ").contains(&said),
+        "README does not say {said:?}"
+    );
+}

@@ -13,7 +13,7 @@ use crate::backend::Backend;
 use crate::golden::{self, Case, Outcome};
 use crate::qemu::build::{build, preflight};
 use crate::qemu::check::{check_boards, Expected};
-use crate::qemu::measure::{measure, print_measurement, print_summary};
+use crate::qemu::measure::{markdown, measure, print_measurement, print_summary};
 use crate::qemu::run::{
     run_case_bytes, run_command, run_in, scratch_dir, EXIT_DONE, EXIT_FAULT, EXIT_IO, EXIT_PANIC,
 };
@@ -52,6 +52,10 @@ pub struct Args {
     /// largest mesh it simplifies (bisection). Not pass/fail.
     #[arg(long)]
     pub measure: bool,
+    /// With --measure: also write the measurements as Markdown tables to this file (the
+    /// project's is bench/DEVICES.md, which the docs quote).
+    #[arg(long, value_name = "FILE", requires = "measure")]
+    pub out: Option<PathBuf>,
     /// The golden directory (`cases.toml`, `libm/`, `micromath/`).
     #[arg(long, value_name = "DIR", default_value_os_t = golden::default_dir())]
     pub dir: PathBuf,
@@ -109,6 +113,11 @@ pub fn run(a: &Args) -> Result<ExitCode> {
             all.push(m);
         }
         print_summary(&all);
+        if let Some(path) = &a.out {
+            std::fs::write(path, markdown(&all))
+                .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+            crate::outln!("tables: {}", path.display());
+        }
     } else if a.smoke {
         let case = &golden::load_cases(&a.dir)?[0];
         for b in &boards {

@@ -557,3 +557,129 @@ pub fn print_summary(ms: &[Measurement]) {
         );
     }
 }
+
+/// A number with a space between thousands, as the docs write them (`34 846`).
+fn spaced(n: u64) -> String {
+    let d = n.to_string();
+    let mut out = String::new();
+    for (i, c) in d.chars().enumerate() {
+        if i > 0 && (d.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// The measurements as the Markdown tables of bench/DEVICES.md: per board, per case that
+/// ran, per progressive stream. The docs quote these figures; a docs test checks the quotes.
+pub fn markdown(ms: &[Measurement]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let backend = ms.first().map_or(String::new(), |m| m.backend.to_string());
+    let _ = write!(
+        s,
+        "# Device measurements\n\nWritten by `cargo run -p host-sim --release -- qemu --measure \
+         --out bench/DEVICES.md` ({backend} backend); do not edit. Sizes in bytes. Instructions \
+         are exact (QEMU `-icount shift=0`, SysTick or `mcycle` read around the call). Library \
+         flash and RAM: the test firmware with the library minus without it; 1-inst flash: one \
+         instantiation ({ONE_INSTANTIATION}, as `scripts/flash.sh` measures it). \
+         [docs/devices.md](../docs/devices.md) says what each column means.\n\n## Boards\n\n\
+         | board | firmware flash | firmware RAM | library flash | 1-inst flash | library RAM | \
+         library stack | stack high-water | instructions per collapse | largest mesh u16 | \
+         largest mesh u32 |\n|---|---:|---:|---:|---:|---:|---:|---:|---|---|---|\n"
+    );
+    for m in ms {
+        let per: Vec<u64> = m
+            .cases
+            .iter()
+            .filter(|c| c.collapses > 0)
+            .map(|c| c.instructions / u64::from(c.collapses))
+            .collect();
+        let range = match (per.iter().min(), per.iter().max()) {
+            (Some(a), Some(b)) => format!("{} – {}", spaced(*a), spaced(*b)),
+            _ => "-".into(),
+        };
+        let largest = |i: usize| {
+            m.largest
+                .get(i)
+                .and_then(|l| l.ok)
+                .map_or("-".into(), |(_, t, _)| {
+                    format!("{} triangles", spaced(t as u64))
+                })
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            m.board.name,
+            spaced(m.sizes.flash),
+            spaced(m.sizes.static_ram),
+            spaced(delta(m.sizes.flash, m.sizes_without.flash).max(0) as u64),
+            spaced(delta(m.instantiation.1, m.instantiation.0).max(0) as u64),
+            spaced(delta(m.sizes.static_ram, m.sizes_without.static_ram).max(0) as u64),
+            spaced(u64::from(
+                m.cases.iter().map(|c| c.stack_bytes).max().unwrap_or(0)
+            )),
+            spaced(u64::from(
+                m.cases
+                    .iter()
+                    .map(|c| c.stack_high_water)
+                    .max()
+                    .unwrap_or(0)
+            )),
+            range,
+            largest(0),
+            largest(1)
+        );
+    }
+    s += "\n## Cases\n\nEvery golden case a board ran (a case too big for a board is skipped).\n\n\
+          | board | case | triangles in → out | collapses | instructions | per collapse | \
+          library stack |\n|---|---|---|---:|---:|---:|---:|\n";
+    for m in ms {
+        for c in m.cases.iter().filter(|c| c.verdict == "identical") {
+            let per = c.instructions / u64::from(c.collapses.max(1));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} → {} | {} | {} | {} | {} |",
+                m.board.name,
+                c.name,
+                spaced(u64::from(c.triangles_in)),
+                spaced(u64::from(c.triangles_out)),
+                spaced(u64::from(c.collapses)),
+                spaced(c.instructions),
+                spaced(per),
+                spaced(u64::from(c.stack_bytes))
+            );
+        }
+    }
+    s += "\n## Progressive streams\n\nEach golden stream decoded on the board; instructions per \
+          split (decoding, coarsening every level, refining every level).\n\n\
+          | board | stream | splits | decode | coarsen | refine |\n|---|---|---:|---:|---:|---:|\n";
+    for m in ms {
+        for st in &m.streams {
+            let per = |x: u64| spaced(x / u64::from(st.splits.max(1)));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} |",
+                m.board.name,
+                st.name,
+                spaced(u64::from(st.splits)),
+                per(st.decode),
+                per(st.coarsen),
+                per(st.refine)
+            );
+        }
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn thousands_are_spaced_as_the_docs_write_them() {
+        assert_eq!(super::spaced(0), "0");
+        assert_eq!(super::spaced(999), "999");
+        assert_eq!(super::spaced(34_846), "34 846");
+        assert_eq!(super::spaced(91_018_440), "91 018 440");
+    }
+}
