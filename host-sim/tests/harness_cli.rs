@@ -3,8 +3,20 @@
 
 use std::path::Path;
 
-mod common;
-use common::{run, s, text};
+fn run(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
 
 /// Every subcommand's `--help`.
 fn all_help() -> Vec<(String, String)> {
@@ -57,23 +69,12 @@ fn no_internal_labels_in_help() {
 #[test]
 fn stream_says_why_before_running() {
     let d = tempfile::tempdir().unwrap();
-    // A 60 x 60 grid of quads: 3 721 vertices.
-    let n = 60u32;
-    let mut mesh = host_sim::io::MeshData::default();
-    for y in 0..=n {
-        for x in 0..=n {
-            let (fx, fy) = (x as f32 / n as f32, y as f32 / n as f32);
-            mesh.positions
-                .push([fx, fy, 0.08 * (fx * 7.0).sin() * (fy * 5.0).cos()]);
-        }
-    }
-    for y in 0..n {
-        for x in 0..n {
-            let v = y * (n + 1) + x;
-            mesh.triangles.push([v, v + 1, v + n + 2]);
-            mesh.triangles.push([v, v + n + 2, v + n + 1]);
-        }
-    }
+    // A 60 x 60 grid of quads (the golden cases' generator): 3 721 vertices.
+    let g = meshfmt::golden::bumpy_grid(60);
+    let mesh = host_sim::io::MeshData {
+        positions: g.positions,
+        triangles: g.triangles,
+    };
     let obj = d.path().join("g.obj");
     host_sim::io::save(&obj, &mesh).unwrap();
     let o = run(&["stream", s(&obj)]);
