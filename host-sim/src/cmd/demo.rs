@@ -116,7 +116,7 @@ pub fn target_text(h: &meshfmt::ResultHeader) -> String {
     let pct = |n: u32| 100.0 * f64::from(n) / f64::from(h.triangles_in.max(1));
     format!(
         "{} ({:.1} %): {}",
-        thousands(h.target_triangles.into()),
+        crate::qemu::measure::spaced(h.target_triangles.into()),
         pct(h.target_triangles),
         if h.target_reached {
             "reached".to_string()
@@ -124,19 +124,6 @@ pub fn target_text(h: &meshfmt::ResultHeader) -> String {
             format!("NOT reached, stopped at {:.1} %", pct(h.triangles_out))
         }
     )
-}
-
-/// Groups digits by thousands.
-fn thousands(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(' ');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// Runs `host-sim demo`.
@@ -347,22 +334,22 @@ fn side_by_side(
     );
     row(
         "triangles in",
-        thousands(h.triangles_in.into()),
-        thousands(d.triangles_in.into()),
+        crate::qemu::measure::spaced(h.triangles_in.into()),
+        crate::qemu::measure::spaced(d.triangles_in.into()),
     );
     run_rows("", board, (h, d), host_wall, run.wall);
     row(
         "workspace RAM",
         format!(
             "{} B (u32 links, sized to the mesh)",
-            thousands(tinydecimate::Storage::<u32>::bytes(
+            crate::qemu::measure::spaced(tinydecimate::Storage::<u32>::bytes(
                 case.positions.len(),
                 case.triangles.len()
             ) as u64),
         ),
         format!(
             "{} B ({} V / {} T capacity)",
-            thousands(d.workspace_bytes.into()),
+            crate::qemu::measure::spaced(d.workspace_bytes.into()),
             d.capacity_vertices,
             d.capacity_triangles
         ),
@@ -372,8 +359,8 @@ fn side_by_side(
         "-".into(),
         format!(
             "{} B (library: {} B)",
-            thousands(d.stack_high_water.into()),
-            thousands(d.stack_bytes.into())
+            crate::qemu::measure::spaced(d.stack_high_water.into()),
+            crate::qemu::measure::spaced(d.stack_bytes.into())
         ),
     );
 }
@@ -390,13 +377,13 @@ fn run_rows(
 ) {
     row(
         &format!("triangles out{suffix}"),
-        thousands(h.triangles_out.into()),
-        thousands(d.triangles_out.into()),
+        crate::qemu::measure::spaced(h.triangles_out.into()),
+        crate::qemu::measure::spaced(d.triangles_out.into()),
     );
     row(
         &format!("collapses{suffix}"),
-        thousands(h.collapses.into()),
-        thousands(d.collapses.into()),
+        crate::qemu::measure::spaced(h.collapses.into()),
+        crate::qemu::measure::spaced(d.collapses.into()),
     );
     row(
         &format!("emulated instructions{suffix}"),
@@ -414,11 +401,11 @@ fn instructions_text(board: &qemu::Board, d: &meshfmt::ResultHeader) -> String {
     let instr = board.instructions(d.ticks);
     format!(
         "{}{}",
-        thousands(instr),
+        crate::qemu::measure::spaced(instr),
         if d.collapses > 0 {
             format!(
                 " ({} per collapse)",
-                thousands(instr / u64::from(d.collapses))
+                crate::qemu::measure::spaced(instr / u64::from(d.collapses))
             )
         } else {
             String::new()
@@ -482,7 +469,7 @@ fn pipeline_rows(
         &format!("workspace RAM, {name} mode"),
         format!(
             "{} B (sized to the mesh)",
-            thousands(crate::simplify::pipeline_bytes(
+            crate::qemu::measure::spaced(crate::simplify::pipeline_bytes(
                 mode,
                 case.positions.len(),
                 case.triangles.len()
@@ -490,7 +477,7 @@ fn pipeline_rows(
         ),
         format!(
             "{} B ({} V / {} T capacity)",
-            thousands(d.workspace_bytes.into()),
+            crate::qemu::measure::spaced(d.workspace_bytes.into()),
             d.capacity_vertices,
             d.capacity_triangles
         ),
@@ -500,8 +487,8 @@ fn pipeline_rows(
         "-".into(),
         format!(
             "{} B (library: {} B)",
-            thousands(d.stack_high_water.into()),
-            thousands(d.stack_bytes.into())
+            crate::qemu::measure::spaced(d.stack_high_water.into()),
+            crate::qemu::measure::spaced(d.stack_bytes.into())
         ),
     );
     let c = compare(case, backend, host, device)?;
@@ -647,12 +634,15 @@ mod tests {
             instructions_text(board, &d),
             format!(
                 "{} ({} per collapse)",
-                thousands(instr),
-                thousands(instr / 40)
+                crate::qemu::measure::spaced(instr),
+                crate::qemu::measure::spaced(instr / 40)
             )
         );
         d.collapses = 0;
-        assert_eq!(instructions_text(board, &d), thousands(instr));
+        assert_eq!(
+            instructions_text(board, &d),
+            crate::qemu::measure::spaced(instr)
+        );
     }
 
     #[test]
@@ -678,7 +668,7 @@ mod tests {
         );
         let s = subset_that_fits(&case, 1000, 7);
         assert_eq!(s.triangles.len(), 7);
-        assert_eq!(thousands(1234567), "1 234 567");
-        assert_eq!(thousands(12), "12");
+        assert_eq!(crate::qemu::measure::spaced(1234567), "1 234 567");
+        assert_eq!(crate::qemu::measure::spaced(12), "12");
     }
 }

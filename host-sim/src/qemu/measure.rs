@@ -521,16 +521,7 @@ pub fn print_summary(ms: &[Measurement]) {
         "largest u32"
     );
     for m in ms {
-        let per: Vec<u64> = m
-            .cases
-            .iter()
-            .filter(|c| c.collapses > 0)
-            .map(|c| c.instructions / u64::from(c.collapses))
-            .collect();
-        let range = match (per.iter().min(), per.iter().max()) {
-            (Some(a), Some(b)) => format!("{a}..{b}"),
-            _ => "-".into(),
-        };
+        let range = per_collapse(m).map_or("-".into(), |(a, b)| format!("{a}..{b}"));
         let largest = |i: usize| {
             m.largest
                 .get(i)
@@ -558,8 +549,18 @@ pub fn print_summary(ms: &[Measurement]) {
     }
 }
 
+/// The least and the most instructions per collapse over the cases a board ran.
+fn per_collapse(m: &Measurement) -> Option<(u64, u64)> {
+    let per = m
+        .cases
+        .iter()
+        .filter(|c| c.collapses > 0)
+        .map(|c| c.instructions / u64::from(c.collapses));
+    Some((per.clone().min()?, per.max()?))
+}
+
 /// A number with a space between thousands, as the docs write them (`34 846`).
-fn spaced(n: u64) -> String {
+pub(crate) fn spaced(n: u64) -> String {
     let d = n.to_string();
     let mut out = String::new();
     for (i, c) in d.chars().enumerate() {
@@ -590,16 +591,9 @@ pub fn markdown(ms: &[Measurement]) -> String {
          largest mesh u32 |\n|---|---:|---:|---:|---:|---:|---:|---:|---|---|---|\n"
     );
     for m in ms {
-        let per: Vec<u64> = m
-            .cases
-            .iter()
-            .filter(|c| c.collapses > 0)
-            .map(|c| c.instructions / u64::from(c.collapses))
-            .collect();
-        let range = match (per.iter().min(), per.iter().max()) {
-            (Some(a), Some(b)) => format!("{} – {}", spaced(*a), spaced(*b)),
-            _ => "-".into(),
-        };
+        let range = per_collapse(m).map_or("-".into(), |(a, b)| {
+            format!("{} – {}", spaced(a), spaced(b))
+        });
         let largest = |i: usize| {
             m.largest
                 .get(i)
