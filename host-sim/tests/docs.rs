@@ -814,11 +814,30 @@ fn readme_times_are_the_bench_results() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
-/// The README's instructions per collapse on the M4F are the cow's rows of bench/DEVICES.md
-/// (written by `host-sim qemu --measure --out bench/DEVICES.md`).
+/// The README's instructions per collapse on the M4F and its flash of one instantiation per
+/// target are the rows of bench/DEVICES.md (written by `host-sim qemu --measure --out
+/// bench/DEVICES.md`).
 #[test]
 fn readme_instructions_are_the_device_tables() {
     let tables = read("bench/DEVICES.md");
+    // The boards table's "1-inst flash" column, per board.
+    let flash = |board: &str| -> String {
+        let row = tables
+            .lines()
+            .find(|l| l.starts_with(&format!("| {board} | ")))
+            .unwrap_or_else(|| panic!("bench/DEVICES.md has no board row for {board}"));
+        row.split('|').nth(5).unwrap().trim().to_string()
+    };
+    let said = format!(
+        "**{}** on thumbv7em, **{}** on thumbv6m, **{}** on riscv32imc",
+        flash("mps2-an386") + " B",
+        flash("microbit") + " B",
+        flash("riscv32imc-virt-400k") + " B"
+    );
+    assert!(
+        read("README.md").contains(&said),
+        "README does not say {said:?}"
+    );
     let per_collapse = |case: &str| -> String {
         let row = tables
             .lines()
