@@ -97,6 +97,9 @@ fn survivor<L: Index, I: Index>(
 
 /// Checks every rule for `a -> b`; with `at`, the rules on `a`'s triangles for `b` moved to
 /// `at` (optimal placement; [`check_placed`] adds `b`'s own triangles, which change too).
+/// The steps, in order, each a commented block: the flag and seam rules; the vertices opposite
+/// the edge (`link`, `locked`); the boundary; every surviving triangle ([`survivor`]:
+/// duplicate, shape, turn, folds); the link condition; the folds across the link.
 pub(crate) fn check<L: Index, I: Index>(
     mesh: &Mesh<'_, L, I>,
     rules: &Rules,
