@@ -820,14 +820,16 @@ fn readme_times_are_the_bench_results() {
 #[test]
 fn readme_instructions_are_the_device_tables() {
     let tables = read("bench/DEVICES.md");
-    // The boards table's "1-inst flash" column, per board.
-    let flash = |board: &str| -> String {
+    // Cell `column` of the row that starts with the cells `first`.
+    let cell = |first: &str, column: usize| -> String {
         let row = tables
             .lines()
-            .find(|l| l.starts_with(&format!("| {board} | ")))
-            .unwrap_or_else(|| panic!("bench/DEVICES.md has no board row for {board}"));
-        row.split('|').nth(5).unwrap().trim().to_string()
+            .find(|l| l.starts_with(&format!("| {first} |")))
+            .unwrap_or_else(|| panic!("bench/DEVICES.md has no row | {first} |"));
+        row.split('|').nth(column).unwrap().trim().to_string()
     };
+    // The boards table's "1-inst flash" column, per board.
+    let flash = |board: &str| cell(board, 5);
     let said = format!(
         "**{}** on thumbv7em, **{}** on thumbv6m, **{}** on riscv32imc",
         flash("mps2-an386") + " B",
@@ -838,13 +840,8 @@ fn readme_instructions_are_the_device_tables() {
         read("README.md").contains(&said),
         "README does not say {said:?}"
     );
-    let per_collapse = |case: &str| -> String {
-        let row = tables
-            .lines()
-            .find(|l| l.starts_with(&format!("| mps2-an386 | {case} |")))
-            .unwrap_or_else(|| panic!("bench/DEVICES.md has no mps2-an386 row for {case}"));
-        row.split('|').nth(6).unwrap().trim().to_string()
-    };
+    // The cases table's "per collapse" column on the M4F.
+    let per_collapse = |case: &str| cell(&format!("mps2-an386 | {case}"), 6);
     let (exact, fast) = (per_collapse("cow-new-u16"), per_collapse("cow-fast-u16"));
     let readme = read("README.md");
     let said = format!("{exact} emulated instructions on the M4F for the cow ({fast} in the");
