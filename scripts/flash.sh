@@ -7,12 +7,14 @@
 # opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
 # of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
 #
-# Usage: scripts/flash.sh [--all] [--micromath] [--opt-level L] [--symbols N] [--target T]...
+# Usage: scripts/flash.sh [--all] [--out FILE] [--micromath] [--opt-level L] [--symbols N] [--target T]...
 #   --all         also Config::paper(), a second triangle index type (u32 triangles on the same
-#                 Workspace<u16, ..>) and a second link type (Workspace<u32, ..> over u32)
+#                 Workspace<u16, ..>), a second link type (Workspace<u32, ..> over u32) and the
+#                 library features batched, seams and parts each compiled into the default call
+#   --out FILE    also write the table to FILE (bench/FLASH.md is `--all --out bench/FLASH.md`)
 #   --micromath   the library's micromath backend instead of libm
 #   --opt-level L another opt-level than the "s" of tests/flash's Cargo.toml (e.g. z: smaller,
-#                 and slower: docs/devices.md has the instructions at each level)
+#                 and slower: docs/devices.md says why "s" is the default)
 #   --symbols N   how many of the largest symbols the call adds to list per target (default 15)
 #   --target T    a Rust target (repeatable; default thumbv7em-none-eabihf thumbv6m-none-eabi
 #                 riscv32imc-unknown-none-elf)
@@ -23,6 +25,7 @@ cd "$(dirname "$0")/.."
 root=$PWD
 
 all=0
+out=
 extra=()
 opt=s
 nsym=15
@@ -32,9 +35,10 @@ while [ $# -gt 0 ]; do
         --all | --paper) all=1 ;;
         --micromath) extra=(micromath) ;;
         --opt-level) opt=$2; shift ;;
+        --out) out=$2; shift ;;
         --symbols) nsym=$2; shift ;;
         --target) targets+=("$2"); shift ;;
-        -h | --help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown argument: $1 (see --help)" >&2; exit 2 ;;
     esac
     shift
@@ -67,6 +71,9 @@ if [ $all = 1 ]; then
         "paper|paper|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::paper()"
         "u32-triangles|u32-triangles|Config::new(), Workspace<u16, 512, 1024>: u16 triangles + u32 triangles"
         "u32-links|u32-links|Config::new(), Workspace<u16, ..> on u16 + Workspace<u32, 512, 1024> on u32"
+        "batched|batched|Workspace<u16, 512, 1024>::simplify, Config::new(), feature batched"
+        "seams|seams|Workspace<u16, 512, 1024>::simplify, Config::new(), feature seams"
+        "parts|parts|Workspace<u16, 512, 1024>::simplify, Config::new(), feature parts"
     )
 fi
 
@@ -86,6 +93,14 @@ build() { # target name features
 # .text + .rodata of an image, in bytes.
 code() {
     "$bin/llvm-size" -A "$1" | awk '$1 == ".text" || $1 == ".rodata" { s += $2 } END { print s }'
+}
+
+# Bytes with thousands spaced, as bench/DEVICES.md writes them; signed with --sign.
+spaced() {
+    local n=$1 sign=
+    if [ "${2:-}" = --sign ]; then sign=+; fi
+    if [ "$n" -lt 0 ]; then sign=-; n=$((-n)); fi
+    echo "$sign$(echo "$n" | sed -e ':a' -e 's/\([0-9]\)\([0-9]\{3\}\)\($\| \)/\1 \2\3/' -e 'ta')"
 }
 
 kb() { awk -v b="$1" 'BEGIN { printf "%.1f KB", b / 1024 }'; }
@@ -122,31 +137,39 @@ for t in "${targets[@]}"; do
     done
 done
 
-echo
-echo "flash of the library (.text + .rodata; image with the call - image without; opt-level \"$opt\")${extra[0]:+, ${extra[0]} backend}"
-echo
-echo "| target | instantiation | without | with | library (difference) |"
-echo "|---|---|---:|---:|---:|"
-for t in "${targets[@]}"; do
-    base=${size[$t/without]}
-    for v in "${variants[@]:1}"; do
-        IFS='|' read -r name _ what <<<"$v"
-        s=${size[$t/$name]}
-        d=$((s - base))
-        echo "| $t | $what | $base B ($(kb "$base")) | $s B ($(kb "$s")) | **$d B ($(kb "$d"))** |"
-    done
-done
-if [ $all = 1 ]; then
+# The table: each variant's library flash, and (with --all) what it adds over the default call.
+table() {
+    echo "flash of the library (.text + .rodata; image with the call - image without; opt-level \"$opt\", fat LTO, one codegen unit, panic = abort)${extra[0]:+, ${extra[0]} backend}"
     echo
-    echo "what each addition costs over the single instantiation (Config::new(), u16):"
+    echo "| target | instantiation | without | with | library (difference) | over the default call |"
+    echo "|---|---|---:|---:|---:|---:|"
     for t in "${targets[@]}"; do
+        base=${size[$t/without]}
         one=${size[$t/call]}
-        for v in "${variants[@]:4}"; do
+        for v in "${variants[@]:1}"; do
             IFS='|' read -r name _ what <<<"$v"
-            d=$((size[$t/$name] - one))
-            printf '  %-22s %-82s %+7d B (%s)\n' "$t" "$what" "$d" "$(kb "$d")"
+            s=${size[$t/$name]}
+            d=$((s - base))
+            case $name in
+                call | fast | lean) over=- ;;
+                *) over="$(spaced $((s - one)) --sign) B" ;;
+            esac
+            echo "| $t | $what | $(spaced "$base") B | $(spaced "$s") B | **$(spaced "$d") B** ($(kb "$d")) | $over |"
         done
     done
+}
+
+echo
+table
+if [ -n "$out" ]; then
+    {
+        echo "# Flash of one instantiation"
+        echo
+        echo "Written by \`scripts/flash.sh$([ $all = 1 ] && echo " --all") --out $out\`${extra[0]:+ (--${extra[0]})}; do not edit. The firmware in tests/flash is built without and with each call; [docs/devices.md](../docs/devices.md#flash) says what the figures mean."
+        echo
+        table
+    } >"$out"
+    echo "wrote $out" >&2
 fi
 
 for t in "${targets[@]}"; do

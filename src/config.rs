@@ -211,7 +211,8 @@ impl Config {
     /// cutting a corner to reach a count (meshoptimizer's `target_error` plays this part).
     /// Infinite (the default): no limit. Costs without a distance (normal variation) are never
     /// limited. Not a guarantee: for a guaranteed bound see [`Config::max_error`].
-    /// Non-negative; a finite limit needs the greedy schedule and edge collapse.
+    /// Non-negative; a finite limit needs an ordered schedule (greedy or batched) and edge
+    /// collapse or vertex removal.
     #[inline]
     pub const fn error_limit(&self) -> f32 {
         self.error_limit

@@ -45,7 +45,7 @@ pub enum ConfigField {
     BoundaryWeight,
     MaxError,
     /// [`Config::error_limit`](crate::Config::error_limit) negative or NaN, or finite with
-    /// another schedule than greedy or with [`TriangleCollapse`](crate::TriangleCollapse).
+    /// the passes schedule or with [`TriangleCollapse`](crate::TriangleCollapse).
     ErrorLimit,
     ControlAngle,
     /// [`TriangleCollapse`](crate::TriangleCollapse) or
@@ -155,7 +155,7 @@ impl core::fmt::Display for Error {
                 ),
                 ConfigField::Parts => write!(
                     f,
-                    "configuration field Parts: removing parts needs the greedy schedule, no \
+                    "configuration field Parts: removing parts needs the greedy or batched schedule, no \
                      error bound and no collapse log, before the first step"
                 ),
                 _ => write!(f, "configuration field {field:?} is out of range"),

@@ -1,5 +1,5 @@
-//! A model as a tool or a renderer writes it, in one call: what `tinydecimate simplify` does by
-//! default, for firmware.
+//! A model as a tool or a renderer writes it, in one call: what `tinydecimate simplify --engine
+//! exact` does by default, for firmware.
 //!
 //! [`Storage::simplify`] takes the index buffer as given. A model whose vertices are split on
 //! a UV seam, a hard normal or a material border has two vertices at each seam position; to
@@ -18,7 +18,8 @@
 //! The error limit is the configuration's, as everywhere: the CLI's default is
 //! [`Config::MODEL_ERROR_LIMIT`] of the diagonal, set with
 //! [`Config::with_relative_error_limit`]. With that configuration the call gives the bytes
-//! `tinydecimate simplify` writes with its defaults (`--seams weld --parts prune`).
+//! `tinydecimate simplify --engine exact` writes with its other defaults (`--seams weld
+//! --parts prune`).
 //!
 //! ```
 //! # #[cfg(all(feature = "seams", feature = "parts"))]
@@ -105,7 +106,7 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
     Workspace<L, MAX_VERTICES, MAX_TRIANGLES>
 {
     /// [`Storage::simplify_model`] on this workspace: a model's seams welded, its small parts
-    /// pruned, as `tinydecimate simplify` does by default (crate feature `seams`).
+    /// pruned, as `tinydecimate simplify --engine exact` does by default (crate feature `seams`).
     pub fn simplify_model<I: Index>(
         &mut self,
         positions: &[[f32; 3]],
@@ -119,7 +120,8 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
 }
 
 impl<L: Index> Storage<'_, L> {
-    /// Simplifies a model's `triangles` in place as `tinydecimate simplify` does by default:
+    /// Simplifies a model's `triangles` in place as `tinydecimate simplify --engine exact` does
+    /// by default:
     /// vertices at one position welded and collapsed together (no crack along a seam), each
     /// corner keeping the caller's vertex (its wedge), and with
     /// [`ModelStorage::with_parts`] small parts removed whole (see [`crate::model`]).

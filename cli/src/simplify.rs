@@ -76,7 +76,7 @@ pub fn library_error(e: tinydecimate::Error) -> anyhow::Error {
         } => " (drop --schedule passes with --quadric stored)",
         Error::InvalidConfig {
             field: ConfigField::ErrorLimit,
-        } => " (--error-limit needs the greedy schedule and --operator edge)",
+        } => " (--error-limit needs --schedule greedy or batched, and not --operator triangle)",
         _ => "",
     };
     anyhow!("tinydecimate: {e}{hint}")

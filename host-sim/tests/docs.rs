@@ -163,25 +163,49 @@ fn firmware_advice_and_example() {
     assert!(test_sh.contains("--example simplify_in_flash --target thumbv7em-none-eabihf"));
 }
 
-/// docs/devices.md names the cases the soft-float cores skip, as qemu.rs lists them.
+/// docs/devices.md's "Expected skips" paragraph names exactly the cases the Cortex-M0 and
+/// Cortex-M3 boards skip (`EXPECTED_SKIPS`): the cases both skip, then "The Cortex-M0 also
+/// skips" and its own.
 #[test]
 fn devices_doc_names_the_expected_skips() {
-    let readme = read("docs/devices.md");
-    let qemu = read("host-sim/src/qemu.rs");
-    for (list, board) in [("MICROBIT_SKIPS", "Cortex-M0"), ("LM3S_SKIPS", "Cortex-M3")] {
-        let line = qemu
-            .lines()
-            .find(|l| l.starts_with(&format!("const {list}")))
-            .unwrap();
-        let para = &readme[readme.find(board).unwrap()..];
-        let para = &para[..para.find(')').unwrap() + 200];
-        for name in line.split('"').skip(1).step_by(2) {
-            assert!(
-                para.contains(&format!("`{name}`")),
-                "{board} {name}: {para}"
-            );
-        }
-    }
+    let skips = |board: &str| -> BTreeSet<String> {
+        let (_, cases) = host_sim::qemu::EXPECTED_SKIPS
+            .iter()
+            .find(|(b, _)| *b == board)
+            .unwrap_or_else(|| panic!("no {board} in EXPECTED_SKIPS"));
+        cases.iter().map(|c| c.to_string()).collect()
+    };
+    let (m0, m3) = (skips("microbit"), skips("lm3s6965evb"));
+    assert!(m0.len() > 20 && m3.len() > 20, "{m0:?} {m3:?}");
+    assert!(
+        m3.is_subset(&m0),
+        "the Cortex-M3 skips a case the M0 runs: the page says it does not"
+    );
+    // Case names in backticks: lower case, digits and hyphens.
+    let named = |text: &str| -> BTreeSet<String> {
+        text.split('`')
+            .skip(1)
+            .step_by(2)
+            .filter(|w| {
+                w.contains('-')
+                    && w.chars()
+                        .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+            })
+            .map(str::to_string)
+            .collect()
+    };
+    let page = read("docs/devices.md");
+    let start = page
+        .find("**Expected skips.**")
+        .expect("an Expected skips paragraph");
+    let para = &page[start..];
+    let para = &para[..para.find("\n\n").unwrap_or(para.len())];
+    let (both, own) = para
+        .split_once("The Cortex-M0 also skips")
+        .expect("the M0's own skips");
+    let own = &own[..own.find(". ").unwrap_or(own.len())];
+    assert_eq!(named(both), &m0 & &m3, "the cases both boards skip");
+    assert_eq!(named(own), &m0 - &m3, "the cases only the Cortex-M0 skips");
 }
 
 /// The README is a front door: short, and no log (dates, issue numbers, seed labels). The pages
@@ -814,39 +838,362 @@ fn readme_times_are_the_bench_results() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
-/// The README's instructions per collapse on the M4F and its flash of one instantiation per
-/// target are the rows of bench/DEVICES.md (written by `host-sim qemu --measure --out
-/// bench/DEVICES.md`).
+/// The measured figures of a Markdown text outside code: a ratio (`0.55x`; `1.0x`, a target, is
+/// not one), an instruction count (`29.7 k`, `85.3 M`, `2 612 instructions`), a byte count of a
+/// thousand or more (`22 328 B`), a time (`0.54 ms`, `3 s`) and an error with decimals
+/// (`0.72 %`; `10 %`, a target, is not one).
+fn measured_figures(text: &str) -> Vec<String> {
+    // Drop fenced blocks and inline code: commands and code, not prose.
+    let mut prose = String::new();
+    for (i, block) in text.split("```").enumerate() {
+        if i % 2 == 0 {
+            for (j, part) in block.split('`').enumerate() {
+                if j % 2 == 0 {
+                    prose.push_str(part);
+                }
+                prose.push(' ');
+            }
+        }
+    }
+    let chars: Vec<char> = prose.chars().collect();
+    let mut found = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let starts = chars[i].is_ascii_digit()
+            && (i == 0
+                || !(chars[i - 1].is_alphanumeric() || matches!(chars[i - 1], '.' | '-' | '_')));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        // The number: digits, thousands groups after a space, a fraction.
+        let mut end = i;
+        while end < chars.len() && chars[end].is_ascii_digit() {
+            end += 1;
+        }
+        while end + 3 < chars.len()
+            && chars[end] == ' '
+            && chars[end + 1..end + 4].iter().all(char::is_ascii_digit)
+            && chars.get(end + 4).is_none_or(|c| !c.is_ascii_digit())
+        {
+            end += 4;
+        }
+        if end + 1 < chars.len() && chars[end] == '.' && chars[end + 1].is_ascii_digit() {
+            end += 1;
+            while end < chars.len() && chars[end].is_ascii_digit() {
+                end += 1;
+            }
+        }
+        let number: String = chars[i..end].iter().collect();
+        let rest: String = chars[end..(end + 14).min(chars.len())].iter().collect();
+        let value: f64 = number.replace(' ', "").parse().unwrap_or(0.0);
+        let unit = |u: &str| {
+            [u.to_string(), format!(" {u}")].iter().any(|w| {
+                rest.starts_with(w.as_str())
+                    && rest[w.len()..]
+                        .chars()
+                        .next()
+                        .is_none_or(|c| !c.is_alphanumeric())
+            })
+        };
+        let figure = (unit("x") && value != 1.0)
+            || unit("k")
+            || unit("M")
+            || rest.starts_with(" instructions")
+            || (unit("B") && value >= 1000.0)
+            || unit("ms")
+            || unit("s")
+            || (number.contains('.') && unit("%"));
+        if figure {
+            let unit: String = rest
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_alphabetic())
+                .collect();
+            found.push(format!("{number}{unit}"));
+        }
+        i = end;
+    }
+    found
+}
+
+/// The pages of docs/ link to the generated tables (bench/DEVICES.md, bench/FLASH.md,
+/// bench/RESULTS.md, bench/STORED.md, bench/CLUSTER.md) and quote no measurement themselves:
+/// what was tried and dropped is a decision record that points at git history for its figures.
+/// The README's few figures are checked cell by cell (`readme_figures_are_the_generated_tables`).
 #[test]
-fn readme_instructions_are_the_device_tables() {
-    let tables = read("bench/DEVICES.md");
-    // Cell `column` of the row that starts with the cells `first`.
-    let cell = |first: &str, column: usize| -> String {
-        let row = tables
-            .lines()
-            .find(|l| l.starts_with(&format!("| {first} |")))
-            .unwrap_or_else(|| panic!("bench/DEVICES.md has no row | {first} |"));
-        row.split('|').nth(column).unwrap().trim().to_string()
+fn figure_pages_quote_no_measurement() {
+    let planted = "took 29.7 k instructions (0.55x), 22 328 B and 0.54 ms for 0.72 % at 10 %; \
+                   1.0x is a target, 16 KB a board, `85.3 M` code";
+    assert_eq!(
+        measured_figures(planted),
+        ["29.7k", "0.55x", "22 328B", "0.54ms", "0.72"],
+        "the figure scanner"
+    );
+    let mut problems = Vec::new();
+    let mut pages = 0;
+    for (page, text) in texts() {
+        if !(page.contains("/docs/") && page.ends_with(".md")) {
+            continue;
+        }
+        pages += 1;
+        let figures = measured_figures(&text);
+        if !figures.is_empty() {
+            problems.push(format!("{page} quotes {figures:?}"));
+        }
+    }
+    assert!(pages >= 15, "only {pages} pages of docs/ read");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// Cell `column` (a header's text) of the row of the generated table `file` whose first cells
+/// are `first` (`"board | case"`), with bold marks dropped.
+fn table_cell(file: &str, first: &str, column: &str) -> String {
+    let text = read(file);
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.starts_with(&format!("| {first} |")))
+        .unwrap_or_else(|| panic!("{file} has no row | {first} |"));
+    // The table's header is the line above its `|---` separator.
+    let separator = (0..at)
+        .rev()
+        .find(|&i| lines[i].starts_with("|---"))
+        .unwrap_or_else(|| panic!("{file}: row {first:?} has no header"));
+    let header: Vec<&str> = lines[separator - 1].split('|').map(str::trim).collect();
+    let index = header
+        .iter()
+        .position(|h| *h == column)
+        .unwrap_or_else(|| panic!("{file}: no column {column:?} in {header:?}"));
+    let cell = lines[at].split('|').nth(index).unwrap_or("");
+    cell.replace("**", "").trim().to_string()
+}
+
+/// A cell's number: its digits before any unit or parenthesis (`"**22 328 B** (21.8 KB)"` and
+/// `"+2 220 B"` give 22 328 and 2 220).
+fn number(cell: &str) -> u64 {
+    let digits: String = cell
+        .trim_start_matches('+')
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == ' ')
+        .filter(char::is_ascii_digit)
+        .collect();
+    digits
+        .parse()
+        .unwrap_or_else(|_| panic!("no number in {cell:?}"))
+}
+
+/// A number with thousands spaced, as the generated tables and the README write them.
+fn spaced(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Every figure of the README's "firmware engineer's numbers" and of its modes table that is a
+/// measurement is a cell of a generated file: bench/FLASH.md (`scripts/flash.sh --all --out
+/// bench/FLASH.md`), bench/DEVICES.md (`host-sim qemu --measure --out bench/DEVICES.md`),
+/// bench/results.json and bench/CLUSTER.md (`host-sim bench`). A re-measure that changes one
+/// fails here until the README says the new figure.
+#[test]
+fn readme_figures_are_the_generated_tables() {
+    let readme = read("README.md").replace('\n', " ");
+    let mut problems = Vec::new();
+    let mut says = |what: String| {
+        if !readme.contains(&what) {
+            problems.push(format!("README does not say {what:?}"));
+        }
     };
-    // The boards table's "1-inst flash" column, per board.
-    let flash = |board: &str| cell(board, 5);
-    let said = format!(
-        "**{}** on thumbv7em, **{}** on thumbv6m, **{}** on riscv32imc",
-        flash("mps2-an386") + " B",
-        flash("microbit") + " B",
-        flash("riscv32imc-virt-400k") + " B"
+
+    // Flash, bench/FLASH.md; the default call's agrees with bench/DEVICES.md's boards.
+    let default = "Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()";
+    let flash = |target: &str, variant: &str, column: &str| {
+        number(&table_cell(
+            "bench/FLASH.md",
+            &format!("{target} | {variant}"),
+            column,
+        ))
+    };
+    let library = |target: &str, variant: &str| flash(target, variant, "library (difference)");
+    let added = |variant: &str| flash("thumbv7em-none-eabihf", variant, "over the default call");
+    let (v7em, v6m, rv) = (
+        library("thumbv7em-none-eabihf", default),
+        library("thumbv6m-none-eabi", default),
+        library("riscv32imc-unknown-none-elf", default),
     );
+    says(format!(
+        "**{} B** on thumbv7em, **{} B** on thumbv6m, **{} B** on riscv32imc",
+        spaced(v7em),
+        spaced(v6m),
+        spaced(rv)
+    ));
+    for (board, bytes) in [
+        ("mps2-an386", v7em),
+        ("microbit", v6m),
+        ("riscv32imc-virt-400k", rv),
+    ] {
+        let measured = number(&table_cell("bench/DEVICES.md", board, "1-inst flash"));
+        assert_eq!(
+            measured, bytes,
+            "{board}: bench/DEVICES.md and bench/FLASH.md"
+        );
+    }
+    let second = "Config::new(), Workspace<u16, 512, 1024>: u16 triangles + u32 triangles";
+    says(format!(
+        "a second index type in the same firmware adds {} B on thumbv7em",
+        spaced(added(second))
+    ));
+    for feature in ["batched", "seams", "parts"] {
+        let variant =
+            format!("Workspace<u16, 512, 1024>::simplify, Config::new(), feature {feature}");
+        says(format!(
+            "| +{} B with the feature |",
+            spaced(added(&variant))
+        ));
+    }
+    let fast = "fast mode: FastWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()";
+    let lean = "lean mode: LeanWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()";
+    says(format!(
+        "| {} B ([bench/FLASH.md](bench/FLASH.md)) |",
+        spaced(library("thumbv7em-none-eabihf", fast))
+    ));
+    says(format!(
+        "| {} B (same file) |",
+        spaced(library("thumbv7em-none-eabihf", lean))
+    ));
+
+    // Stack and instructions, bench/DEVICES.md.
+    let case = |case: &str, column: &str| {
+        number(&table_cell(
+            "bench/DEVICES.md",
+            &format!("mps2-an386 | {case}"),
+            column,
+        ))
+    };
+    let board_stack = |board: &str| number(&table_cell("bench/DEVICES.md", board, "library stack"));
+    says(format!(
+        "{} B on the M4F, {} B on the M0, {} B with vertex decimation",
+        spaced(case("cow-new-u16", "library stack")),
+        spaced(board_stack("microbit")),
+        spaced(board_stack("mps2-an386"))
+    ));
+    let (exact, fast) = (
+        case("cow-new-u16", "per collapse"),
+        case("cow-fast-u16", "per collapse"),
+    );
+    says(format!(
+        "{} emulated instructions on the M4F for the cow ({} in the fast mode), about {:.2} ms ({:.2} ms) at 64 MHz",
+        spaced(exact),
+        spaced(fast),
+        exact as f64 / 64e3,
+        fast as f64 / 64e3
+    ));
+    // The M4F's cases, for the ranges of a kind of case.
+    let devices = read("bench/DEVICES.md");
+    let cases: Vec<(String, u64, u64)> = devices
+        .lines()
+        .filter_map(|l| l.strip_prefix("| mps2-an386 | "))
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            // The cases table's rows: case | triangles in → out | collapses | instructions |
+            // per collapse | library stack.
+            (cells.len() >= 6 && cells[1].contains('→'))
+                .then(|| (cells[0].to_string(), number(cells[4]), number(cells[5])))
+        })
+        .collect();
+    let deepest = cases.iter().max_by_key(|c| c.2).unwrap();
     assert!(
-        read("README.md").contains(&said),
-        "README does not say {said:?}"
+        deepest.0.contains("vertex-decimation"),
+        "the deepest stack on the M4F is {deepest:?}, not vertex decimation's"
     );
-    // The cases table's "per collapse" column on the M4F.
-    let per_collapse = |case: &str| cell(&format!("mps2-an386 | {case}"), 6);
-    let (exact, fast) = (per_collapse("cow-new-u16"), per_collapse("cow-fast-u16"));
-    let readme = read("README.md");
-    let said = format!("{exact} emulated instructions on the M4F for the cow ({fast} in the");
-    assert!(
-        readme.replace('\n', " ").contains(&said),
-        "README does not say {said:?}"
-    );
+    let range = |kind: &str| {
+        let per: Vec<u64> = cases
+            .iter()
+            .filter(|c| c.0.contains(kind))
+            .map(|c| c.1)
+            .collect();
+        assert!(per.len() >= 2, "{kind}: {per:?}");
+        let (lo, hi) = (per.iter().min().unwrap(), per.iter().max().unwrap());
+        format!(
+            "{} – {} instructions per collapse on the M4F",
+            spaced(*lo),
+            spaced(*hi)
+        )
+    };
+    says(range("-stored-optimal-"));
+    says(range("-bound"));
+    let stream = |column: &str| {
+        number(&table_cell(
+            "bench/DEVICES.md",
+            "mps2-an386 | pm-cow-quantised",
+            column,
+        ))
+    };
+    says(format!(
+        "{} instructions per collapse, {} per split on the M4F's slider",
+        spaced(stream("coarsen")),
+        spaced(stream("refine"))
+    ));
+
+    // Error and memory against meshoptimizer, bench/results.json.
+    let results: serde_json::Value = serde_json::from_str(&read("bench/results.json")).unwrap();
+    let mode = |method: &str| -> serde_json::Value {
+        results["summary"]["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == method)
+            .unwrap_or_else(|| panic!("no {method} in bench/results.json"))
+            .clone()
+    };
+    let mean = |method: &str| mode(method)["overall"]["mean_geomean"].as_f64().unwrap();
+    let scratch = mode("meshopt")["scratch_bytes_per_triangle"].clone();
+    says(format!(
+        "meshoptimizer takes {:.1}-{:.1} B on the bench meshes",
+        scratch[0].as_f64().unwrap(),
+        scratch[1].as_f64().unwrap()
+    ));
+    says(format!(
+        "Metro mean error {:.2}x meshoptimizer's (geometric mean; the default's {:.2}x)",
+        mean("batched"),
+        mean("default")
+    ));
+    says(format!(
+        "Metro mean error {:.2}x meshoptimizer's (geometric mean) |",
+        mean("energy")
+    ));
+    let worst: Vec<String> = mode("vertex_decimation")["worst"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| format!("{:.2}x", w["clean"]["mean_vs_meshopt"].as_f64().unwrap()))
+        .collect();
+    says(format!(
+        "worst mean error on the clean meshes {} meshoptimizer's at 50 / 25 / 10 %",
+        worst.join(" / ")
+    ));
+
+    // Clustering against simplifySloppy, bench/CLUSTER.md's summary sentences.
+    let cluster = read("bench/CLUSTER.md");
+    let geomean = |words: &str| -> String {
+        let sentence = cluster
+            .split(". ")
+            .find(|s| s.contains(words))
+            .unwrap_or_else(|| panic!("bench/CLUSTER.md says nothing of {words:?}"));
+        let at = sentence.find("geometric mean ").unwrap() + "geometric mean ".len();
+        let word = sentence[at..].split(' ').next().unwrap();
+        word.trim_end_matches(['.', ',', ';']).to_string()
+    };
+    says(format!(
+        "{} `simplifySloppy`'s time with 40 B per vertex, {} streamed",
+        geomean("40 B per input vertex"),
+        geomean("memory for the output only")
+    ));
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

@@ -86,7 +86,7 @@ impl Pass {
 /// A pass aims at no more than `live / PASS_SHARE` collapses (about half the live triangles
 /// for 4), however far the target is: meshoptimizer aims each pass at the target, but with the
 /// memoryless cost a pass that aims far ends up collapsing past prices that its locked vertices
-/// would have undercut. The choice and its measurement: docs/speed.md, batched schedule.
+/// would have undercut (decision record: docs/speed.md, batched schedule).
 #[cfg(feature = "batched")]
 const PASS_SHARE: usize = 4;
 
@@ -94,7 +94,7 @@ const PASS_SHARE: usize = 4;
 /// The pass's limit over the price of the candidate that would reach the pass's goal.
 /// meshoptimizer takes 1.5 (`1.5f * edge_collapses[collapse_order[edge_collapse_goal]].error`);
 /// with the memoryless cost 1.0 gives a lower mean error for the same instructions
-/// (docs/speed.md, batched schedule).
+/// (decision record: docs/speed.md, batched schedule).
 const PASS_LIMIT: f32 = 1.0;
 
 #[cfg(feature = "batched")]

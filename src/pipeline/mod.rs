@@ -8,7 +8,8 @@
 //!
 //! The lean mode walks a vertex's fan for its quadric each time a pass prices it (and for a
 //! border vertex's open edges), where the fast mode reads an array: it trades instructions for
-//! RAM (both modes' figures: docs/speed.md#lean-mode). Both price with the same planes and
+//! RAM (its instructions: the `cow-lean-u16` row of bench/DEVICES.md; the decision:
+//! docs/speed.md#lean-mode). Both price with the same planes and
 //! apply the same rules; only the order of each quadric's sum differs (triangle order
 //! against fan order), so a price may differ in its last bits and the outputs with it.
 //!
@@ -109,7 +110,7 @@
 //! collapse whose moving vertex would keep more is refused, so the checks run on fixed fan
 //! buffers. `examples/fast_cow.rs` runs it on one mesh (`FAST_COW_LEAN=1`: the lean mode), for
 //! callgrind and timing;
-//! docs/speed.md#fast-mode has its instructions and the decisions behind its passes.
+//! docs/speed.md#fast-mode has the decisions behind its passes.
 
 mod build;
 mod classify;

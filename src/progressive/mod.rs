@@ -25,7 +25,7 @@
 //! `s`'s list (they stay sorted) and puts the restored triangles, whose slots are the largest,
 //! at the heads of their corners' lists: O(1) each, where an ascending order would walk every
 //! list to its end. A collapse unlinks those same triangles from the heads, and merges two
-//! sorted lists. Both are O(valence) (the ascending order's cost is in docs/progressive.md).
+//! sorted lists. Both are O(valence) (decision record: docs/progressive.md).
 //!
 //! Memory: the triangle buffer, one link per corner and one list head per vertex (for `u16`:
 //! 12 bytes per input triangle and 2 per vertex), plus 16 bytes per [`Split`].

@@ -69,7 +69,7 @@ const COS_HARD: f32 = 0.5;
 /// interior-edge vertex along its line), and only a vertex with more than two spokes sharper
 /// than 60° is a corner that never goes. Schroeder's distance orders by shape alone and the
 /// loop splitting fills for shape alone, so error piles up where vertices go in turn (both
-/// fills measured: docs/decimation.md).
+/// fills: docs/decimation.md, its decision records).
 ///
 /// Triangulation: recursive loop splitting. A split line joins two loop vertices that are not
 /// neighbours; its split plane holds the line and the average plane's normal. A split is

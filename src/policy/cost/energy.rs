@@ -72,7 +72,7 @@ pub type Samples = [f32; 10];
 /// where every move's `E_dist` is zero. `κ` is in units of sample weight: a created edge of
 /// length ℓ costs as much as κ samples at distance ℓ from the new planes. A larger κ trades
 /// distance for triangle shape; the default [`Energy::KAPPA`] = 0.01 keeps distance leading
-/// and the spring as the tie-breaker (the measurements behind it: docs/algorithm.md; the
+/// and the spring as the tie-breaker (decision record: docs/algorithm.md; the
 /// shape it buys on a flat grid: tests/energy.rs).
 ///
 /// **Cost.** 40 bytes per vertex (the samples) instead of the memoryless quadric's none and
@@ -83,7 +83,7 @@ pub type Samples = [f32; 10];
 /// whose fan a collapse changed is re-keyed in full (the engine does so for a storing cost
 /// with [`Cost::needs_fan`]). Each candidate costs one pass over the ring (a cross product
 /// and a 1/√ per triangle) against the quadric's one 3×3 form (its instructions:
-/// docs/algorithm.md).
+/// the `*-energy-*` cases of bench/DEVICES.md).
 pub struct Energy<'s> {
     samples: &'s mut [Samples],
     /// Weight of `E_dist`.

@@ -20,7 +20,7 @@ use crate::{Config, ConfigField, CostKind, Error};
 /// A_fan: the fan's area) is what keeps thin parts: an area-weighted sum alone makes a fan of
 /// small triangles cheap to remove however far it moves, so thin parts (the cow's teats and
 /// tail) go first; dividing by the fan's area alone (a mean squared distance) keeps them but
-/// raises the mean error on every shared mesh (the variants' table: docs/algorithm.md).
+/// raises the mean error on every shared mesh (decision record: docs/algorithm.md).
 ///
 /// Needs [`Config::cost`] = [`CostKind::Quadric`]; the boundary weight is
 /// [`Config::boundary_weight`].

@@ -142,7 +142,7 @@ pub trait Cost {
     fn merge(&mut self, _from: usize, _to: usize, _p_from: V3, _p_to: V3, _p_new: V3) {}
     /// Whether [`Cost::place`] may ever return a position. `false` (the default) lets the
     /// compiler drop the engine's placement paths from the image of a cost that never moves a
-    /// vertex (the flash this saves is in docs/devices.md).
+    /// vertex.
     const PLACES: bool = false;
     /// Where the kept vertex goes for this move, if it moves at all (optimal placement); the
     /// engine checks the legality rules there and writes it to the caller's mutable positions.

@@ -41,7 +41,7 @@
 //! triangle of a's fan, `duplicate`, `sliver`, `normal_turn` and `fold`; last the link
 //! condition's walks of both fans (`link`), the folds across b's edges to o1 and o2, whose
 //! triangles that walk finds, and the error bound. On flat, sliver-rich (CAD) meshes most
-//! candidates fail a shape rule, so they never pay for the walks (figures in docs/speed.md). A
+//! candidates fail a shape rule, so they never pay for the walks. A
 //! refusal is counted under the first
 //! rule that fails, so the order shapes [`Report::rejected`](crate::Report::rejected), never
 //! the verdict. The table's order is the report's, not the checking order.

@@ -7,7 +7,8 @@
 //! the same statics and nothing else, so (image with) - (image without) is the library.
 //! `paper`, `u32-triangles` and `u32-links` change or add instantiations, `fast` calls the fast
 //! mode (`pipeline::FastWorkspace<u16, 512, 1024>`) instead, `lean` the lean mode
-//! (`pipeline::LeanWorkspace<u16, 512, 1024>`) (see Cargo.toml).
+//! (`pipeline::LeanWorkspace<u16, 512, 1024>`); `batched`, `seams` and `parts` compile the
+//! library feature of that name into the default call (see Cargo.toml).
 //!
 //! Never run, only linked and measured: `scripts/flash.sh` (and `host-sim qemu --measure`).
 #![no_std]
