@@ -2,6 +2,7 @@
 //! wrong once must not come back; the README stays a short front door; every relative link in
 //! the documentation resolves; and the published crate holds the library and nothing else.
 
+use host_sim::qemu::measure::spaced;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -981,19 +982,6 @@ fn number(cell: &str) -> u64 {
     digits
         .parse()
         .unwrap_or_else(|_| panic!("no number in {cell:?}"))
-}
-
-/// A number with thousands spaced, as the generated tables and the README write them.
-fn spaced(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(' ');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// Every figure of the README's "firmware engineer's numbers" and of its modes table that is a

@@ -560,7 +560,7 @@ fn per_collapse(m: &Measurement) -> Option<(u64, u64)> {
 }
 
 /// A number with a space between thousands, as the docs write them (`34 846`).
-pub(crate) fn spaced(n: u64) -> String {
+pub fn spaced(n: u64) -> String {
     let d = n.to_string();
     let mut out = String::new();
     for (i, c) in d.chars().enumerate() {
