@@ -439,26 +439,6 @@ impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
     }
 }
 
-/// Runs the fast mode on `mesh` (seams welded by position first when `weld`): the library
-/// call `FastWorkspace::simplify` on a workspace of the smallest link type that fits.
-pub fn simplify_fast(
-    mesh: &MeshData,
-    config: &Config,
-    weld: bool,
-) -> Result<(MeshData, Report, Duration)> {
-    simplify_pipeline(mesh, config, weld, Pipeline::Fast)
-}
-
-/// Runs the lean mode on `mesh` (seams welded by position first when `weld`): the library
-/// call `LeanWorkspace::simplify` on a workspace of the smallest link type that fits.
-pub fn simplify_lean(
-    mesh: &MeshData,
-    config: &Config,
-    weld: bool,
-) -> Result<(MeshData, Report, Duration)> {
-    simplify_pipeline(mesh, config, weld, Pipeline::Lean)
-}
-
 /// Runs the pipeline in `mode` on `mesh` (seams welded by position first when `weld`): the
 /// library call on a workspace of the smallest link type that fits ([`pipeline_run`]). The
 /// wall time is that of the weld and the library call.
@@ -471,29 +451,10 @@ pub fn simplify_pipeline(
     pipeline_welded(mesh, config, mode, weld, false)
 }
 
-/// The library call `FastWorkspace::simplify` on `triangles` as they are (any index type), on
-/// the workspace of the smallest link type that fits: the host's fast run, shared by
-/// [`simplify_fast`] and the golden reference of a fast case (`host-sim demo`, `qemu`).
-pub fn fast_workspace_run<I: tinydecimate::Index>(
-    positions: &[[f32; 3]],
-    triangles: &mut [[I; 3]],
-    config: &Config,
-) -> Result<Report, tinydecimate::Error> {
-    pipeline_run(Pipeline::Fast, positions, triangles, config)
-}
-
-/// The library call `LeanWorkspace::simplify`, as [`fast_workspace_run`]: the host's lean
-/// run, shared by [`simplify_lean`] and the golden reference of a lean case.
-pub fn lean_workspace_run<I: tinydecimate::Index>(
-    positions: &[[f32; 3]],
-    triangles: &mut [[I; 3]],
-    config: &Config,
-) -> Result<Report, tinydecimate::Error> {
-    pipeline_run(Pipeline::Lean, positions, triangles, config)
-}
-
-/// The library call of `mode` on `triangles` as they are (any index type), on the workspace
-/// of the smallest link type that fits.
+/// The library call of `mode` (`FastWorkspace::simplify` or `LeanWorkspace::simplify`) on
+/// `triangles` as they are (any index type), on the workspace of the smallest link type that
+/// fits: the host's pipeline run, shared by [`simplify_pipeline`] and the golden reference of
+/// a fast or lean case (`host-sim demo`, `qemu`).
 pub fn pipeline_run<I: tinydecimate::Index>(
     mode: Pipeline,
     positions: &[[f32; 3]],

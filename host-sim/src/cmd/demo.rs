@@ -610,7 +610,13 @@ mod tests {
         assert_eq!(fast.triangles, case.triangles);
         let host = golden::reference(&fast).unwrap();
         let mut t = case.triangles.clone();
-        let r = crate::simplify::fast_workspace_run(&case.positions, &mut t, &case.config).unwrap();
+        let r = crate::simplify::pipeline_run(
+            crate::simplify::Pipeline::Fast,
+            &case.positions,
+            &mut t,
+            &case.config,
+        )
+        .unwrap();
         t.truncate(r.triangles_out);
         assert_eq!(host.triangles, t);
         assert_eq!(host.header.collapses as usize, r.collapses);
@@ -621,7 +627,13 @@ mod tests {
         assert_eq!(lean.name, "g-lean");
         let host = golden::reference(&lean).unwrap();
         let mut t = case.triangles.clone();
-        let r = crate::simplify::lean_workspace_run(&case.positions, &mut t, &case.config).unwrap();
+        let r = crate::simplify::pipeline_run(
+            crate::simplify::Pipeline::Lean,
+            &case.positions,
+            &mut t,
+            &case.config,
+        )
+        .unwrap();
         t.truncate(r.triangles_out);
         assert_eq!(host.triangles, t);
         assert_eq!(host.header.collapses as usize, r.collapses);

@@ -537,8 +537,18 @@ fn run_reference<I: tinydecimate::Index>(
                 EdgeCollapse,
             )?
             .run(),
-        Entry::Fast => crate::simplify::fast_workspace_run(positions, triangles, config)?,
-        Entry::Lean => crate::simplify::lean_workspace_run(positions, triangles, config)?,
+        Entry::Fast => crate::simplify::pipeline_run(
+            crate::simplify::Pipeline::Fast,
+            positions,
+            triangles,
+            config,
+        )?,
+        Entry::Lean => crate::simplify::pipeline_run(
+            crate::simplify::Pipeline::Lean,
+            positions,
+            triangles,
+            config,
+        )?,
         Entry::FastWedges | Entry::LeanWedges => {
             let mode = if entry == Entry::FastWedges {
                 crate::simplify::Pipeline::Fast
