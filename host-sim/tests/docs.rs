@@ -791,20 +791,27 @@ fn docs_name_features_and_items_that_exist() {
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
+/// The summary of one mode (`"default"`, `"batched"`, `"meshopt"`, ...) in bench/results.json.
+fn bench_mode(method: &str) -> serde_json::Value {
+    let results: serde_json::Value = serde_json::from_str(&read("bench/results.json")).unwrap();
+    results["summary"]["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == method)
+        .unwrap_or_else(|| panic!("no {method} in bench/results.json"))
+        .clone()
+}
+
 /// The README's modes table quotes each mode's time against meshoptimizer from the bench's
 /// generated results (bench/results.json, `host-sim bench`), rounded as printed: a re-run of
 /// the bench that changes a figure fails here until the README says the new one.
 #[test]
 fn readme_times_are_the_bench_results() {
-    let results: serde_json::Value = serde_json::from_str(&read("bench/results.json")).unwrap();
     let geomean = |method: &str| -> f64 {
-        results["summary"]["modes"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|m| m["method"] == method)
-            .and_then(|m| m["time_vs_meshopt_geomean"].as_f64())
-            .unwrap_or_else(|| panic!("no {method} in bench/results.json"))
+        bench_mode(method)["time_vs_meshopt_geomean"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{method}: no time in bench/results.json"))
     };
     let rows = [
         ("memoryless quadric, greedy", "default"),
@@ -1130,18 +1137,12 @@ fn readme_figures_are_the_generated_tables() {
     ));
 
     // Error and memory against meshoptimizer, bench/results.json.
-    let results: serde_json::Value = serde_json::from_str(&read("bench/results.json")).unwrap();
-    let mode = |method: &str| -> serde_json::Value {
-        results["summary"]["modes"]
-            .as_array()
+    let mean = |method: &str| {
+        bench_mode(method)["overall"]["mean_geomean"]
+            .as_f64()
             .unwrap()
-            .iter()
-            .find(|m| m["method"] == method)
-            .unwrap_or_else(|| panic!("no {method} in bench/results.json"))
-            .clone()
     };
-    let mean = |method: &str| mode(method)["overall"]["mean_geomean"].as_f64().unwrap();
-    let scratch = mode("meshopt")["scratch_bytes_per_triangle"].clone();
+    let scratch = bench_mode("meshopt")["scratch_bytes_per_triangle"].clone();
     says(format!(
         "meshoptimizer takes {:.1}-{:.1} B on the bench meshes",
         scratch[0].as_f64().unwrap(),
@@ -1156,7 +1157,7 @@ fn readme_figures_are_the_generated_tables() {
         "Metro mean error {:.2}x meshoptimizer's (geometric mean) |",
         mean("energy")
     ));
-    let worst: Vec<String> = mode("vertex_decimation")["worst"]
+    let worst: Vec<String> = bench_mode("vertex_decimation")["worst"]
         .as_array()
         .unwrap()
         .iter()
