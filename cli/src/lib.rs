@@ -76,6 +76,7 @@ pub mod progress;
 pub mod render;
 pub mod simplify;
 pub mod uvstretch;
+mod vec3;
 pub mod workspace;
 
 /// The glTF reader and writer (`io::gltf`), also at the crate's root.

@@ -37,7 +37,7 @@ use serde::Serialize;
 
 use crate::io::MeshData;
 
-type V3 = [f64; 3];
+use crate::vec3::{cross, dot, norm2, sub, V3};
 
 /// Sampling settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -135,22 +135,6 @@ impl std::fmt::Display for MetroReport {
 // ---------------------------------------------------------------------------------------------
 // Geometry
 
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm2(a: V3) -> f64 {
-    dot(a, a)
-}
 fn lerp(a: V3, b: V3, t: f64) -> V3 {
     [
         a[0] + (b[0] - a[0]) * t,

@@ -44,26 +44,7 @@ const FRONT: [f64; 3] = [190.0, 200.0, 220.0];
 const BACK: [f64; 3] = [235.0, 150.0, 90.0];
 const FILL: f64 = 0.92;
 
-type V3 = [f64; 3];
-
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn normalize(a: V3) -> V3 {
-    let l = dot(a, a).sqrt();
-    if l > 0.0 {
-        a.map(|c| c / l)
-    } else {
-        a
-    }
-}
+use crate::vec3::{cross, dot, normalize, V3};
 
 /// An orthographic camera.
 #[derive(Clone, Copy, Debug)]

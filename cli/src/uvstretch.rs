@@ -23,21 +23,11 @@
 //! A third, [`torn_triangles`], counts the defect a user sees at once: result triangles whose
 //! corners come from two texture charts, which show a piece of another chart's texture.
 
-type V3 = [f64; 3];
+use crate::vec3::{cross, norm2, sub, V3};
 
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn norm2(a: V3) -> f64 {
-    a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
-}
 fn area3(q: [V3; 3]) -> f64 {
     let (u, v) = (sub(q[1], q[0]), sub(q[2], q[0]));
-    let c = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
+    let c = cross(u, v);
     norm2(c).sqrt() / 2.0
 }
 

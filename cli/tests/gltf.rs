@@ -652,7 +652,10 @@ fn simplify_command_takes_attribute_weights() {
         "{text}{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    assert!(text.contains("simplifyWithAttributes"), "{text}");
+    // meshoptimizer's figures beside ours: feature `meshopt` (on in the workspace's build).
+    if cfg!(feature = "meshopt") {
+        assert!(text.contains("simplifyWithAttributes"), "{text}");
+    }
     assert!(
         text.contains("valid") && !text.contains("NOT valid"),
         "{text}"
