@@ -121,9 +121,8 @@ impl<L: Index, const MAX_VERTICES: usize, const MAX_TRIANGLES: usize>
 
 impl<L: Index> Storage<'_, L> {
     /// Simplifies a model's `triangles` in place as `tinydecimate simplify --engine exact` does
-    /// by default:
-    /// vertices at one position welded and collapsed together (no crack along a seam), each
-    /// corner keeping the caller's vertex (its wedge), and with
+    /// by default: vertices at one position welded and collapsed together (no crack along a
+    /// seam), each corner keeping the caller's vertex (its wedge), and with
     /// [`ModelStorage::with_parts`] small parts removed whole (see [`crate::model`]).
     ///
     /// On success the first `report.triangles_out` entries of `triangles` hold the result in

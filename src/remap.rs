@@ -2,8 +2,8 @@
 //! rest, and move every attribute stream (normals, texture coordinates, colours, bone weights,
 //! any `Copy` type per vertex) to match, in place.
 //!
-//! With subset placement (every run but one with `Placement::Optimal` and `Positions::Write`) each
-//! vertex of the result is an input vertex, and the library never reads or writes anything
+//! With subset placement (every run but one with `Placement::Optimal` and
+//! `Positions::Write`) each vertex of the result is an input vertex, and the library never reads or writes anything
 //! but positions and triangles: the caller's attribute buffers stay exactly right for the
 //! result as long as they are kept, indexed like the positions. Nothing here is needed to
 //! draw the result. These two functions are for firmware that wants the vertex buffers of
@@ -21,10 +21,10 @@
 //! this property: the first triangle `[5, 0, 1]` makes vertex 5 new vertex 0 and vertex 0 new
 //! vertex 1). The cost is that the result is not reordered for the vertex cache.
 //!
-//! Optimal placement (`Placement::Optimal` with `Positions::Write`) moves the kept vertex of each collapse to a new position
-//! and does not interpolate attributes: the moved vertex keeps the attributes of the input
-//! vertex whose slot it occupies. That is why `tinydecimate simplify` refuses `--placement
-//! optimal` on a mesh with attributes.
+//! Optimal placement (`Placement::Optimal` with `Positions::Write`) moves the kept vertex of
+//! each collapse to a new position and does not interpolate attributes: the moved vertex
+//! keeps the attributes of the input vertex whose slot it occupies. That is why
+//! `tinydecimate simplify` refuses `--placement optimal` on a mesh with attributes.
 //!
 //! Both functions are generic and hold no state: a firmware that does not call them carries
 //! none of their code. No heap, no panics: every index is checked before anything is written.
