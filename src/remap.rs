@@ -3,9 +3,9 @@
 //! any `Copy` type per vertex) to match, in place.
 //!
 //! With subset placement (every run but one with `Placement::Optimal` and
-//! `Positions::Write`) each vertex of the result is an input vertex, and the library never reads or writes anything
-//! but positions and triangles: the caller's attribute buffers stay exactly right for the
-//! result as long as they are kept, indexed like the positions. Nothing here is needed to
+//! `Positions::Write`) each vertex of the result is an input vertex, and the library never
+//! reads or writes anything but positions and triangles: the caller's attribute buffers stay
+//! exactly right for the result as long as they are kept, indexed like the positions. Nothing here is needed to
 //! draw the result. These two functions are for firmware that wants the vertex buffers of
 //! the result packed, like meshoptimizer's `meshopt_optimizeVertexFetchRemap` followed by
 //! `meshopt_remapVertexBuffer`, but without a second buffer:
