@@ -143,16 +143,9 @@ pub(crate) fn parse_ply(bytes: &[u8]) -> Parsed {
 
 pub(crate) fn ply_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String> {
     use ply_rs_bw::ply::{
-        Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
-        ScalarType,
+        Addable, DefaultElement, ElementDef, Property, PropertyDef, PropertyType, ScalarType,
     };
-    use ply_rs_bw::writer::Writer;
 
-    let mut ply = Ply::<DefaultElement>::new();
-    ply.header.encoding = Encoding::BinaryLittleEndian;
-    ply.header
-        .comments
-        .push("written by tinydecimate host-sim".into());
     let mut vdef = ElementDef::new("vertex".into());
     for k in ["x", "y", "z"] {
         vdef.properties.add(PropertyDef::new(
@@ -160,14 +153,6 @@ pub(crate) fn ply_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String>
             PropertyType::Scalar(ScalarType::Float),
         ));
     }
-    ply.header.elements.add(vdef);
-    let mut fdef = ElementDef::new("face".into());
-    fdef.properties.add(PropertyDef::new(
-        "vertex_indices".into(),
-        PropertyType::List(ScalarType::UChar, ScalarType::Int),
-    ));
-    ply.header.elements.add(fdef);
-
     let vertices: Vec<DefaultElement> = mesh
         .positions
         .iter()
@@ -179,8 +164,36 @@ pub(crate) fn ply_bytes(mesh: &MeshData) -> std::result::Result<Vec<u8>, String>
             e
         })
         .collect();
-    let mut faces = Vec::with_capacity(mesh.triangles.len());
-    for t in &mesh.triangles {
+    encode(vdef, vertices, &mesh.triangles)
+}
+
+/// Binary little-endian PLY of a `vertex` element as given and a `face` element of
+/// `triangles` (the writer of both the positions-only file and one with its properties kept).
+pub(crate) fn encode(
+    vertex_def: ply_rs_bw::ply::ElementDef,
+    vertices: Vec<ply_rs_bw::ply::DefaultElement>,
+    triangles: &[[u32; 3]],
+) -> std::result::Result<Vec<u8>, String> {
+    use ply_rs_bw::ply::{
+        Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
+        ScalarType,
+    };
+    use ply_rs_bw::writer::Writer;
+
+    let mut ply = Ply::<DefaultElement>::new();
+    ply.header.encoding = Encoding::BinaryLittleEndian;
+    ply.header
+        .comments
+        .push("written by tinydecimate host-sim".into());
+    ply.header.elements.add(vertex_def);
+    let mut fdef = ElementDef::new("face".into());
+    fdef.properties.add(PropertyDef::new(
+        "vertex_indices".into(),
+        PropertyType::List(ScalarType::UChar, ScalarType::Int),
+    ));
+    ply.header.elements.add(fdef);
+    let mut faces = Vec::with_capacity(triangles.len());
+    for t in triangles {
         let mut list = Vec::with_capacity(3);
         for &i in t {
             list.push(

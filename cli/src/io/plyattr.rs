@@ -11,10 +11,7 @@
 use std::io::Cursor;
 
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{
-    Addable, DefaultElement, ElementDef, Encoding, Ply, Property, PropertyDef, PropertyType,
-    ScalarType,
-};
+use ply_rs_bw::ply::{DefaultElement, ElementDef};
 
 use crate::io::MeshData;
 
@@ -77,34 +74,6 @@ pub fn parse(bytes: &[u8]) -> Result<PlyFile, String> {
 /// Binary PLY of `triangles` (input numbering) with the kept vertices' properties.
 pub fn write(f: &PlyFile, triangles: &[[u32; 3]]) -> Result<Vec<u8>, String> {
     let (tris, old) = crate::io::gltf::compact(triangles, f.vertices.len())?;
-    let mut ply = Ply::<DefaultElement>::new();
-    ply.header.encoding = Encoding::BinaryLittleEndian;
-    ply.header
-        .comments
-        .push("written by tinydecimate host-sim".into());
-    ply.header.elements.add(f.vertex_def.clone());
-    let mut fdef = ElementDef::new("face".into());
-    fdef.properties.add(PropertyDef::new(
-        "vertex_indices".into(),
-        PropertyType::List(ScalarType::UChar, ScalarType::Int),
-    ));
-    ply.header.elements.add(fdef);
-    let vertices: Vec<DefaultElement> = old.iter().map(|&o| f.vertices[o].clone()).collect();
-    let mut faces = Vec::with_capacity(tris.len());
-    for t in &tris {
-        let list = t
-            .iter()
-            .map(|&i| i32::try_from(i).map_err(|_| format!("vertex index {i} too large")))
-            .collect::<Result<Vec<i32>, String>>()?;
-        let mut e = DefaultElement::new();
-        e.insert("vertex_indices".into(), Property::ListInt(list));
-        faces.push(e);
-    }
-    ply.payload.insert("vertex".into(), vertices);
-    ply.payload.insert("face".into(), faces);
-    let mut out = Vec::new();
-    ply_rs_bw::writer::Writer::new()
-        .write_ply(&mut out, &mut ply)
-        .map_err(|e| format!("cannot encode PLY: {e}"))?;
-    Ok(out)
+    let vertices = old.iter().map(|&o| f.vertices[o].clone()).collect();
+    crate::io::ply::encode(f.vertex_def.clone(), vertices, &tris)
 }
