@@ -621,6 +621,20 @@ impl Args {
         }
     }
 
+    /// `config` with the distances these arguments give relative to the mesh (the error bound
+    /// and the error limit, as a fraction of `positions`' diagonal or in its units), validated.
+    pub fn with_distances(&self, config: Config, positions: &[[f32; 3]]) -> Result<Config> {
+        let mut config = config;
+        if let Some(e) = self.max_error {
+            config = config.with_max_error(e.distance(positions));
+        }
+        config = config.with_error_limit(self.error_limit().distance(positions));
+        config
+            .validate()
+            .map_err(|e| anyhow!("configuration: {e}"))?;
+        Ok(config)
+    }
+
     /// The library configuration these arguments ask for.
     pub fn config(&self) -> Config {
         // `passes` means the paper as written (λ = 1, features take no part in any collapse).
@@ -757,14 +771,7 @@ struct Run {
 fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
     let mesh = crate::io::load_noting(&args.input)?;
     let args = &args.resolve(&mesh);
-    let mut config = args.config();
-    if let Some(e) = args.max_error {
-        config = config.with_max_error(e.distance(&mesh.positions));
-    }
-    config = config.with_error_limit(args.error_limit().distance(&mesh.positions));
-    config
-        .validate()
-        .map_err(|e| anyhow!("configuration: {e}"))?;
+    let config = args.with_distances(args.config(), &mesh.positions)?;
     if args.attribute_weights.is_some() {
         bail!(
             "{}: --attribute-weights needs vertex attributes: a glTF, or an OBJ with vt or vn \

@@ -229,13 +229,7 @@ fn simplify_parts(
             let share = (n as f64 * mesh.triangles.len() as f64 / total.max(1) as f64).round();
             config = config.with_target(Target::Triangles(share as usize));
         }
-        if let Some(e) = args.max_error {
-            config = config.with_max_error(e.distance(&mesh.positions));
-        }
-        config = config.with_error_limit(args.error_limit().distance(&mesh.positions));
-        config
-            .validate()
-            .map_err(|e| anyhow!("configuration: {e}"))?;
+        let config = args.with_distances(config, &mesh.positions)?;
         // Hard edges welded: the library and meshoptimizer's anchor see the keyed mesh.
         let shading = shading.as_ref().filter(|s| {
             // With split seams every split is a boundary the user asked for, hard edges too
