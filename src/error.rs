@@ -92,6 +92,13 @@ pub enum Error {
         /// The vertex.
         vertex: usize,
     },
+    /// A used vertex of an integer run has a coordinate at or above
+    /// `pipeline::integer::GRID` (the grid has 15 bits; `pipeline::quantise` puts a float
+    /// mesh on it).
+    OffGrid {
+        /// The vertex.
+        vertex: usize,
+    },
     /// A configuration value is out of range.
     InvalidConfig {
         /// The field.
@@ -132,6 +139,9 @@ impl core::fmt::Display for Error {
             }
             Error::NonFinitePosition { vertex } => {
                 write!(f, "vertex {vertex} has a non-finite coordinate")
+            }
+            Error::OffGrid { vertex } => {
+                write!(f, "vertex {vertex} has a coordinate off the 15-bit grid (32768 or more)")
             }
             Error::InvalidConfig { field } => match field {
                 ConfigField::MaxError => write!(

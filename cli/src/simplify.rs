@@ -11,7 +11,7 @@ use tinydecimate::choice::{Chosen, ChosenBound, ChosenCost, ChosenOperator};
 use tinydecimate::cost::{
     AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
 };
-use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+use tinydecimate::pipeline::{Arithmetic, FastWorkspace, Integer, LeanWorkspace};
 use tinydecimate::{Builtin, Config, Positions, Report, VertexDecimation};
 
 use crate::io::MeshData;
@@ -111,6 +111,8 @@ pub struct Run {
     /// the exact engine: seams welded by position when `weld` (the output keeps the welded
     /// numbering), no parts, wedges, bound or other cost.
     pub pipeline: Option<Pipeline>,
+    /// The pipeline in integers (`pipeline::Integer`), on the positions put on a 15-bit grid.
+    pub integer: bool,
 }
 
 /// A mode of the library's pipeline (`tinydecimate::pipeline`): the same passes and rules,
@@ -225,6 +227,7 @@ pub fn simplify_with_attributes(
         prune,
         energy,
         pipeline,
+        integer,
     } = *run;
     if let Some(mode) = pipeline {
         if attributes.is_some()
@@ -240,7 +243,7 @@ pub fn simplify_with_attributes(
             ));
         }
         let config = config.with_prune_parts(prune);
-        return simplify_pipeline(mesh, &config, weld, mode);
+        return simplify_pipeline(mesh, &config, weld, mode, integer);
     }
     // A removal has no collapse cost to weigh a part against, nor wedges for new triangles:
     // its run is welded by position, and the output keeps the welded numbering.
@@ -370,7 +373,7 @@ pub fn simplify_with_attributes(
     tris.truncate(report.triangles_out);
     Ok((
         MeshData {
-            positions,
+            positions: mesh.positions.clone(),
             triangles: tris,
         },
         report,
@@ -388,6 +391,16 @@ static LEAN_SMALL: Mutex<LeanWorkspace<u16, 65_535, 65_535>> = Mutex::new(LeanWo
 static LEAN_LARGE: Mutex<LeanWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES>> =
     Mutex::new(LeanWorkspace::new());
 
+/// The integer pipeline's workspaces (`--integer`), as the float ones.
+static INT_FAST_SMALL: Mutex<FastWorkspace<u16, 65_535, 65_535, Integer>> =
+    Mutex::new(FastWorkspace::new());
+static INT_FAST_LARGE: Mutex<FastWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES, Integer>> =
+    Mutex::new(FastWorkspace::new());
+static INT_LEAN_SMALL: Mutex<LeanWorkspace<u16, 65_535, 65_535, Integer>> =
+    Mutex::new(LeanWorkspace::new());
+static INT_LEAN_LARGE: Mutex<LeanWorkspace<u32, FAST_VERTICES, FAST_TRIANGLES, Integer>> =
+    Mutex::new(LeanWorkspace::new());
+
 /// The largest mesh `--engine fast` (and `lean`) takes, in vertices.
 pub const FAST_VERTICES: usize = 1 << 20;
 /// The largest mesh `--engine fast` (and `lean`) takes, in triangles.
@@ -396,21 +409,23 @@ pub const FAST_TRIANGLES: usize = 1 << 21;
 /// A workspace of the pipeline: `FastWorkspace` or `LeanWorkspace`, whose `simplify` have one
 /// signature.
 trait PipelineWorkspace {
+    type Position;
     fn run<I: tinydecimate::Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[Self::Position],
         triangles: &mut [[I; 3]],
         wedges: Option<&mut [[I; 3]]>,
         config: &Config,
     ) -> Result<Report, tinydecimate::Error>;
 }
 
-impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
-    for FastWorkspace<L, V, T>
+impl<L: tinydecimate::Index, const V: usize, const T: usize, N: Arithmetic> PipelineWorkspace
+    for FastWorkspace<L, V, T, N>
 {
+    type Position = N::Position;
     fn run<I: tinydecimate::Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         wedges: Option<&mut [[I; 3]]>,
         config: &Config,
@@ -422,12 +437,13 @@ impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
     }
 }
 
-impl<L: tinydecimate::Index, const V: usize, const T: usize> PipelineWorkspace
-    for LeanWorkspace<L, V, T>
+impl<L: tinydecimate::Index, const V: usize, const T: usize, N: Arithmetic> PipelineWorkspace
+    for LeanWorkspace<L, V, T, N>
 {
+    type Position = N::Position;
     fn run<I: tinydecimate::Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         wedges: Option<&mut [[I; 3]]>,
         config: &Config,
@@ -447,8 +463,9 @@ pub fn simplify_pipeline(
     config: &Config,
     weld: bool,
     mode: Pipeline,
+    integer: bool,
 ) -> Result<(MeshData, Report, Duration)> {
-    pipeline_welded(mesh, config, mode, weld, false)
+    pipeline_welded(mesh, config, (mode, integer), weld, false)
 }
 
 /// The library call of `mode` (`FastWorkspace::simplify` or `LeanWorkspace::simplify`) on
@@ -483,17 +500,6 @@ fn run_on<I: tinydecimate::Index>(
     wedges: Option<&mut [[I; 3]]>,
     config: &Config,
 ) -> Result<Report, tinydecimate::Error> {
-    fn on<W: PipelineWorkspace, I: tinydecimate::Index>(
-        ws: &Mutex<W>,
-        positions: &[[f32; 3]],
-        triangles: &mut [[I; 3]],
-        wedges: Option<&mut [[I; 3]]>,
-        config: &Config,
-    ) -> Result<Report, tinydecimate::Error> {
-        ws.lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .run(positions, triangles, wedges, config)
-    }
     let small = positions.len() < 65_535 && triangles.len() < 65_535;
     match (mode, small) {
         (Pipeline::Fast, true) => on(&FAST_SMALL, positions, triangles, wedges, config),
@@ -503,6 +509,55 @@ fn run_on<I: tinydecimate::Index>(
     }
 }
 
+/// [`run_on`] in integers (`pipeline::Integer`) on grid positions.
+fn run_on_grid<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[u16; 3]],
+    triangles: &mut [[I; 3]],
+    wedges: Option<&mut [[I; 3]]>,
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    let small = positions.len() < 65_535 && triangles.len() < 65_535;
+    match (mode, small) {
+        (Pipeline::Fast, true) => on(&INT_FAST_SMALL, positions, triangles, wedges, config),
+        (Pipeline::Fast, false) => on(&INT_FAST_LARGE, positions, triangles, wedges, config),
+        (Pipeline::Lean, true) => on(&INT_LEAN_SMALL, positions, triangles, wedges, config),
+        (Pipeline::Lean, false) => on(&INT_LEAN_LARGE, positions, triangles, wedges, config),
+    }
+}
+
+/// One library call on a locked workspace.
+fn on<W: PipelineWorkspace, I: tinydecimate::Index>(
+    ws: &Mutex<W>,
+    positions: &[W::Position],
+    triangles: &mut [[I; 3]],
+    wedges: Option<&mut [[I; 3]]>,
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    ws.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .run(positions, triangles, wedges, config)
+}
+
+/// [`pipeline_run`] in integers: `positions` put on the 15-bit grid (`pipeline::quantise`)
+/// and the run on it (`FastWorkspace<_, _, _, Integer>`); the output indexes the input's
+/// vertices, as the float run's does.
+pub fn pipeline_run_integer<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[f32; 3]],
+    triangles: &mut [[I; 3]],
+    wedges: Option<&mut [[I; 3]]>,
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    let mut grid = vec![[0u16; 3]; positions.len()];
+    let frame = tinydecimate::pipeline::quantise(positions, &mut grid)?;
+    // The run measures in grid cells.
+    let config = config.with_error_limit(config.error_limit() / frame.step);
+    let mut report = run_on_grid(mode, &grid, triangles, wedges, &config)?;
+    report.collapse_error *= frame.step;
+    Ok(report)
+}
+
 /// Runs the pipeline in `mode` on `mesh` whose vertices carry attributes: seams welded by
 /// position and the wedges kept (`simplify_with_wedges`), so the output names the input's
 /// vertices and a seam moves as one. The wall time is that of the weld and the library call.
@@ -510,8 +565,9 @@ pub fn simplify_pipeline_wedges(
     mesh: &MeshData,
     config: &Config,
     mode: Pipeline,
+    integer: bool,
 ) -> Result<(MeshData, Report, Duration)> {
-    pipeline_welded(mesh, config, mode, true, true)
+    pipeline_welded(mesh, config, (mode, integer), true, true)
 }
 
 /// The pipeline in `mode` on `mesh`, welded by position first when `weld` and the mesh has
@@ -520,7 +576,7 @@ pub fn simplify_pipeline_wedges(
 fn pipeline_welded(
     mesh: &MeshData,
     config: &Config,
-    mode: Pipeline,
+    (mode, integer): (Pipeline, bool),
     weld: bool,
     keep_wedges: bool,
 ) -> Result<(MeshData, Report, Duration)> {
@@ -534,7 +590,12 @@ fn pipeline_welded(
             .map_err(library_error)?;
     }
     let wedges = (welded && keep_wedges).then_some(wedges.as_mut_slice());
-    let report = run_on(mode, &mesh.positions, &mut tris, wedges, config).map_err(library_error)?;
+    let report = if integer {
+        pipeline_run_integer(mode, &mesh.positions, &mut tris, wedges, config)
+    } else {
+        run_on(mode, &mesh.positions, &mut tris, wedges, config)
+    }
+    .map_err(library_error)?;
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     Ok((

@@ -1,6 +1,7 @@
 //! build: validation (before anything is written), fan lists.
 
-use super::{bump_end, set_end, Frame};
+use super::float::Frame;
+use super::{bump_end, set_end};
 use crate::error::Capacity;
 use crate::index::Index;
 use crate::Error;
@@ -114,7 +115,7 @@ fn in_order<I: Index>(
 
 /// Fan lists of the first `nt` triangles (a counting sort of their corners by vertex, as
 /// meshoptimizer's `buildTriangleAdjacency`), from the corner counts that compact left in
-/// `scratch` (the cost array, free until the next pick, as `u32` bit patterns; it then holds
+/// `scratch` (the cost array, free until the next pick; it then holds
 /// each list's write position): `v`'s list is `lists[end(v - 1)..end(v)]`, its triangles from
 /// the highest number down.
 #[inline(never)]
@@ -122,7 +123,7 @@ pub(super) fn link<I: Index, L: Index>(
     triangles: &[[I; 3]],
     nt: usize,
     (first, flags): (&mut [L], &mut [u8]),
-    scratch: &mut [f32],
+    scratch: &mut [u32],
     lists: &mut [L],
 ) {
     let tris = triangles.get(..nt).unwrap_or(&[]);
@@ -132,8 +133,8 @@ pub(super) fn link<I: Index, L: Index>(
     // Each list's start as its write position, its end in `first` (below 3·nt: fits a u32).
     let mut sum = 0u32;
     for (v, c) in scratch.iter_mut().enumerate() {
-        let count = c.to_bits();
-        *c = f32::from_bits(sum);
+        let count = *c;
+        *c = sum;
         sum = sum.wrapping_add(count);
         set_end(first, flags, v, sum as usize);
     }
@@ -141,8 +142,8 @@ pub(super) fn link<I: Index, L: Index>(
     for (t, tr) in tris.iter().enumerate().rev() {
         for i in tr {
             if let Some(c) = scratch.get_mut(i.to_usize()) {
-                let s = c.to_bits();
-                *c = f32::from_bits(s.wrapping_add(1));
+                let s = *c;
+                *c = s.wrapping_add(1);
                 if let Some(x) = lists.get_mut(s as usize) {
                     *x = L::narrow(t);
                 }
@@ -158,13 +159,13 @@ fn link_wide<I: Index, L: Index>(
     tris: &[[I; 3]],
     first: &mut [L],
     flags: &mut [u8],
-    counts: &[f32],
+    counts: &[u32],
     lists: &mut [L],
 ) {
     let mut sum = 0;
     for (v, c) in counts.iter().enumerate() {
         set_end(first, flags, v, sum);
-        sum += c.to_bits() as usize;
+        sum += *c as usize;
     }
     for (t, tr) in tris.iter().enumerate().rev() {
         for i in tr {

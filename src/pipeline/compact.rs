@@ -5,14 +5,14 @@ use super::{dead, flag};
 use crate::index::Index;
 
 /// Moves the triangles of the first `nt` without a repeated index to the front, in order,
-/// counting their corners per vertex in `counts` (the fan lists' first pass, as `u32` bit
-/// patterns in the candidates' cost array, free between a pass and the next pick); returns how
+/// counting their corners per vertex in `counts` (the fan lists' first pass, in the
+/// candidates' cost array, free between a pass and the next pick); returns how
 /// many there are and how many were dropped.
 #[inline(never)]
 pub(super) fn compact<I: Index>(
     triangles: &mut [[I; 3]],
     nt: usize,
-    counts: &mut [f32],
+    counts: &mut [u32],
 ) -> (usize, usize) {
     compact_with::<I, false>((triangles, &mut []), nt, counts)
 }
@@ -22,7 +22,7 @@ pub(super) fn compact<I: Index>(
 pub(super) fn compact_wedges<I: Index>(
     (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     nt: usize,
-    counts: &mut [f32],
+    counts: &mut [u32],
 ) -> (usize, usize) {
     compact_with::<I, true>((triangles, wedges), nt, counts)
 }
@@ -31,10 +31,10 @@ pub(super) fn compact_wedges<I: Index>(
 fn compact_with<I: Index, const W: bool>(
     (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     nt: usize,
-    counts: &mut [f32],
+    counts: &mut [u32],
 ) -> (usize, usize) {
     for c in counts.iter_mut() {
-        *c = f32::from_bits(0);
+        *c = 0;
     }
     let mut w = 0;
     for r in 0..nt {
@@ -46,7 +46,7 @@ fn compact_with<I: Index, const W: bool>(
         for v in tr {
             if let Some(c) = counts.get_mut(v) {
                 // At most `nt` corners per vertex: no wrap.
-                *c = f32::from_bits(c.to_bits().wrapping_add(1));
+                *c = c.wrapping_add(1);
             }
         }
         if w != r {

@@ -116,19 +116,26 @@ mod build;
 mod classify;
 mod compact;
 mod fill;
+mod float;
+mod geometry;
+mod integer;
 mod perform;
 mod pick;
 mod prune;
 mod sort;
 
+pub use geometry::{Arithmetic, Float, Integer};
+pub use integer::{quantise, GridFrame, GRID};
+
 use crate::error::Capacity;
 use crate::index::Index;
-use crate::math::{self, V3};
-use crate::quadric::PointQuadric;
 use crate::report::{Rejections, Report, Stop};
 use crate::{Config, Error};
+use core::marker::PhantomData;
+use geometry::Geometry;
 
-/// Bins of the counting sort (12 bits of the cost: 8 of exponent, 4 of mantissa, from 2⁻⁴⁸).
+/// Bins of the counting sort (the float cost's 8 bits of exponent and 4 of mantissa from 2⁻⁴⁸;
+/// the integer price's 6 and 4).
 pub(crate) const BINS: usize = 1024;
 
 /// A pass removes at most `1 / PASS_SHARE` of the live triangles, however far the target is:
@@ -179,43 +186,23 @@ pub(crate) mod flag {
 /// candidate target, sort slot), a candidate cost (`f32`) and a flag byte; per triangle three
 /// fan list entries (one per corner); plus a histogram of [`BINS`](FastWorkspace::BINS) links. With `u16` links and
 /// `V ≈ T/2` that is about 24.5 bytes per triangle ([`FastWorkspace::BYTES`]).
-pub struct FastWorkspace<L: Index, const V: usize, const T: usize> {
-    quadrics: [PointQuadric; V],
+pub struct FastWorkspace<L: Index, const V: usize, const T: usize, N: Arithmetic = Float> {
+    quadrics: [N::Stored; V],
     first: [L; V],
     border_next: [L; V],
     target: [L; V],
-    cost: [f32; V],
+    cost: [u32; V],
     order: [L; V],
     flags: [u8; V],
     lists: [[L; 3]; T],
     histogram: [L; BINS],
 }
 
-impl<L: Index, const V: usize, const T: usize> Default for FastWorkspace<L, V, T> {
+impl<L: Index, const V: usize, const T: usize, N: Arithmetic> Default
+    for FastWorkspace<L, V, T, N>
+{
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// A run's state that every step reads: the positions in the unit frame.
-#[derive(Clone, Copy)]
-pub(crate) struct Frame<'p> {
-    positions: &'p [[f32; 3]],
-    min: V3,
-    scale: f32,
-}
-
-impl Frame<'_> {
-    /// Position of `v`, translated by the bounding box's corner and scaled by a power of two
-    /// to an extent in `[1, 2)` (meshoptimizer's `rescalePositions`).
-    #[inline]
-    pub(crate) fn at(&self, v: usize) -> V3 {
-        let p = self.positions.get(v).copied().unwrap_or([0.0; 3]);
-        [
-            (p[0] - self.min[0]) * self.scale,
-            (p[1] - self.min[1]) * self.scale,
-            (p[2] - self.min[2]) * self.scale,
-        ]
     }
 }
 
@@ -409,16 +396,16 @@ pub(crate) fn fan<'m, L: Index, I: Index>(
 
 /// What one pass or one run counted.
 #[derive(Default)]
-pub(crate) struct Stats {
+pub(crate) struct Stats<E> {
     pub(crate) collapses: usize,
     pub(crate) rejected: Rejections,
     /// Candidates not collapsed because their price was over the error limit.
     pub(crate) over_limit: u32,
-    /// The largest error of a collapse made (unit frame, squared).
-    pub(crate) worst: f32,
+    /// The largest error of a collapse made (the arithmetic's squared distance).
+    pub(crate) worst: E,
 }
 
-impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
+impl<L: Index, const V: usize, const T: usize, N: Arithmetic> FastWorkspace<L, V, T, N> {
     /// Size of the workspace in bytes: all of the fast mode's RAM apart from the caller's
     /// triangle buffer, positions and a bounded stack frame.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -429,11 +416,11 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     /// An empty workspace; `const` and all zero bits, so a `static` goes to `.bss`.
     pub const fn new() -> Self {
         FastWorkspace {
-            quadrics: [[0.0; 6]; V],
+            quadrics: [N::EMPTY; V],
             first: [L::ZERO; V],
             border_next: [L::ZERO; V],
             target: [L::ZERO; V],
-            cost: [0.0; V],
+            cost: [0; V],
             order: [L::ZERO; V],
             flags: [0; V],
             lists: [[L::ZERO; 3]; T],
@@ -454,7 +441,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     /// [`Error::Capacity`], [`Error::IndexOutOfRange`], [`Error::NonFinitePosition`].
     pub fn simplify<I: Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
@@ -478,7 +465,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     /// [`Error::IndexOutOfRange`] for a wedge past `positions`.
     pub fn simplify_with_wedges<I: Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         wedges: &mut [[I; 3]],
         config: &Config,
@@ -490,7 +477,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
     #[inline(always)]
     fn run<I: Index, const W: bool>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         buffers: (&mut [[I; 3]], &mut [[I; 3]]),
         config: &Config,
     ) -> Result<Report, Error> {
@@ -506,7 +493,7 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
             histogram: &mut self.histogram,
         };
         let quadrics = self.quadrics.get_mut(..nv).unwrap_or(&mut []);
-        run::<I, L, _, W>(positions, buffers, config, arrays, fill::Stored(quadrics))
+        run::<I, L, N, _, W>(positions, buffers, config, arrays, fill::Stored(quadrics))
     }
 }
 
@@ -521,23 +508,26 @@ impl<L: Index, const V: usize, const T: usize> FastWorkspace<L, V, T> {
 /// [`BINS`](LeanWorkspace::BINS) links. A border vertex's open edges are found from its fan
 /// where the fast mode reads its stored successor. With `u16` links and `V ≈ T/2` that is
 /// about 11.5 bytes per triangle ([`LeanWorkspace::BYTES`]).
-pub struct LeanWorkspace<L: Index, const V: usize, const T: usize> {
+pub struct LeanWorkspace<L: Index, const V: usize, const T: usize, N: Arithmetic = Float> {
     first: [L; V],
     target: [L; V],
-    cost: [f32; V],
+    cost: [u32; V],
     order: [L; V],
     flags: [u8; V],
     lists: [[L; 3]; T],
     histogram: [L; BINS],
+    arithmetic: PhantomData<N>,
 }
 
-impl<L: Index, const V: usize, const T: usize> Default for LeanWorkspace<L, V, T> {
+impl<L: Index, const V: usize, const T: usize, N: Arithmetic> Default
+    for LeanWorkspace<L, V, T, N>
+{
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
+impl<L: Index, const V: usize, const T: usize, N: Arithmetic> LeanWorkspace<L, V, T, N> {
     /// Size of the workspace in bytes: all of the lean mode's RAM apart from the caller's
     /// triangle buffer, positions and a bounded stack frame.
     pub const BYTES: usize = core::mem::size_of::<Self>();
@@ -550,11 +540,12 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
         LeanWorkspace {
             first: [L::ZERO; V],
             target: [L::ZERO; V],
-            cost: [0.0; V],
+            cost: [0; V],
             order: [L::ZERO; V],
             flags: [0; V],
             lists: [[L::ZERO; 3]; T],
             histogram: [L::ZERO; BINS],
+            arithmetic: PhantomData,
         }
     }
 
@@ -563,7 +554,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     /// each quadric built from its vertex's fan where the fast mode reads a stored one.
     pub fn simplify<I: Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         config: &Config,
     ) -> Result<Report, Error> {
@@ -574,7 +565,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     /// the same contract and errors.
     pub fn simplify_with_wedges<I: Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         triangles: &mut [[I; 3]],
         wedges: &mut [[I; 3]],
         config: &Config,
@@ -586,7 +577,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
     #[inline(always)]
     fn run<I: Index, const W: bool>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[N::Position],
         buffers: (&mut [[I; 3]], &mut [[I; 3]]),
         config: &Config,
     ) -> Result<Report, Error> {
@@ -600,7 +591,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
             lists: self.lists.as_flattened_mut(),
             histogram: &mut self.histogram,
         };
-        run::<I, L, _, W>(positions, buffers, config, arrays, fill::Fans)
+        run::<I, L, N, _, W>(positions, buffers, config, arrays, fill::Fans)
     }
 }
 
@@ -609,7 +600,7 @@ impl<L: Index, const V: usize, const T: usize> LeanWorkspace<L, V, T> {
 fn compact_pass<I: Index, const W: bool>(
     (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     nt: usize,
-    counts: &mut [f32],
+    counts: &mut [u32],
 ) -> (usize, usize) {
     if W {
         compact::compact_wedges((triangles, wedges), nt, counts)
@@ -646,7 +637,7 @@ struct Arrays<'w, L: Index> {
     first: &'w mut [L],
     border_next: &'w mut [L],
     target: &'w mut [L],
-    cost: &'w mut [f32],
+    cost: &'w mut [u32],
     order: &'w mut [L],
     flags: &'w mut [u8],
     lists: &'w mut [L],
@@ -655,8 +646,8 @@ struct Arrays<'w, L: Index> {
 
 /// The pipeline, top to bottom (module documentation), with quadrics from `quadrics`; with
 /// wedges when `W` (`wedges` then at least as long as `triangles`, else unused).
-fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
-    positions: &[[f32; 3]],
+fn run<'p, I: Index, L: Index, N: Arithmetic, Q: fill::Quadrics<N::Frame<'p>>, const W: bool>(
+    positions: &'p [N::Position],
     (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     config: &Config,
     w: Arrays<'_, L>,
@@ -675,7 +666,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         w.first.len().min(L::COUNT),
         (w.lists.len() / 3).min(L::COUNT),
     );
-    let frame = build::validate(positions, triangles, (cv, ct), w.flags)?;
+    let frame = N::frame(positions, triangles, (cv, ct), w.flags)?;
     let nv = positions.len();
     let short = Error::Capacity {
         what: Capacity::Vertices,
@@ -732,19 +723,18 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
     }
     let valid = nt;
 
-    // The limit as a price: a squared distance in the unit frame.
-    let limit = config.error_limit * frame.scale;
-    let limit = limit * limit;
+    // The limit as an error: a squared distance in the run's frame.
+    let limit = frame.limit(config.error_limit);
 
     let target_triangles = config.target.triangles(valid);
     let mut stats = Stats::default();
     let mut passes = 0u32;
-    // The input's area (unit frame), for the price's mean triangle area.
-    let mut area = 0.0f32;
+    // The input's area, for the price's mean triangle area.
+    let mut area = <N::Frame<'p> as Geometry>::AREA_ZERO;
     let mut pass_triangles = heapless::Vec::new();
     // prune: the smallest part's size (0 until measured), the parts gone.
     let prune = config.prune_parts;
-    let mut next_part = 0.0f32;
+    let mut next_part = <N::Frame<'p> as Geometry>::ERR_ZERO;
     let (mut parts_removed, mut part_vertices) = (0usize, 0usize);
     let mut stop = loop {
         if nt <= target_triangles {
@@ -759,20 +749,18 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         if passes == 0 {
             area = summed.unwrap_or_else(|| fill::area(&frame, tris));
         }
-        let price = fill::Price {
-            mean_area: area / nt as f32,
-        };
-        pick::pick::<I, L, Q, W>(
+        let mean = <N::Frame<'p> as Geometry>::mean_area(area, nt);
+        pick::pick::<I, L, _, Q, W>(
             &frame,
             tris,
             adj,
             flags,
             border_next,
-            (&quadrics, price),
+            (&quadrics, mean),
             (&mut *target, &mut *cost),
             histogram,
         );
-        let m = sort::sort(target, cost, order, histogram);
+        let m = sort::sort::<L, N::Frame<'p>>(target, cost, order, histogram);
         if m == 0 {
             break Stop::NoLegalCollapse;
         }
@@ -781,13 +769,13 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         // A pass aims at half the live triangles at most (see `PASS_SHARE`).
         let goal = (nt - target_triangles).min((nt / PASS_SHARE).max(2));
         let refused = stats.over_limit;
-        let done = perform::perform::<I, L, Q, W>(
+        let done = perform::perform::<I, L, _, Q, W>(
             &frame,
             (tris, corners),
             (&*first, lists.get(..3 * nt).unwrap_or(&[])),
             flags,
             border_next,
-            (&quadrics, price),
+            (&quadrics, mean),
             (&mut *target, &*cost, order.get(..m).unwrap_or(&[])),
             (goal, limit, prune),
             &mut stats,
@@ -822,10 +810,13 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
     // raises the smallest size, so it ends within a round per vertex.
     if prune && matches!(stop, Stop::ErrorLimit | Stop::NoLegalCollapse) {
         for _ in 0..=nv {
-            if nt <= target_triangles || next_part > limit || !next_part.is_finite() {
+            if nt <= target_triangles
+                || next_part > limit
+                || !<N::Frame<'p> as Geometry>::finite(next_part)
+            {
                 break;
             }
-            let cutoff = (next_part * 1.5).min(limit);
+            let cutoff = <N::Frame<'p> as Geometry>::grow(next_part, limit);
             let p = prune::prune(&frame, triangles, nt, flags, (order, cost), cutoff);
             parts_removed += p.parts;
             part_vertices += p.vertices;
@@ -846,7 +837,7 @@ fn run<I: Index, L: Index, Q: fill::Quadrics, const W: bool>(
         }
     }
     let collapse_error = if config.error_limit.is_finite() {
-        math::sqrt(stats.worst) / frame.scale
+        frame.distance(stats.worst)
     } else {
         0.0
     };

@@ -3,7 +3,7 @@
 //! A candidate is skipped when either end is already an end of a collapse in this pass (so a
 //! quadric or a fan is never read stale, and a vertex never moves twice), and the pass stops
 //! at its goal or at its error goal: a factor of the cost of the candidate that would reach
-//! the goal ([`ERROR_GOAL`], [`TAIL_GOAL`] in a run's tail), once a sixth of the goal is done.
+//! the goal ([`Goal::Error`], [`Goal::Tail`] in a run's tail), once a sixth of the goal is done.
 //! A candidate over the error goal is skipped, and the pass ends at the first whose sort key
 //! is over the error goal's (the counting sort orders a bin by vertex, not by price). A
 //! candidate whose triangles a collapse of the pass changed is priced again from its fan as it
@@ -28,7 +28,7 @@
 //! With wedges, after rule 1: the seam rule ([`along_seam`]), each of a's wedges must have a
 //! wedge of b to go to, from the removed triangle on its side, and neither removed triangle
 //! may be the last of its chart ([`last_of_chart`]); and with rule 2 the sliver preference
-//! ([`thinner`]), a texture's guard.
+//! (`thinner`), a texture's guard.
 //!
 //! A candidate over the error limit (its error, the price as a mean squared distance in the
 //! unit frame, above the limit's square) is never collapsed.
@@ -37,62 +37,21 @@
 //! degenerate: compact drops them), with wedges each moved corner's wedge too, and locks both
 //! ends.
 
-use super::fill::{vertex_quadric, Price, Quadrics};
-use super::sort::key;
-use super::{
-    dead, fan, flag, flags_of, link, list, on, others, set_link, slot, tri, Frame, Stats, NONE,
-};
+use super::fill::{vertex_quadric, Quadrics};
+use super::geometry::{Geometry, Goal};
+use super::{dead, fan, flag, flags_of, link, list, on, others, set_link, slot, tri, Stats, NONE};
 use crate::index::Index;
 use crate::legality::Reject;
-use crate::math::{self, V3};
-use crate::quadric;
 
-/// Below this a squared cross product (in the unit frame) has no direction: a triangle of area
-/// 5e-10 of the bounding box's face. Survivors must be above it, so fold tests never underflow.
-const TINY: f32 = 1e-18;
-/// `|n|² / (Σ edge²)²` below this: a normal that rounding decides (zero area).
-const FLAT: f32 = 1e-8;
-/// The pass's error goal over the price of the candidate that would reach its goal.
-/// meshoptimizer takes 1.5 with its accumulated quadrics; with quadrics filled afresh each pass
-/// (a price that only sees the current triangles) a pass that runs past that price collapses
-/// vertices whose neighbours, locked by this pass, would have been cheaper: below 1, so that
-/// more, shorter passes price from fresher triangles.
-const ERROR_GOAL: f32 = 0.9;
-/// The error goal's factor in the tail of a run, a pass whose goal is under `1 / TAIL_SHARE` of
-/// its candidates: there the cheap candidates left are mostly refused, pass after pass, and a
-/// goal below 1 ends each pass after a collapse or two (a pass costs a sweep of the mesh).
-const TAIL_GOAL: f32 = 1.5;
-/// See [`TAIL_GOAL`].
+/// The pass's error goal over the price of the candidate that would reach its goal: 0.9
+/// ([`Goal::Error`]). meshoptimizer takes 1.5 with its accumulated quadrics; with quadrics
+/// filled afresh each pass (a price that only sees the current triangles) a pass that runs past
+/// that price collapses vertices whose neighbours, locked by this pass, would have been
+/// cheaper: below 1, so that more, shorter passes price from fresher triangles. In the tail of
+/// a run, a pass whose goal is under `1 / TAIL_SHARE` of its candidates, 1.5 ([`Goal::Tail`]):
+/// there the cheap candidates left are mostly refused, pass after pass, and a goal below 1
+/// ends each pass after a collapse or two (a pass costs a sweep of the mesh).
 const TAIL_SHARE: usize = 8;
-/// meshoptimizer's flip limit, `cos ≈ 0.25` (about 75°), squared.
-const FLIP2: f32 = 0.0625;
-/// The fold limit, `-0.89`, squared: the checker's `-0.9` (in `f64`) with a margin for the
-/// rounding of `f32` normals of small triangles, so that no pair this test passes is one the
-/// checker calls folded.
-const FOLD2: f32 = 0.89 * 0.89;
-
-#[inline]
-fn normal(p: [V3; 3]) -> V3 {
-    math::cross(math::sub(p[1], p[0]), math::sub(p[2], p[0]))
-}
-
-/// A normal and its squared length.
-#[inline(always)]
-fn squared(n: V3) -> (V3, f32) {
-    (n, math::dot(n, n))
-}
-
-/// Whether two triangles sharing an edge fold onto each other. `n1` is a survivor's normal
-/// (`|n1|² > TINY`); a neighbour's normal below `TINY` counts as folded (refused, never
-/// guessed). With both above `TINY` no product here leaves f32's normal range in the unit
-/// frame. Each normal comes with its squared length (a survivor's is known from rule 2).
-#[inline(always)]
-fn folded((n1, u2): (V3, f32), (n2, v2): (V3, f32)) -> bool {
-    // Written so that NaN refuses too.
-    let directed = v2 > TINY;
-    let d = math::dot(n1, n2);
-    !directed || (d < 0.0 && d * d > FOLD2 * u2 * v2)
-}
 
 // Rule switches, for showing that each rule matters (`PIPELINE_RULE_OFF=<name>` at build
 // time switches one off; a constant, so a normal build carries no trace of it).
@@ -110,15 +69,15 @@ const RULE_SEAM: &str = "seam";
 /// this pass has touched, and its price.
 #[inline(never)]
 #[allow(clippy::too_many_arguments)]
-fn alternative<I: Index, L: Index, Q: Quadrics, const W: bool>(
-    frame: &Frame<'_>,
+fn alternative<I: Index, L: Index, G: Geometry, Q: Quadrics<G>, const W: bool>(
+    frame: &G,
     tris: &[[I; 3]],
     adj: (&[L], &[L]),
     (flags, border_next): (&[u8], &[L]),
-    (quadrics, q, price): (&Q, &quadric::PointQuadric, Price),
+    (quadrics, q, mean): (&Q, &G::Q, G::Area),
     a: usize,
     b: usize,
-) -> Option<(usize, f32)> {
+) -> Option<(usize, G::Cost)> {
     let border = flags_of(flags, a) & flag::KIND == flag::BORDER;
     let next = if border {
         quadrics.next(tris, adj, flags, border_next, a)
@@ -127,7 +86,7 @@ fn alternative<I: Index, L: Index, Q: Quadrics, const W: bool>(
     };
     let seam = W && flags_of(flags, a) & flag::SEAM != 0;
     let pa = frame.at(a);
-    let mut best: Option<(usize, f32)> = None;
+    let mut best: Option<(usize, G::Raw)> = None;
     for (_, tr, k) in fan(tris, adj, flags, a) {
         if dead(tr) {
             continue;
@@ -147,39 +106,38 @@ fn alternative<I: Index, L: Index, Q: Quadrics, const W: bool>(
             {
                 continue;
             }
-            let e = quadric::point_error(q, math::sub(frame.at(w), pa));
+            let e = frame.raw(q, pa, frame.at(w));
             if best.is_none_or(|(v, c)| e < c || (e == c && w < v)) {
                 best = Some((w, e));
             }
         }
     }
-    let factor = price.factor(q);
-    best.map(|(w, e)| (w, e * factor))
+    best.map(|(w, e)| (w, frame.price(mean, q, e)))
 }
 
 /// Runs one pass over `order`; returns the collapses made.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
-    frame: &Frame<'_>,
+pub(super) fn perform<I: Index, L: Index, G: Geometry, Q: Quadrics<G>, const W: bool>(
+    frame: &G,
     (tris, corners): (&mut [[I; 3]], &mut [[I; 3]]),
     adj: (&[L], &[L]),
     flags: &mut [u8],
     border_next: &mut [L],
-    (quadrics, price): (&Q, Price),
-    (target, cost, order): (&mut [L], &[f32], &[L]),
-    (goal, limit, measure): (usize, f32, bool),
-    stats: &mut Stats,
+    (quadrics, mean): (&Q, G::Area),
+    (target, cost, order): (&mut [L], &[u32], &[L]),
+    (goal, limit, measure): (usize, G::Err, bool),
+    stats: &mut Stats<G::Err>,
 ) -> usize {
     let m = order.len();
-    let cost_of = |v: usize| cost.get(v).copied().unwrap_or(f32::INFINITY);
+    let cost_of = |v: usize| cost.get(v).map_or(G::COST_MAX, |&c| G::cost_of(c));
     let factor = if goal * TAIL_SHARE < m {
-        TAIL_GOAL
+        Goal::Tail
     } else {
-        ERROR_GOAL
+        Goal::Error
     };
     let mut edge_goal = goal / 2;
-    let (mut removed, mut done, mut worst) = (0usize, 0usize, 0.0f32);
+    let (mut removed, mut done, mut worst) = (0usize, 0usize, G::COST_ZERO);
     for i in 0..m {
         if removed >= goal {
             break;
@@ -187,14 +145,14 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
         let a = link(order, i);
         let c = cost_of(a);
         let error_goal = if edge_goal < m {
-            factor * cost_of(link(order, edge_goal))
+            G::goal(cost_of(link(order, edge_goal)), factor)
         } else {
-            f32::INFINITY
+            G::COST_MAX
         };
         if c > error_goal && c > worst && removed > goal / 6 {
             // Sorted by key: within a bin the order is by vertex, not by price, so a dearer
             // candidate ends the pass only once the bins are past the goal's.
-            if key(c) > key(error_goal) {
+            if G::key(G::cost_bits(c)) > G::key(G::cost_bits(error_goal)) {
                 break;
             }
             continue;
@@ -207,7 +165,7 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
         // from its fan as it is now (as the batched schedule prices a popped vertex again),
         // and left to the next pass if that is over the pass's error goal.
         let (c, fresh) = if flags_of(flags, a) & flag::DIRTY != 0 {
-            let q = vertex_quadric::<I, L, Q, W>(
+            let q = vertex_quadric::<I, L, G, Q, W>(
                 frame,
                 &*tris,
                 adj,
@@ -215,8 +173,8 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
                 quadrics,
                 a,
             );
-            let c = price.of(&q, math::sub(frame.at(b), frame.at(a)));
-            if c > error_goal.max(cost_of(a)) {
+            let c = frame.price(mean, &q, frame.raw(&q, frame.at(a), frame.at(b)));
+            if c > G::cost_max(error_goal, cost_of(a)) {
                 continue;
             }
             (c, Some(q))
@@ -228,18 +186,19 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
             Some(q) => q,
             None => quadrics.of::<I, L, W>(frame, tris, adj, flags, &*border_next, a),
         };
-        let e = if limit.is_finite() || measure {
-            price.error(&qa(&*flags, &*tris), c)
+        let e = if G::finite(limit) || measure {
+            frame.error(mean, &qa(&*flags, &*tris), (frame.at(a), frame.at(b)), c)
         } else {
-            0.0
+            G::ERR_ZERO
         };
-        if e > limit || e.is_nan() {
+        // Written so that NaN refuses too.
+        if !(e <= limit) {
             // Sorted by price, not by error: a later candidate may still be under.
             stats.over_limit += 1;
             continue;
         }
         let (b, dying, e) =
-            match check::<I, L, W>(frame, (&*tris, &*corners), adj, flags, target, a, b) {
+            match check::<I, L, G, W>(frame, (&*tris, &*corners), adj, flags, target, a, b) {
                 Ok(n) => (b, n, e),
                 Err(r) => {
                     stats.rejected.count(r);
@@ -247,26 +206,27 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
                     // a's next cheapest target, at once: a vertex keeps one candidate, so one
                     // whose cheapest collapse stays illegal would otherwise never move.
                     let qa = qa(&*flags, &*tris);
-                    let Some((x, cx)) = alternative::<I, L, Q, W>(
+                    let Some((x, cx)) = alternative::<I, L, G, Q, W>(
                         frame,
                         tris,
                         adj,
                         (&*flags, &*border_next),
-                        (quadrics, &qa, price),
+                        (quadrics, &qa, mean),
                         a,
                         b,
                     ) else {
                         continue;
                     };
-                    let ex = if limit.is_finite() || measure {
-                        price.error(&qa, cx)
+                    let ex = if G::finite(limit) || measure {
+                        frame.error(mean, &qa, (frame.at(a), frame.at(x)), cx)
                     } else {
-                        0.0
+                        G::ERR_ZERO
                     };
-                    if cx > error_goal.max(c) || ex > limit || ex.is_nan() {
+                    if cx > G::cost_max(error_goal, c) || !(ex <= limit) {
                         continue;
                     }
-                    match check::<I, L, W>(frame, (&*tris, &*corners), adj, flags, target, a, x) {
+                    match check::<I, L, G, W>(frame, (&*tris, &*corners), adj, flags, target, a, x)
+                    {
                         Ok(n) => (x, n, ex),
                         Err(r) => {
                             stats.rejected.count(r);
@@ -298,16 +258,16 @@ pub(super) fn perform<I: Index, L: Index, Q: Quadrics, const W: bool>(
 /// A surviving triangle of a's fan: its number, its other vertices (after and before a), their
 /// positions and its normal after the collapse with its squared length.
 #[derive(Clone, Copy)]
-struct Survivor {
+struct Survivor<G: Geometry> {
     t: u32,
     x: u32,
     y: u32,
-    n: (V3, f32),
-    px: V3,
-    py: V3,
+    n: G::N,
+    px: G::P,
+    py: G::P,
 }
 
-impl Survivor {
+impl<G: Geometry> Survivor<G> {
     #[inline]
     fn x(&self) -> usize {
         self.x as usize
@@ -324,8 +284,8 @@ const MAX_FAN: usize = 32;
 /// Every rule for `a → b` on the current mesh (module documentation, in that order); `Ok` gives
 /// the triangles the collapse removes (the live ones on a-b).
 #[inline(never)]
-fn check<I: Index, L: Index, const W: bool>(
-    frame: &Frame<'_>,
+fn check<I: Index, L: Index, G: Geometry, const W: bool>(
+    frame: &G,
     (tris, corners): (&[[I; 3]], &[[I; 3]]),
     adj: (&[L], &[L]),
     flags: &mut [u8],
@@ -347,7 +307,7 @@ fn check<I: Index, L: Index, const W: bool>(
     // (a, o2, b)), and each survivor's flip and area.
     let (pa, pb) = (frame.at(a), frame.at(b));
     // Not zeroed: a fan rarely fills it.
-    let mut fan_a = heapless::Vec::<Survivor, MAX_FAN>::new();
+    let mut fan_a = heapless::Vec::<Survivor<G>, MAX_FAN>::new();
     let (mut o1, mut o2, mut n_ab, mut na) = (NONE, NONE, 0, 0);
     // With wedges: the removed triangles' (a wedge, b wedge), on the o1 and o2 sides.
     let mut sides = [(NONE, NONE); 2];
@@ -377,27 +337,13 @@ fn check<I: Index, L: Index, const W: bool>(
             continue;
         }
         let (px, py) = (frame.at(x), frame.at(y));
-        let n0 = normal([pa, px, py]);
-        let n1 = normal([pb, px, py]);
-        let abd = math::dot(n1, n1);
-        let (ex, ey, exy) = (math::sub(px, pb), math::sub(py, pb), math::sub(px, py));
-        let s = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
-        if const { on(RULE_AREA) } && !(abd > TINY && abd > FLAT * s * s) {
-            return Err(Reject::Sliver);
-        }
-        let ndp = math::dot(n0, n1);
-        let abc = math::dot(n0, n0);
-        if const { on(RULE_FLIP) } && (ndp <= 0.0 || ndp * ndp <= FLIP2 * abc * abd) {
-            return Err(Reject::NormalTurn);
-        }
-        if W && thinner(abd, s, abc, [px, py, pa]) {
-            return Err(Reject::Sliver);
-        }
+        let rules = (const { on(RULE_AREA) }, const { on(RULE_FLIP) }, W);
+        let n = frame.survivor([pa, pb, px, py], rules)?;
         let s = Survivor {
             t: t as u32,
             x: x as u32,
             y: y as u32,
-            n: (n1, abd),
+            n,
             px,
             py,
         };
@@ -492,8 +438,8 @@ fn check<I: Index, L: Index, const W: bool>(
 
     // 4. Folds: each survivor against its neighbours after the collapse.
     // b's triangle across b-o1 (or b-o2): b and o1 at their known positions.
-    let unchanged = |t: usize, o: usize, po: V3| {
-        normal(tri(tris, t).map(|v| {
+    let unchanged = |t: usize, o: usize, po: G::P| {
+        frame.normal(tri(tris, t).map(|v| {
             if v == b {
                 pb
             } else if v == o {
@@ -507,16 +453,14 @@ fn check<I: Index, L: Index, const W: bool>(
         // Across the spoke to x: the survivor with x before a, or b's triangle on b-o1 when
         // the one on a-o1 dies; across the spoke to o2 likewise.
         let spoke = match fan_a.iter().find(|u| u.y == s.x) {
-            Some(u) => folded(s.n, u.n),
-            None if s.x() == o1 && across1 != NONE => {
-                folded(s.n, squared(unchanged(across1, o1, s.px)))
-            }
+            Some(u) => G::folded(s.n, u.n),
+            None if s.x() == o1 && across1 != NONE => G::folded(s.n, unchanged(across1, o1, s.px)),
             None => false,
         };
         if spoke {
             return Err(Reject::Fold);
         }
-        if s.y() == o2 && across2 != NONE && folded(s.n, squared(unchanged(across2, o2, s.py))) {
+        if s.y() == o2 && across2 != NONE && G::folded(s.n, unchanged(across2, o2, s.py)) {
             return Err(Reject::Fold);
         }
         // Across the outer edge x-y: searched in the list of an end that has not moved or
@@ -561,7 +505,7 @@ fn check<I: Index, L: Index, const W: bool>(
                         frame.at(v as usize)
                     }
                 });
-                if folded(s.n, squared(normal(p))) {
+                if G::folded(s.n, frame.normal(p)) {
                     return Err(Reject::Fold);
                 }
                 if manifold {
@@ -572,22 +516,6 @@ fn check<I: Index, L: Index, const W: bool>(
     }
     Ok(n_ab)
 }
-
-/// With wedges: whether a surviving triangle becomes a sliver, its quality (`4√3 · area /
-/// Σ edge²`) below [`MIN_QUALITY`] and lower than before. A thin triangle stretches the
-/// texture across it; the exact engine's sliver preference (`Config::min_quality`), kept to
-/// textured runs, where the positions-only bench found no gain in it.
-#[inline(never)]
-fn thinner(new: f32, s_new: f32, old: f32, [px, py, pa]: [V3; 3]) -> bool {
-    let (ex, ey, exy) = (math::sub(px, pa), math::sub(py, pa), math::sub(px, py));
-    let s_old = math::dot(ex, ex) + math::dot(ey, ey) + math::dot(exy, exy);
-    // quality² = 12 |n|² / s², compared without a division.
-    let limit = MIN_QUALITY * MIN_QUALITY / 12.0;
-    new < limit * s_new * s_new && new * s_old * s_old < old * s_new * s_new
-}
-
-/// See [`thinner`]: `Config::new()`'s `min_quality`.
-const MIN_QUALITY: f32 = 0.05;
 
 /// Triangle `t`'s wedges at slots `k` and `j`.
 #[inline]
@@ -620,10 +548,10 @@ fn moved_wedge(x: usize, sides: [(usize, usize); 2]) -> usize {
 /// The seam rule: every wedge of a's surviving corners has a wedge of b to go to
 /// ([`moved_wedge`]). One wedge: a is inside one attribute region. Two: a-b must be a spoke
 /// where the wedge changes, so that each side's removed triangle carries it across.
-fn along_seam<I: Index>(
+fn along_seam<I: Index, G: Geometry>(
     corners: &[[I; 3]],
     tris: &[[I; 3]],
-    fan_a: &[Survivor],
+    fan_a: &[Survivor<G>],
     a: usize,
     sides: [(usize, usize); 2],
 ) -> bool {
@@ -770,21 +698,5 @@ fn collapse<I: Index, L: Index>(
     }
     if let Some(f) = flags.get_mut(b) {
         *f |= flag::PASS;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A pair whose normals meet at the checker's limit (dot −0.9 in `f64`) or a little inside
-    /// it is folded here: the margin that covers `f32` rounding.
-    #[test]
-    fn a_pair_at_the_checkers_fold_limit_is_folded() {
-        let up = squared([0.0, 0.0, 2.0]);
-        let at = |d: f32| squared([3.0 * math::sqrt(1.0 - d * d), 0.0, 3.0 * d]);
-        assert!(folded(up, at(-0.9)));
-        assert!(folded(up, at(-0.895)));
-        assert!(!folded(up, at(-0.88)));
     }
 }

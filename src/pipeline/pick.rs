@@ -5,12 +5,10 @@
 //! neighbour; a border vertex only onto a border vertex along its border edge (either
 //! direction); a locked vertex never moves.
 
-use super::fill::{Price, Quadrics};
-use super::sort::key;
-use super::{along, fan, flag, flags_of, others, Frame, BINS, NONE};
+use super::fill::Quadrics;
+use super::geometry::Geometry;
+use super::{along, fan, flag, flags_of, others, BINS, NONE};
 use crate::index::Index;
-use crate::math::{self, V3};
-use crate::quadric;
 
 /// Prices every allowed collapse of each vertex along its fan's edges: a free vertex towards
 /// the vertex after it in each triangle (the triangle across offers the other direction), a
@@ -19,14 +17,14 @@ use crate::quadric;
 /// candidate's sort key in `histogram` (the counting sort's first pass).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
-    frame: &Frame<'_>,
+pub(super) fn pick<I: Index, L: Index, G: Geometry, Q: Quadrics<G>, const W: bool>(
+    frame: &G,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
     flags: &[u8],
     border_next: &[L],
-    (quadrics, price): (&Q, Price),
-    (target, cost): (&mut [L], &mut [f32]),
+    (quadrics, mean): (&Q, G::Area),
+    (target, cost): (&mut [L], &mut [u32]),
     histogram: &mut [L; BINS],
 ) {
     for h in histogram.iter_mut() {
@@ -38,10 +36,10 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
             || (!const { super::on("locked") } && k == flag::LOCKED)
     };
     // The lean mode's neighbours of one fan, reused vertex to vertex.
-    let mut seen = [(0u32, [0.0f32; 3]); FAN];
+    let mut seen = [(0u32, G::ORIGIN); FAN];
     for (a, (ta, ca)) in target.iter_mut().zip(cost.iter_mut()).enumerate() {
         let ka = flags_of(flags, a) & flag::KIND;
-        let (mut best, mut to) = (f32::INFINITY, NONE);
+        let (mut best, mut to) = (G::COST_MAX, NONE);
         let border = !free(ka) && ka == flag::BORDER;
         // Without stored quadrics, a free vertex's quadric and offers come from one walk of
         // its fan (a border vertex's offers need its open edges, found from the fan again).
@@ -55,16 +53,17 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
         if let Some((b, e, q)) = once {
             if b != NONE {
                 // The factor is a's own: it does not change which target is cheapest.
-                best = e * price.factor(&q);
+                best = frame.price(mean, &q, e);
                 to = b;
             }
         } else if free(ka) || border {
             let q = quadrics.of::<I, L, W>(frame, triangles, adj, flags, border_next, a);
             let pa = frame.at(a);
+            let mut least = G::RAW_MAX;
             let mut offer = |b: usize| {
-                let e = quadric::point_error(&q, math::sub(frame.at(b), pa));
-                if e < best || (e == best && b < to) {
-                    best = e;
+                let e = frame.raw(&q, pa, frame.at(b));
+                if e < least || (e == least && b < to) {
+                    least = e;
                     to = b;
                 }
             };
@@ -91,14 +90,14 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
             }
             // The factor is a's own: it does not change which target is cheapest.
             if to != NONE {
-                best *= price.factor(&q);
+                best = frame.price(mean, &q, least);
             }
         }
-        *ca = best;
+        *ca = G::cost_bits(best);
         *ta = if to == NONE {
             L::NIL
         } else {
-            if let Some(h) = histogram.get_mut(key(best)) {
+            if let Some(h) = histogram.get_mut(G::key(G::cost_bits(best))) {
                 *h = L::narrow(h.to_usize() + 1);
             }
             L::narrow(to)
@@ -111,15 +110,15 @@ pub(super) fn pick<I: Index, L: Index, Q: Quadrics, const W: bool>(
 /// [`vertex_quadric`](super::fill::vertex_quadric) sums it, each neighbour kept in `seen` for
 /// the offers. `None` for a fan larger than `seen` (the caller walks it twice).
 #[inline]
-fn once<I: Index, L: Index>(
-    frame: &Frame<'_>,
+fn once<I: Index, L: Index, G: Geometry>(
+    frame: &G,
     triangles: &[[I; 3]],
     adj: (&[L], &[L]),
     flags: &[u8],
     a: usize,
-    seen: &mut [(u32, V3); FAN],
-) -> Option<(usize, f32, quadric::PointQuadric)> {
-    let mut q = [0.0; 6];
+    seen: &mut [(u32, G::P); FAN],
+) -> Option<(usize, G::Raw, G::Q)> {
+    let mut q = G::EMPTY;
     let mut n = 0;
     let pa = frame.at(a);
     for (_, tr, k) in fan(triangles, adj, flags, a) {
@@ -128,12 +127,13 @@ fn once<I: Index, L: Index>(
         *seen.get_mut(n)? = (x as u32, px);
         n += 1;
         // No triangle is dead at pick (compact dropped them).
-        quadric::point_add(&mut q, &super::fill::triangle([pa, px, frame.at(y)], 1.0));
+        frame.face(&mut q, [pa, px, frame.at(y)]);
     }
-    let (mut best, mut to) = (f32::INFINITY, NONE);
+    let q = frame.finish(q);
+    let (mut best, mut to) = (G::RAW_MAX, NONE);
     for &(b, pb) in seen.get(..n)? {
         let b = b as usize;
-        let e = quadric::point_error(&q, math::sub(pb, pa));
+        let e = frame.raw(&q, pa, pb);
         if e < best || (e == best && b < to) {
             best = e;
             to = b;

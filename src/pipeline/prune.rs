@@ -13,18 +13,18 @@
 //!
 //! No memory of its own: parts are labelled afresh each time, by union-find over the live
 //! triangles (path halving, the smaller vertex as root: deterministic) in the sort order's
-//! links, and sized in the candidates' cost array, both free between a pass and the next pick.
+//! links, and sized in the candidates' cost array (as the arithmetic stores an error), both free between a pass and the next pick.
 //! A part's size is the largest squared distance of its vertices from its root (its smallest
-//! live vertex), in the unit frame: between r² and 4r² for the radius r of its bounding
+//! live vertex), in the run's frame: between r² and 4r² for the radius r of its bounding
 //! sphere, so a part goes no earlier than meshoptimizer's measure (the squared radius about
 //! the centroid) would let it. Time: O(V + T) a call.
 
-use super::{dead, flag, flags_of, link, set_link, tri, Frame};
+use super::geometry::Geometry;
+use super::{dead, flag, flags_of, link, set_link, tri};
 use crate::index::Index;
-use crate::math;
 
 /// What a call removed, and the smallest part it left (besides the largest).
-pub(super) struct Pruned {
+pub(super) struct Pruned<E> {
     /// Triangles removed.
     pub triangles: usize,
     /// Parts removed.
@@ -32,10 +32,10 @@ pub(super) struct Pruned {
     /// Vertices removed with them.
     pub vertices: usize,
     /// The largest size among the parts removed (0 if none).
-    pub largest: f32,
+    pub largest: E,
     /// The smallest size above the cutoff among the parts left, the largest part aside
     /// (infinite if none).
-    pub next: f32,
+    pub next: E,
 }
 
 /// The root of `v`'s part, halving the path on the way.
@@ -70,14 +70,14 @@ fn join<L: Index>(parent: &mut [L], a: usize, b: usize) {
 /// compact drops) and its vertices `GONE`. `parent` and `size` are scratch, one entry per
 /// vertex (as `flags`).
 #[inline(never)]
-pub(super) fn prune<I: Index, L: Index>(
-    frame: &Frame<'_>,
+pub(super) fn prune<I: Index, L: Index, G: Geometry>(
+    frame: &G,
     triangles: &mut [[I; 3]],
     nt: usize,
     flags: &mut [u8],
-    (parent, size): (&mut [L], &mut [f32]),
-    cutoff: f32,
-) -> Pruned {
+    (parent, size): (&mut [L], &mut [u32]),
+    cutoff: G::Err,
+) -> Pruned<G::Err> {
     let nv = flags.len().min(parent.len()).min(size.len());
     let (parent, size) = (
         parent.get_mut(..nv).unwrap_or(&mut []),
@@ -96,7 +96,7 @@ pub(super) fn prune<I: Index, L: Index>(
     }
     // Sizes at the roots, every live vertex pointing at its root.
     for s in size.iter_mut() {
-        *s = 0.0;
+        *s = G::err_bits(G::ERR_ZERO);
     }
     for v in 0..nv {
         if flags_of(flags, v) & flag::KIND == flag::GONE {
@@ -104,11 +104,10 @@ pub(super) fn prune<I: Index, L: Index>(
         }
         let r = find(parent, v);
         set_link(parent, v, r);
-        let d = math::sub(frame.at(v), frame.at(r));
+        let d2 = frame.size(frame.at(r), frame.at(v));
         if let Some(s) = size.get_mut(r) {
-            let d2 = math::dot(d, d);
-            if d2 > *s {
-                *s = d2;
+            if d2 > G::err_of(*s) {
+                *s = G::err_bits(d2);
             }
         }
     }
@@ -116,20 +115,20 @@ pub(super) fn prune<I: Index, L: Index>(
     let live = |flags: &[u8], v: usize| flags_of(flags, v) & flag::KIND != flag::GONE;
     // The largest part stays (ties: the smaller root).
     let mut keep = usize::MAX;
-    let mut keep_size = -1.0f32;
+    let mut keep_size = None;
     for v in 0..nv {
-        let s = size.get(v).copied().unwrap_or(0.0);
-        if root(parent, v) && live(flags, v) && s > keep_size {
+        let s = size.get(v).map_or(G::ERR_ZERO, |&s| G::err_of(s));
+        if root(parent, v) && live(flags, v) && keep_size.is_none_or(|k| s > k) {
             keep = v;
-            keep_size = s;
+            keep_size = Some(s);
         }
     }
     let mut out = Pruned {
         triangles: 0,
         parts: 0,
         vertices: 0,
-        largest: 0.0,
-        next: f32::INFINITY,
+        largest: G::ERR_ZERO,
+        next: G::ERR_MAX,
     };
     for t in 0..nt {
         let tr = tri(triangles, t);
@@ -137,9 +136,9 @@ pub(super) fn prune<I: Index, L: Index>(
             continue;
         }
         let r = link(parent, tr[0]);
-        let s = size.get(r).copied().unwrap_or(f32::INFINITY);
+        let s = size.get(r).map_or(G::ERR_MAX, |&s| G::err_of(s));
         // Written so that NaN keeps the part.
-        if r == keep || s > cutoff || s.is_nan() {
+        if r == keep || !(s <= cutoff) {
             continue;
         }
         // A part is counted at its first triangle: its root's mark.
@@ -168,7 +167,7 @@ pub(super) fn prune<I: Index, L: Index>(
         }
     }
     for v in 0..nv {
-        let s = size.get(v).copied().unwrap_or(0.0);
+        let s = size.get(v).map_or(G::ERR_ZERO, |&s| G::err_of(s));
         if flags_of(flags, v) & flag::MARK != 0 {
             if let Some(f) = flags.get_mut(v) {
                 *f = (*f & flag::HIGH) | flag::GONE;

@@ -2,30 +2,16 @@
 //! (meshoptimizer's `sortEdgeCollapses`: 8 bits of exponent and 4 of mantissa), stable, so
 //! equal keys stay in vertex order.
 
+use super::geometry::Geometry;
 use super::BINS;
 use crate::index::Index;
-
-/// `2⁻⁴⁸`'s 12-bit key: costs below it share bin 0.
-const BASE: usize = (127 - 48) << 4;
-
-/// The bin of a non-negative cost.
-#[inline]
-pub(super) fn key(cost: f32) -> usize {
-    let k = (cost.to_bits() >> 19) as usize & 0xfff;
-    let k = k.saturating_sub(BASE);
-    if k < BINS {
-        k
-    } else {
-        BINS - 1
-    }
-}
 
 /// Writes the vertices with a candidate into `order` by cost, from the key counts that pick
 /// left in `histogram`; returns how many.
 #[inline(never)]
-pub(super) fn sort<L: Index>(
+pub(super) fn sort<L: Index, G: Geometry>(
     target: &[L],
-    cost: &[f32],
+    cost: &[u32],
     order: &mut [L],
     histogram: &mut [L; BINS],
 ) -> usize {
@@ -39,7 +25,7 @@ pub(super) fn sort<L: Index>(
         if *t == L::NIL {
             continue;
         }
-        if let Some(h) = histogram.get_mut(key(*c)) {
+        if let Some(h) = histogram.get_mut(G::key(*c)) {
             let at = h.to_usize();
             if let Some(o) = order.get_mut(at) {
                 *o = L::narrow(v);

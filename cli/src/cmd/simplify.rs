@@ -460,6 +460,13 @@ pub struct Args {
     /// configures; `auto` (the default) is `fast` unless such an option is given.
     #[arg(long, value_enum, default_value_t = EngineArg::Auto)]
     pub engine: EngineArg,
+    /// The fast or lean engine in integers (`pipeline::Integer`, for cores without an FPU):
+    /// the positions put on a 15-bit grid over the bounding box's largest extent
+    /// (`pipeline::quantise`: one cell is that extent / 32 767, and a position moves by at
+    /// most half a cell's diagonal, 0.87 cell), every decision in fixed point on the grid; the
+    /// output's vertices keep their input positions.
+    #[arg(long)]
+    pub integer: bool,
     /// Collapse schedule.
     #[arg(long, value_enum, default_value_t = ScheduleArg::Greedy)]
     pub schedule: ScheduleArg,
@@ -769,7 +776,15 @@ struct Run {
 
 /// Loads the input, runs the library as `args` ask and writes the output file.
 fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
-    let mesh = crate::io::load_noting(&args.input)?;
+    let mut mesh = crate::io::load_noting(&args.input)?;
+    if args.integer {
+        // The run's input is the mesh on the grid: the check and the error compare with it,
+        // and the output's vertices are grid positions.
+        let mut grid = vec![[0u16; 3]; mesh.positions.len()];
+        let frame = tinydecimate::pipeline::quantise(&mesh.positions, &mut grid)
+            .map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+        mesh.positions = grid.iter().map(|&q| frame.position(q)).collect();
+    }
     let args = &args.resolve(&mesh);
     let config = args.with_distances(args.config(), &mesh.positions)?;
     if args.attribute_weights.is_some() {
@@ -806,6 +821,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         prune: args.prunes(),
         energy: (args.cost == Some(CostArg::Energy)).then_some(args.spring),
         pipeline,
+        integer: args.integer,
     };
     let (out, report, elapsed) = simplify_with(&mesh, &config, &run)?;
     let written = if keep_numbering {
@@ -838,7 +854,22 @@ pub(crate) fn refuse_exact_only(args: &Args) -> Result<()> {
             mode.name()
         );
     }
+    if args.integer && args.engine == EngineArg::Exact {
+        bail!("--integer runs the fast or the lean engine: drop --engine exact");
+    }
+    if let (true, Some(option)) = (args.integer, args.exact_only()) {
+        bail!("--integer runs the fast or the lean engine, which do not take {option}");
+    }
     Ok(())
+}
+
+/// ", in integers" and the grid, with `--integer`.
+fn integer_words(args: &Args) -> &'static str {
+    if args.integer {
+        ", in integers on a 15-bit grid"
+    } else {
+        ""
+    }
 }
 
 /// The run in words: files, modes, the library's report and the memory figures.
@@ -876,13 +907,15 @@ fn run_text(args: &Args, run: &Run) -> String {
         let _ = writeln!(
             text,
             "  engine                 fast (meshoptimizer's pipeline: stored quadrics, sorted \
-             passes, subset placement)"
+             passes, subset placement){}",
+            integer_words(args)
         );
     } else if pipeline == Some(crate::simplify::Pipeline::Lean) {
         let _ = writeln!(
             text,
             "  engine                 lean (meshoptimizer's pipeline: quadrics from each \
-             vertex's fan, sorted passes, subset placement)"
+             vertex's fan, sorted passes, subset placement){}",
+            integer_words(args)
         );
     } else if *stored {
         let _ =

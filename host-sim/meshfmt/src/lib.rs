@@ -498,6 +498,7 @@ pub enum ErrorKind {
     CapacityQuadrics = 6,
     CapacityControls = 7,
     OriginalMismatch = 8,
+    OffGrid = 9,
 }
 
 /// Which board produced a result (0 for the host).
@@ -663,6 +664,7 @@ impl ResultHeader {
             6 => ErrorKind::CapacityQuadrics,
             7 => ErrorKind::CapacityControls,
             8 => ErrorKind::OriginalMismatch,
+            9 => ErrorKind::OffGrid,
             _ => return Err(FormatError::Code),
         };
         let hash = [r.u8(), r.u8(), r.u8()];
@@ -917,6 +919,7 @@ pub mod lib {
                     Error::NonFinitePosition { vertex } => {
                         (ErrorKind::NonFinitePosition, narrow(vertex), 0)
                     }
+                    Error::OffGrid { vertex } => (ErrorKind::OffGrid, narrow(vertex), 0),
                     Error::InvalidConfig { field } => (ErrorKind::InvalidConfig, field as u32, 0),
                     Error::OriginalMismatch { triangle } => {
                         (ErrorKind::OriginalMismatch, narrow(triangle), 0)

@@ -105,6 +105,7 @@ fn error_text(h: &ResultHeader) -> String {
         ErrorKind::CapacityQuadrics => format!("capacity: {a} quadrics needed, {b} available"),
         ErrorKind::CapacityControls => format!("capacity: {a} control links needed, {b} available"),
         ErrorKind::OriginalMismatch => format!("original triangle {a} differs"),
+        ErrorKind::OffGrid => format!("off the grid: vertex {a}"),
     }
 }
 

@@ -44,10 +44,11 @@ fn run_library(
         let config = &config.with_prune_parts(args.prunes());
         if args.seams == super::SeamsArg::Weld {
             let (out, report, elapsed) =
-                crate::simplify::simplify_pipeline_wedges(mesh, config, mode)?;
+                crate::simplify::simplify_pipeline_wedges(mesh, config, mode, args.integer)?;
             return Ok((out.triangles, report, elapsed));
         }
-        let (out, report, elapsed) = crate::simplify::simplify_pipeline(mesh, config, false, mode)?;
+        let (out, report, elapsed) =
+            crate::simplify::simplify_pipeline(mesh, config, false, mode, args.integer)?;
         return Ok((out.triangles, report, elapsed));
     }
     let stored = args.quadric == QuadricArg::Stored;
@@ -76,6 +77,18 @@ fn gltf_out(args: &Args) -> bool {
 
 /// Runs `simplify` here when the input or output is glTF, or the input is an OBJ with texture
 /// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
+/// `--integer` on a mesh with attributes: refused (the integer pipeline takes positions alone).
+fn refuse_integer(args: &Args) -> Result<()> {
+    if args.integer {
+        bail!(
+            "{}: --integer runs on positions alone: give a mesh without texture coordinates or \
+             normals (STL, PLY, OBJ without vt/vn)",
+            args.input.display()
+        );
+    }
+    Ok(())
+}
+
 pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
     let (i, o) = (&args.input, &args.output);
     let gi = crate::io::gltf::is_gltf_path(i);
@@ -104,6 +117,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
             std::fs::File::create(o).map_err(|e| anyhow!("{}: cannot create: {e}", o.display()))?;
             let _ = std::fs::remove_file(o);
         }
+        refuse_integer(args)?;
         return run_gltf(args).map(Some);
     }
     let is_obj = |p: &Path| {
@@ -123,6 +137,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
         if crate::io::objattr::has_attributes(&bytes) {
             refuse_optimal(args)?;
+            refuse_integer(args)?;
             return run_obj(args, &bytes, t0).map(Some);
         }
     }
@@ -144,6 +159,7 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         let extra = crate::io::plyattr::extra_properties(&bytes);
         if !extra.is_empty() {
             refuse_optimal(args)?;
+            refuse_integer(args)?;
             return run_ply(args, &bytes, &extra, t0).map(Some);
         }
     }
