@@ -6,11 +6,13 @@
 //! ```
 //!
 //! `run` is the library call alone (`FastWorkspace::simplify`, or with `FAST_COW_LEAN=1` the
-//! lean mode's `LeanWorkspace::simplify`); reading the OBJ is outside it. Optional arguments: an OBJ path (default `tests/fixtures/cow.obj`), a ratio (0.1) and
+//! lean mode's `LeanWorkspace::simplify`; with `FAST_COW_INTEGER=1` either in integers, on the
+//! positions put on the grid by `pipeline::quantise` before the call); reading the OBJ is
+//! outside it. Optional arguments: an OBJ path (default `tests/fixtures/cow.obj`), a ratio (0.1) and
 //! an output OBJ path.
 
 use std::sync::Mutex;
-use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+use tinydecimate::pipeline::{FastWorkspace, Integer, LeanWorkspace};
 use tinydecimate::{Config, Report};
 
 /// u16 links (the cow's case), and u32 links for the larger meshes.
@@ -19,6 +21,23 @@ static LARGE: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorksp
 /// The lean mode's (`FAST_COW_LEAN=1`).
 static LEAN_SMALL: Mutex<LeanWorkspace<u16, 65_535, 65_535>> = Mutex::new(LeanWorkspace::new());
 static LEAN_LARGE: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
+
+/// The integer workspaces (`FAST_COW_INTEGER=1`), u16 links.
+static INT_FAST: Mutex<FastWorkspace<u16, 65_535, 65_535, Integer>> =
+    Mutex::new(FastWorkspace::new());
+static INT_LEAN: Mutex<LeanWorkspace<u16, 65_535, 65_535, Integer>> =
+    Mutex::new(LeanWorkspace::new());
+
+#[inline(never)]
+fn run_integer(grid: &[[u16; 3]], tris: &mut [[u32; 3]], ratio: f32) -> Report {
+    let config = Config::new().with_ratio(ratio);
+    if std::env::var_os("FAST_COW_LEAN").is_some() {
+        INT_LEAN.lock().unwrap().simplify(grid, tris, &config)
+    } else {
+        INT_FAST.lock().unwrap().simplify(grid, tris, &config)
+    }
+    .expect("simplify")
+}
 
 #[inline(never)]
 fn run(positions: &[[f32; 3]], tris: &mut [[u32; 3]], ratio: f32) -> Report {
@@ -72,8 +91,17 @@ fn main() {
         }
     }
     let input = tris.clone();
+    let integer = std::env::var_os("FAST_COW_INTEGER").is_some();
+    let mut grid = vec![[0u16; 3]; positions.len()];
+    if integer {
+        tinydecimate::pipeline::quantise(&positions, &mut grid).expect("quantise");
+    }
     let t0 = std::time::Instant::now();
-    let r = run(&positions, &mut tris, ratio);
+    let r = if integer {
+        run_integer(&grid, &mut tris, ratio)
+    } else {
+        run(&positions, &mut tris, ratio)
+    };
     let dt = t0.elapsed();
     println!(
         "{path}: {} -> {} triangles, {} collapses, {} passes, {:?} in {dt:?}",

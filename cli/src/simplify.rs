@@ -558,6 +558,18 @@ pub fn pipeline_run_integer<I: tinydecimate::Index>(
     Ok(report)
 }
 
+/// The library call of `mode` in integers on positions already on the grid (the error limit,
+/// if any, in grid cells): the host's run of an integer golden case, whose case file carries
+/// the grid positions the firmware runs on.
+pub fn pipeline_run_grid<I: tinydecimate::Index>(
+    mode: Pipeline,
+    positions: &[[u16; 3]],
+    triangles: &mut [[I; 3]],
+    config: &Config,
+) -> Result<Report, tinydecimate::Error> {
+    run_on_grid(mode, positions, triangles, None, config)
+}
+
 /// Runs the pipeline in `mode` on `mesh` whose vertices carry attributes: seams welded by
 /// position and the wedges kept (`simplify_with_wedges`), so the output names the input's
 /// vertices and a seam moves as one. The wall time is that of the weld and the library call.
