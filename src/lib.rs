@@ -18,7 +18,8 @@
 //!    kicks; every step leaves a valid mesh.
 //! 3. **`pipeline::FastWorkspace`** (crate feature `fast`): meshoptimizer's pipeline (stored
 //!    quadrics, passes sorted by cost) in fixed memory with every output valid, the fastest
-//!    way; `pipeline::LeanWorkspace` is the same in the first way's memory.
+//!    way; `pipeline::LeanWorkspace` is the same in the first way's memory. Both also run in
+//!    integers on a 15-bit grid (`pipeline::Integer`, for cores without an FPU).
 //!
 //! Beside them: [`cluster`] for meshes larger than RAM (vertex clustering of a stream),
 //! [`progressive`] and [`stream`] for progressive meshes sent over a link, [`remap`] for the
@@ -169,3 +170,8 @@ pub use progressive::Progressive;
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+
+/// docs/integer.md's example, compiled and run as a doctest.
+#[cfg(all(doctest, feature = "fast"))]
+#[doc = include_str!("../docs/integer.md")]
+pub struct IntegerDoctests;

@@ -540,22 +540,23 @@ fn on<W: PipelineWorkspace, I: tinydecimate::Index>(
 }
 
 /// [`pipeline_run`] in integers: `positions` put on the 15-bit grid (`pipeline::quantise`)
-/// and the run on it (`FastWorkspace<_, _, _, Integer>`); the output indexes the input's
-/// vertices, as the float run's does.
+/// and the run on it (`FastWorkspace<_, _, _, Integer>`), the error limit and the reported
+/// error converted to and from grid cells. Returns the report and the positions the run saw
+/// (the grid's, as `f32`): the output is valid with them; with the input's own positions a
+/// fold that the grid's rounding hid could show.
 pub fn pipeline_run_integer<I: tinydecimate::Index>(
     mode: Pipeline,
     positions: &[[f32; 3]],
     triangles: &mut [[I; 3]],
     wedges: Option<&mut [[I; 3]]>,
     config: &Config,
-) -> Result<Report, tinydecimate::Error> {
+) -> Result<(Report, Vec<[f32; 3]>), tinydecimate::Error> {
     let mut grid = vec![[0u16; 3]; positions.len()];
     let frame = tinydecimate::pipeline::quantise(positions, &mut grid)?;
-    // The run measures in grid cells.
     let config = config.with_error_limit(config.error_limit() / frame.step);
     let mut report = run_on_grid(mode, &grid, triangles, wedges, &config)?;
     report.collapse_error *= frame.step;
-    Ok(report)
+    Ok((report, grid.iter().map(|&q| frame.position(q)).collect()))
 }
 
 /// The library call of `mode` in integers on positions already on the grid (the error limit,
@@ -602,17 +603,20 @@ fn pipeline_welded(
             .map_err(library_error)?;
     }
     let wedges = (welded && keep_wedges).then_some(wedges.as_mut_slice());
-    let report = if integer {
-        pipeline_run_integer(mode, &mesh.positions, &mut tris, wedges, config)
+    let (report, positions) = if integer {
+        let (report, grid) = pipeline_run_integer(mode, &mesh.positions, &mut tris, wedges, config)
+            .map_err(library_error)?;
+        (report, grid)
     } else {
-        run_on(mode, &mesh.positions, &mut tris, wedges, config)
-    }
-    .map_err(library_error)?;
+        let report =
+            run_on(mode, &mesh.positions, &mut tris, wedges, config).map_err(library_error)?;
+        (report, mesh.positions.clone())
+    };
     let elapsed = start.elapsed();
     tris.truncate(report.triangles_out);
     Ok((
         MeshData {
-            positions: mesh.positions.clone(),
+            positions,
             triangles: tris,
         },
         report,

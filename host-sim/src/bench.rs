@@ -164,11 +164,17 @@ pub enum Method {
     /// tinydecimate's lean mode, `pipeline::LeanWorkspace` with `Config::new()`: the fast
     /// mode's pipeline without stored quadrics (`tinydecimate simplify --engine lean`).
     Lean,
+    /// The fast mode in integers, `FastWorkspace<_, _, _, Integer>` with `Config::new()`, on
+    /// the mesh put on its 15-bit grid (`tinydecimate simplify --integer`): the output's
+    /// vertices are grid positions.
+    FastInteger,
+    /// The lean mode in integers, as [`Method::FastInteger`].
+    LeanInteger,
 }
 
 impl Method {
     /// All of them, in table order.
-    pub const ALL: [Method; 12] = [
+    pub const ALL: [Method; 14] = [
         Method::Default,
         Method::GreedyW,
         Method::Paper,
@@ -181,6 +187,8 @@ impl Method {
         Method::Batched,
         Method::Fast,
         Method::Lean,
+        Method::FastInteger,
+        Method::LeanInteger,
     ];
 
     /// The operator of our modes.
@@ -206,6 +214,20 @@ impl Method {
         matches!(self, Method::StoredOptimal | Method::MeshoptUpdate)
     }
 
+    /// Whether the pipeline runs in integers.
+    pub fn integer(self) -> bool {
+        matches!(self, Method::FastInteger | Method::LeanInteger)
+    }
+
+    /// The float mode of an integer one.
+    pub fn float(self) -> Method {
+        match self {
+            Method::FastInteger => Method::Fast,
+            Method::LeanInteger => Method::Lean,
+            m => m,
+        }
+    }
+
     /// Name in the tables.
     pub fn label(self) -> &'static str {
         match self {
@@ -221,6 +243,8 @@ impl Method {
             Method::Batched => "batched quadric",
             Method::Fast => "fast mode",
             Method::Lean => "lean mode",
+            Method::FastInteger => "fast mode, integer",
+            Method::LeanInteger => "lean mode, integer",
         }
     }
 
@@ -231,7 +255,9 @@ impl Method {
             | Method::VertexDecimation
             | Method::Energy
             | Method::Fast
-            | Method::Lean => Some(Config::new()),
+            | Method::Lean
+            | Method::FastInteger
+            | Method::LeanInteger => Some(Config::new()),
             Method::GreedyW => Some(Config::new().with_cost(CostKind::NormalVariation)),
             Method::Paper => Some(Config::paper()),
             Method::Stored | Method::StoredOptimal => Some(Config::stored()),
@@ -255,14 +281,22 @@ impl Method {
             Method::Batched => "`Config::new().with_schedule(Schedule::Batched)`",
             Method::Fast => "`pipeline::FastWorkspace` with `Config::new()`",
             Method::Lean => "`pipeline::LeanWorkspace` with `Config::new()`",
+            Method::FastInteger => {
+                "`pipeline::FastWorkspace<_, _, _, Integer>` with `Config::new()` on the mesh \
+                 put on its grid by `pipeline::quantise`"
+            }
+            Method::LeanInteger => {
+                "`pipeline::LeanWorkspace<_, _, _, Integer>` with `Config::new()`, as the fast \
+                 mode's"
+            }
         }
     }
 
     /// The library's pipeline mode of the fast and the lean mode; `None` for the others.
     pub fn pipeline(self) -> Option<crate::simplify::Pipeline> {
         match self {
-            Method::Fast => Some(crate::simplify::Pipeline::Fast),
-            Method::Lean => Some(crate::simplify::Pipeline::Lean),
+            Method::Fast | Method::FastInteger => Some(crate::simplify::Pipeline::Fast),
+            Method::Lean | Method::LeanInteger => Some(crate::simplify::Pipeline::Lean),
             _ => None,
         }
     }
@@ -415,6 +449,11 @@ pub struct Row {
     pub validity: Validity,
     /// Ours only, when the target was not reached: meshoptimizer at our triangle count.
     pub same_count: Option<SameCount>,
+    /// An integer mode only: its float mode on the same grid mesh, Metro mean and Hausdorff
+    /// distance (% of the diagonal, against the input), the arithmetic's own share of the
+    /// difference.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub float_on_grid: Option<[f64; 2]>,
 }
 
 impl Row {
@@ -672,6 +711,7 @@ fn run_method(
                     prune,
                     energy: (method == Method::Energy).then_some(tinydecimate::cost::Energy::KAPPA),
                     pipeline: method.pipeline(),
+                    integer: method.integer(),
                     ..Default::default()
                 };
                 // The error limit measures a collapse or a removal (not a triangle collapse).
@@ -843,9 +883,24 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
             for &method in &methods {
                 bar.set_message(format!("{name} {ratio} {}", method.label()));
                 let ours = method.is_ours();
-                let input = if ours { mesh } else { welded };
+                // An integer mode's input is the mesh on its grid (its output's vertices are
+                // the grid's): it is checked against that, and its float mode runs on it too.
+                let grid = method.integer().then(|| on_grid(mesh)).transpose()?;
+                let input = match &grid {
+                    Some(g) => g,
+                    None if ours => mesh,
+                    None => welded,
+                };
                 let run = run_method(input, method, ratio, target, opts.reps, opts.prune)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
+                let float_on_grid = match &grid {
+                    Some(g) => {
+                        let f = run_method(g, method.float(), ratio, target, 1, opts.prune)?;
+                        let m = metro(mesh, &f.out, &metro_opts);
+                        Some([m.symmetric_mean_pct, m.hausdorff_pct])
+                    }
+                    None => None,
+                };
                 // Ours welded seams: checked welded (no crack), as `tinydecimate simplify` does.
                 // Ours may prune parts: a part gone whole is allowed, one cut in part is not.
                 let validity = crate::check::compare_parts(
@@ -880,6 +935,7 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                     valid: validity.is_valid(),
                     validity,
                     same_count: None,
+                    float_on_grid,
                 });
                 bar.inc(1);
             }
@@ -957,6 +1013,18 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
         samples_per_triangle: opts.samples_per_triangle,
         summary: summarise(&rows, &opts.ratios),
         rows,
+    })
+}
+
+/// `mesh` with its positions put on the integer pipeline's grid (`pipeline::quantise`), as
+/// `f32`: exact, and quantised again the same grid.
+fn on_grid(mesh: &MeshData) -> Result<MeshData> {
+    let mut grid = vec![[0u16; 3]; mesh.positions.len()];
+    let frame = tinydecimate::pipeline::quantise(&mesh.positions, &mut grid)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(MeshData {
+        positions: grid.iter().map(|&q| frame.position(q)).collect(),
+        triangles: mesh.triangles.clone(),
     })
 }
 

@@ -1,5 +1,10 @@
 //! The pipeline (engine v4): meshoptimizer's edge-collapse pipeline in fixed caller memory,
-//! with every output valid, in two modes that differ only in what they store:
+//! with every output valid, in two modes that differ only in what they store, each in either
+//! of two arithmetics (the workspace's last type parameter): [`Float`] (`f32` positions, the
+//! default) or [`Integer`] (`u16` positions on a 15-bit grid and fixed point throughout, for
+//! cores without an FPU: `integer`'s module documentation and docs/integer.md). The
+//! passes, the sort and the topology are written once; what they compute from positions is
+//! the arithmetic's (`geometry::Geometry`).
 //!
 //! | mode | workspace | per vertex | bytes per triangle (`u16` links) |
 //! |---|---|---|---|

@@ -108,8 +108,119 @@ pub fn markdown(r: &Results) -> String {
     header(&mut s, r);
     summary(&mut s, r);
     stopped_short(&mut s, r);
+    integer(&mut s, r);
     per_mesh(&mut s, r);
     s
+}
+
+/// The integer path against the float path of the same mode, mesh and ratio: Metro mean and
+/// Hausdorff distance, all against the input, of the float run on the input, of the float run
+/// on the integer run's grid, and of the integer run; each row's ratios, and per mode the
+/// geometric mean and the worst row of each. Nothing when the run had no integer mode.
+fn integer(s: &mut String, r: &Results) {
+    let find = |row: &Row, m: Method| {
+        r.rows
+            .iter()
+            .find(|x| x.mesh == row.mesh && x.ratio == row.ratio && x.method == m)
+    };
+    let mut lines = Vec::new();
+    let mut totals = Vec::new();
+    for int in [Method::FastInteger, Method::LeanInteger] {
+        // Ratios: mean and max over the float run, then over the float run on the grid.
+        let mut logs = [0.0f64; 4];
+        let mut worst = [
+            (0.0f64, String::new()),
+            (0.0, String::new()),
+            (0.0, String::new()),
+            (0.0, String::new()),
+        ];
+        let mut n = 0;
+        for row in r.rows.iter().filter(|x| x.method == int) {
+            let (Some(f), Some(g)) = (find(row, int.float()), row.float_on_grid) else {
+                continue;
+            };
+            let q = [
+                row.metro_mean_pct / f.metro_mean_pct,
+                row.metro_max_pct / f.metro_max_pct,
+                row.metro_mean_pct / g[0],
+                row.metro_max_pct / g[1],
+            ];
+            let at = format!("{} {}", row.mesh, fmt_pct(row.ratio));
+            for k in 0..4 {
+                logs[k] += q[k].ln();
+                if q[k] > worst[k].0 {
+                    worst[k] = (q[k], at.clone());
+                }
+            }
+            n += 1;
+            lines.push(format!(
+                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} |",
+                row.mesh,
+                fmt_pct(row.ratio),
+                int.float().label(),
+                f.metro_mean_pct,
+                g[0],
+                row.metro_mean_pct,
+                fmt_x(q[0]),
+                fmt_x(q[2]),
+                f.metro_max_pct,
+                g[1],
+                row.metro_max_pct,
+                fmt_x(q[1]),
+                fmt_x(q[3])
+            ));
+        }
+        if n > 0 {
+            let cell = |k: usize| {
+                format!(
+                    "{} | {} ({})",
+                    fmt_x((logs[k] / n as f64).exp()),
+                    fmt_x(worst[k].0),
+                    worst[k].1
+                )
+            };
+            totals.push(format!(
+                "| {} | {} | {} | {} | {} | {} |",
+                int.label(),
+                n,
+                cell(2),
+                cell(3),
+                cell(0),
+                cell(1)
+            ));
+        }
+    }
+    if totals.is_empty() {
+        return;
+    }
+    let _ = writeln!(s, "\n## Integer against float\n");
+    let _ = writeln!(
+        s,
+        "Each integer run against the float run of the same mode, mesh and ratio on the same \
+         grid mesh (the integer run's input: the arithmetic's own cost), and against the float \
+         run on the input (the grid's rounding too, at most half a cell's diagonal a vertex). \
+         Metro's symmetric mean and Hausdorff distance, % of the input's diagonal, all against \
+         the input; geometric means over the runs and the worst run.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| mode | runs | mean × float on the grid | worst | max × float on the grid | worst | mean × float | worst | max × float | worst |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---|---:|---|---:|---|---:|---|");
+    for t in totals {
+        let _ = writeln!(s, "{t}");
+    }
+    let _ = writeln!(
+        s,
+        "\n| mesh | ratio | mode | float mean % | float on the grid | integer | × float | × on the grid | float max % | float on the grid | integer | × float | × on the grid |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for l in lines {
+        let _ = writeln!(s, "{l}");
+    }
 }
 
 /// The title, the command, the machine, the modes and how they were measured.
