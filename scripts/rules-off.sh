@@ -9,14 +9,28 @@
 #   scripts/rules-off.sh                 # every rule
 #   scripts/rules-off.sh link fold       # some rules
 #   RULES_OFF_TESTS="--test rules" scripts/rules-off.sh   # another subset
+#   RULES_OFF_ENGINE=pipeline scripts/rules-off.sh        # the pipeline's rules (fast and lean
+#                                                          # modes, float and integer)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-# The rules' names, read from their one table (`RULES` in src/policy/legality/mod.rs: a row's
-# `name: "..."` line); a name the table does not hold is a build error, not a silent pass.
-read -r -a all_rules <<<"$(sed -n 's/^ *name: "\([a-z_]*\)",$/\1/p' src/policy/legality/mod.rs | paste -sd' ' -)"
+engine=${RULES_OFF_ENGINE:-exact}
+if [ "$engine" = pipeline ]; then
+  # The pipeline's rules: its `RULE_*` names in src/pipeline/perform.rs, switched off by
+  # PIPELINE_RULE_OFF; its tests run both arithmetics (tests/pipeline.rs, tests/integer.rs).
+  switch=PIPELINE_RULE_OFF
+  read -r -a all_rules <<<"$(sed -n 's/^const RULE_[A-Z]*: &str = "\([a-z]*\)";$/\1/p' src/pipeline/perform.rs | paste -sd' ' -)"
+  default_tests="--features fast,seams --test pipeline --test integer"
+else
+  # The rules' names, read from their one table (`RULES` in src/policy/legality/mod.rs: a
+  # row's `name: "..."` line); a name the table does not hold is a build error, not a silent
+  # pass.
+  switch=TINYDECIMATE_RULE_OFF
+  read -r -a all_rules <<<"$(sed -n 's/^ *name: "\([a-z_]*\)",$/\1/p' src/policy/legality/mod.rs | paste -sd' ' -)"
+  default_tests="--features seams --test rules --test errors --test fuzz_regressions --test properties --test bound --test stored --test seams --test decimate"
+fi
 if [ ${#all_rules[@]} -eq 0 ]; then
-  echo "no rule names found in src/policy/legality/mod.rs (RULES)" >&2
+  echo "no rule names found for the $engine engine" >&2
   exit 2
 fi
 rules=("$@")
@@ -27,7 +41,7 @@ rules=("$@")
 # stored quadrics' validity over both placements, with and without the feature rule
 # (tests/stored.rs: the engine's one-price re-keying runs there); welded seams (tests/seams.rs,
 # for the `seam` rule, with the crate feature `seams`).
-read -r -a tests <<<"${RULES_OFF_TESTS:---features seams --test rules --test errors --test fuzz_regressions --test properties --test bound --test stored --test seams --test decimate}"
+read -r -a tests <<<"${RULES_OFF_TESTS:-$default_tests}"
 per_run_timeout=${RULES_OFF_TIMEOUT:-900}
 
 log_dir=$(mktemp -d)
@@ -37,7 +51,7 @@ start=$SECONDS
 # separated) and `status` (pass, fail, build-error, timeout).
 run() {
   local rule=$1 log="$log_dir/${1:-none}.log" rc
-  timeout "$per_run_timeout" env TINYDECIMATE_RULE_OFF="$rule" \
+  timeout "$per_run_timeout" env "$switch=$rule" \
     cargo test --release -p tinydecimate "${tests[@]}" --no-fail-fast >"$log" 2>&1
   rc=$?
   failing=$(grep -E '^test .* \.\.\. FAILED$' "$log" | sed -E 's/^test (.*) \.\.\. FAILED$/\1/' |

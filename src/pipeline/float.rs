@@ -292,6 +292,11 @@ impl Geometry for Frame<'_> {
     }
 
     #[inline(always)]
+    fn over(e: f32, limit: f32) -> bool {
+        e > limit || e.is_nan()
+    }
+
+    #[inline(always)]
     fn finite(e: f32) -> bool {
         e.is_finite()
     }

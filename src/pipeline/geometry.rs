@@ -152,6 +152,8 @@ pub trait Geometry {
 
     /// The error limit (a distance in the positions' units) as an error.
     fn limit(&self, distance: f32) -> Self::Err;
+    /// Whether error `e` is over `limit` (NaN is).
+    fn over(e: Self::Err, limit: Self::Err) -> bool;
     /// Whether an error is below [`ERR_MAX`](Self::ERR_MAX).
     fn finite(e: Self::Err) -> bool;
     /// `e` times 1.5 (prune's step), at most `limit`.

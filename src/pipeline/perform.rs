@@ -191,8 +191,7 @@ pub(super) fn perform<I: Index, L: Index, G: Geometry, Q: Quadrics<G>, const W: 
         } else {
             G::ERR_ZERO
         };
-        // Written so that NaN refuses too.
-        if !(e <= limit) {
+        if G::over(e, limit) {
             // Sorted by price, not by error: a later candidate may still be under.
             stats.over_limit += 1;
             continue;
@@ -222,7 +221,7 @@ pub(super) fn perform<I: Index, L: Index, G: Geometry, Q: Quadrics<G>, const W: 
                     } else {
                         G::ERR_ZERO
                     };
-                    if cx > G::cost_max(error_goal, c) || !(ex <= limit) {
+                    if cx > G::cost_max(error_goal, c) || G::over(ex, limit) {
                         continue;
                     }
                     match check::<I, L, G, W>(frame, (&*tris, &*corners), adj, flags, target, a, x)

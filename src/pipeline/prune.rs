@@ -137,8 +137,8 @@ pub(super) fn prune<I: Index, L: Index, G: Geometry>(
         }
         let r = link(parent, tr[0]);
         let s = size.get(r).map_or(G::ERR_MAX, |&s| G::err_of(s));
-        // Written so that NaN keeps the part.
-        if r == keep || !(s <= cutoff) {
+        // NaN keeps the part.
+        if r == keep || G::over(s, cutoff) {
             continue;
         }
         // A part is counted at its first triangle: its root's mark.
