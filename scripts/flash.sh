@@ -2,8 +2,10 @@
 # Flash of one instantiation of tinydecimate, measured as a user would: the minimal firmware in
 # tests/flash (positions a static in flash, triangles a static RAM buffer, a static workspace)
 # is built without and with the call `Workspace<u16, 512, 1024>::simplify(.., &Config::new())`
-# (and with the fast mode's `FastWorkspace<u16, 512, 1024>::simplify` instead, and the lean
-# mode's `LeanWorkspace<u16, 512, 1024>::simplify`),
+# (and with the fast mode's `FastWorkspace<u16, 512, 1024>::simplify` instead, the lean
+# mode's `LeanWorkspace<u16, 512, 1024>::simplify`, and both in the integer arithmetic,
+# `FastWorkspace<u16, 512, 1024, Integer>` and `LeanWorkspace<.., Integer>` on grid positions,
+# whose image without the call holds those positions too),
 # opt-level "s", fat LTO, one codegen unit, panic = abort (its Cargo.toml), and the difference
 # of .text + .rodata is the library. `host-sim qemu --measure` reports the same figure per board.
 #
@@ -38,7 +40,7 @@ while [ $# -gt 0 ]; do
         --out) out=$2; shift ;;
         --symbols) nsym=$2; shift ;;
         --target) targets+=("$2"); shift ;;
-        -h | --help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "unknown argument: $1 (see --help)" >&2; exit 2 ;;
     esac
     shift
@@ -62,10 +64,13 @@ export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$root/tests/flash/target}"
 export CARGO_PROFILE_RELEASE_OPT_LEVEL=$opt
 images="$CARGO_TARGET_DIR/images"
 mkdir -p "$images"
-# Variants: name, cargo features (comma-separated, may be empty), what the row shows.
-variants=("without||-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
+# Variants: name, cargo features (comma-separated, may be empty), what the row shows. The first
+# two are the images without the call (the second with the integer calls' grid positions).
+variants=("without||-" "without-grid|grid|-" "call|call|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
     "fast|fast|fast mode: FastWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
-    "lean|lean|lean mode: LeanWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()")
+    "lean|lean|lean mode: LeanWorkspace<u16, 512, 1024>::simplify, u16 triangles, Config::new()"
+    "fast-integer|fast-integer|fast mode, integer: FastWorkspace<u16, 512, 1024, Integer>::simplify, u16 triangles, Config::new()"
+    "lean-integer|lean-integer|lean mode, integer: LeanWorkspace<u16, 512, 1024, Integer>::simplify, u16 triangles, Config::new()")
 if [ $all = 1 ]; then
     variants+=(
         "paper|paper|Workspace<u16, 512, 1024>::simplify, u16 triangles, Config::paper()"
@@ -144,14 +149,17 @@ table() {
     echo "| target | instantiation | without | with | library (difference) | over the default call |"
     echo "|---|---|---:|---:|---:|---:|"
     for t in "${targets[@]}"; do
-        base=${size[$t/without]}
         one=${size[$t/call]}
-        for v in "${variants[@]:1}"; do
+        for v in "${variants[@]:2}"; do
             IFS='|' read -r name _ what <<<"$v"
+            case $name in
+                *-integer) base=${size[$t/without-grid]} ;;
+                *) base=${size[$t/without]} ;;
+            esac
             s=${size[$t/$name]}
             d=$((s - base))
             case $name in
-                call | fast | lean) over=- ;;
+                call | fast | lean | fast-integer | lean-integer) over=- ;;
                 *) over="$(spaced $((s - one)) --sign) B" ;;
             esac
             echo "| $t | $what | $(spaced "$base") B | $(spaced "$s") B | **$(spaced "$d") B** ($(kb "$d")) | $over |"

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use arbitrary::{Result, Unstructured};
 use tinydecimate::cost::{NormalVariation, Quadric};
-use tinydecimate::pipeline::{FastWorkspace, LeanWorkspace};
+use tinydecimate::pipeline::{quantise, Arithmetic, FastWorkspace, Float, Integer, LeanWorkspace};
 use tinydecimate::{
     Config, EdgeCollapse, Error, FeatureMode, Index, Report, Schedule, Stop, Target, Workspace,
 };
@@ -478,7 +478,8 @@ impl Case {
 
 impl Case {
     /// The pipeline's two modes on the case (its configuration: target, passes, error limit),
-    /// each on a fresh workspace and again on the same one; panics with a description on a
+    /// each on a fresh workspace and again on the same one, in both arithmetics (the integer
+    /// one on the positions `quantise` puts on its grid); panics with a description on a
     /// violation.
     pub fn check_pipeline(&self) {
         match (self.workspace, self.wide) {
@@ -494,25 +495,121 @@ impl Case {
 
 fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &Case) {
     let input: Vec<[I; 3]> = case.triangles.iter().map(|t| t.map(I::from_u32)).collect();
+    let expected = pipeline_error::<L, I, V, T>(&case.positions, &input, &case.config);
+    modes::<L, I, V, T, Float>(case, &case.positions, &input, expected, "");
+    pipeline_integer::<L, I, V, T>(case, &input);
+}
+
+/// The error of a pipeline run on `positions`, by the documented order of checks.
+fn pipeline_error<L: Index, I: Idx, const V: usize, const T: usize>(
+    positions: &[[f32; 3]],
+    input: &[[I; 3]],
+    config: &Config,
+) -> Option<Error> {
     // The pipeline's triangle capacity is `T` links, not a third of them.
-    let expected = checked_error(
-        &case.positions,
-        &input,
-        &case.config,
-        (V.min(L::COUNT), T.min(L::COUNT)),
+    checked_error(positions, input, config, (V.min(L::COUNT), T.min(L::COUNT)))
+}
+
+/// The integer arithmetic on the case: its positions put on the grid by `quantise` (the
+/// documented error for a non-finite one), both modes checked there as the float ones are (the
+/// grid positions, exact in `f32`, are the checker's), and a coordinate moved off the grid
+/// refused as documented.
+fn pipeline_integer<L: Index + 'static, I: Idx, const V: usize, const T: usize>(
+    case: &Case,
+    input: &[[I; 3]],
+) {
+    let mut grid = vec![[0u16; 3]; case.positions.len()];
+    if let Err(e) = quantise(&case.positions, &mut grid) {
+        // Every position is checked, used or not.
+        let vertex = case
+            .positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()));
+        assert_eq!(
+            Some(e),
+            vertex.map(|vertex| Error::NonFinitePosition { vertex }),
+            "quantise: unexpected error"
+        );
+        return;
+    }
+    assert!(
+        grid.iter()
+            .flatten()
+            .all(|&c| c < tinydecimate::pipeline::GRID),
+        "quantise: a coordinate off the grid"
     );
+    let on_grid = Case {
+        positions: grid.iter().map(|q| q.map(f32::from)).collect(),
+        ..case.clone()
+    };
+    let expected = pipeline_error::<L, I, V, T>(&on_grid.positions, input, &case.config);
+    let runs = modes::<L, I, V, T, Integer>(&on_grid, &grid, input, expected, ", integer");
+
+    // One vertex off the grid: refused where the run checks its first corner, as a non-finite
+    // position is in the float arithmetic; unused, it changes nothing.
+    let Some(&budget) = case.budgets.first() else {
+        return;
+    };
+    if grid.is_empty() {
+        return;
+    }
+    let v = budget as usize % grid.len();
+    grid[v][budget as usize % 3] |= tinydecimate::pipeline::GRID;
+    let mut marked = on_grid.positions.clone();
+    marked[v] = [f32::NAN; 3];
+    let expected = pipeline_error::<L, I, V, T>(&marked, input, &case.config).map(|e| match e {
+        Error::NonFinitePosition { vertex } => Error::OffGrid { vertex },
+        e => e,
+    });
+    let mut fast = Box::new(FastWorkspace::<L, V, T, Integer>::new());
+    let mut lean = Box::new(LeanWorkspace::<L, V, T, Integer>::new());
+    for (mode, on) in ["fast, integer", "lean, integer"].into_iter().zip(runs) {
+        let mut buf = input.to_vec();
+        let r = if mode.starts_with("fast") {
+            fast.simplify(&grid, &mut buf, &case.config)
+        } else {
+            lean.simplify(&grid, &mut buf, &case.config)
+        };
+        match expected {
+            Some(e) => {
+                assert_eq!(r, Err(e), "{mode}: vertex {v} off the grid");
+                assert!(buf == input, "{mode}: buffer modified on error {e:?}");
+            }
+            None => assert!(
+                (r, buf) == on,
+                "{mode}: unused vertex {v} off the grid changed the result"
+            ),
+        }
+    }
+}
+
+/// A pipeline run: its result and the triangle buffer after it.
+type Run<I> = (std::result::Result<Report, Error>, Vec<[I; 3]>);
+
+/// Both modes in arithmetic `N` on `positions` (`case.positions` the same as `f32`, for the
+/// checker): `expected`, or a valid output, the same again on the same workspace; then with
+/// wedges. Returns each mode's first run. `arithmetic` is appended to the modes' names.
+fn modes<L: Index + 'static, I: Idx, const V: usize, const T: usize, N: Arithmetic>(
+    case: &Case,
+    positions: &[N::Position],
+    input: &[[I; 3]],
+    expected: Option<Error>,
+    arithmetic: &str,
+) -> Vec<Run<I>> {
     let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
     let view = pipeline_view(&case.positions, &inp);
-    let mut fast = Box::new(FastWorkspace::<L, V, T>::new());
-    let mut lean = Box::new(LeanWorkspace::<L, V, T>::new());
-    for mode in ["fast", "lean"] {
+    let mut fast = Box::new(FastWorkspace::<L, V, T, N>::new());
+    let mut lean = Box::new(LeanWorkspace::<L, V, T, N>::new());
+    let mut first = Vec::new();
+    for name in ["fast", "lean"] {
+        let mode = format!("{name}{arithmetic}");
         let mut runs = Vec::new();
         for _ in 0..2 {
-            let mut buf = input.clone();
-            let r = if mode == "fast" {
-                fast.simplify(&case.positions, &mut buf, &case.config)
+            let mut buf = input.to_vec();
+            let r = if name == "fast" {
+                fast.simplify(positions, &mut buf, &case.config)
             } else {
-                lean.simplify(&case.positions, &mut buf, &case.config)
+                lean.simplify(positions, &mut buf, &case.config)
             };
             match &r {
                 Err(e) => {
@@ -522,7 +619,7 @@ fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &C
                 Ok(report) => {
                     assert_eq!(expected, None, "{mode}: expected an error");
                     assert_ne!(report.stop, Stop::Running);
-                    check_output(case, &input, &buf, report, &view, mode);
+                    check_output(case, input, &buf, report, &view, &mode);
                 }
             }
             runs.push((r, buf));
@@ -531,27 +628,44 @@ fn pipeline<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &C
             runs[0] == runs[1],
             "{mode}: a reused workspace gave another result"
         );
+        first.push(runs.swap_remove(0));
     }
     if expected.is_none() {
-        pipeline_wedges::<L, I, V, T>(case, &input, (&mut fast, &mut lean), &view);
+        pipeline_wedges::<L, I, V, T, N>(
+            case,
+            positions,
+            input,
+            (&mut fast, &mut lean),
+            &view,
+            arithmetic,
+        );
     }
+    first
 }
 
 /// The pipeline with wedges (`simplify_with_wedges`) on the case split into two charts: each
 /// vertex copied, the triangles of one chart (a hash of the triangle's number) on the copies,
 /// then welded. Each output must keep every triangle within one chart, and, each wedge read
 /// as its position's first vertex, be a valid simplification of the input welded likewise.
-fn pipeline_wedges<L: Index + 'static, I: Idx, const V: usize, const T: usize>(
+fn pipeline_wedges<L: Index + 'static, I: Idx, const V: usize, const T: usize, N: Arithmetic>(
     case: &Case,
+    positions: &[N::Position],
     input: &[[I; 3]],
-    (fast, lean): (&mut FastWorkspace<L, V, T>, &mut LeanWorkspace<L, V, T>),
+    (fast, lean): (
+        &mut FastWorkspace<L, V, T, N>,
+        &mut LeanWorkspace<L, V, T, N>,
+    ),
     view: &[[f32; 3]],
+    arithmetic: &str,
 ) {
     let nv = case.positions.len();
     if nv == 0 || 2 * nv > V.min(L::COUNT) || 2 * nv > I::COUNT {
         return;
     }
-    let mut positions = case.positions.clone();
+    // Welded by the checker's positions (the same as `positions`, as `f32`).
+    let mut welding = case.positions.clone();
+    welding.extend_from_within(..);
+    let mut positions = positions.to_vec();
     positions.extend_from_within(..);
     let chart = |t: usize| (t as u32).wrapping_mul(0x9E37_79B9) >> 31 == 1;
     let split: Vec<[I; 3]> = input
@@ -568,7 +682,7 @@ fn pipeline_wedges<L: Index + 'static, I: Idx, const V: usize, const T: usize>(
     let mut welded = split.clone();
     let mut wedges = vec![[I::ZERO; 3]; split.len()];
     let mut order = vec![0u32; positions.len()];
-    tinydecimate::seam::weld(&positions, &mut welded, &mut wedges, &mut order)
+    tinydecimate::seam::weld(&welding, &mut welded, &mut wedges, &mut order)
         .expect("weld: indices checked");
     // The first vertex at a position is an original (the copies come after them all).
     let firsts = welded_firsts(&case.positions);
@@ -584,7 +698,7 @@ fn pipeline_wedges<L: Index + 'static, I: Idx, const V: usize, const T: usize>(
         } else {
             lean.simplify_with_wedges(&positions, &mut buf, &mut w, &case.config)
         };
-        let what = format!("{mode} with wedges");
+        let what = format!("{mode}{arithmetic} with wedges");
         let report = r.unwrap_or_else(|e| panic!("{what}: {e:?} on input the plain run took"));
         let out = &buf[..report.triangles_out];
         for t in out {

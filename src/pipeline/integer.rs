@@ -159,10 +159,10 @@ fn validate<'p, I: Index>(
             }
         }
     }
-    let extent = (0..3)
-        .map(|k| hi[k].saturating_sub(lo[k]))
-        .max()
-        .unwrap_or(0);
+    let extent = hi[0]
+        .saturating_sub(lo[0])
+        .max(hi[1].saturating_sub(lo[1]))
+        .max(hi[2].saturating_sub(lo[2]));
     // The power of two at or below the extent (1 for a point).
     let e = if extent == 0 {
         1
@@ -343,11 +343,11 @@ fn scaled(l: u64, s: i32, m: u64) -> u64 {
 #[inline(never)]
 fn add_plane(s: &mut Sum, n: [i32; 3], w: u64) {
     let w = w as i64;
-    let pairs = [(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)];
-    for (e, (i, j)) in s.iter_mut().zip(pairs) {
-        // Q30 to Q22 (below 2²²), times w: below 2^60.2.
-        let nn = i64::from((n[i] * n[j]) >> 8);
-        *e += (nn * w) >> 22;
+    let [x, y, z] = n;
+    // Q30 to Q22 (below 2²²), times w: below 2^60.2. Written out: no index to check.
+    let nn = [x * x, x * y, x * z, y * y, y * z, z * z];
+    for (e, p) in s.iter_mut().zip(nn) {
+        *e += (i64::from(p >> 8) * w) >> 22;
     }
 }
 
@@ -406,7 +406,8 @@ fn mean(raw: u64, w: u64) -> u64 {
     // raw = r · 2^t with r in [2³¹, 2³²).
     let t = bits(raw) as i32 - 32;
     let r = if t >= 0 { raw >> t } else { raw << -t } as u32;
-    let q = u64::from(r / d);
+    // d ≥ 1: w ≥ 1 keeps a bit after the shift.
+    let q = u64::from(r / d.max(1));
     // raw · ERR / w = (r / d) · 2^(t + 8 - sw); t ≤ 27 and sw ≤ 10 keep the shifts below 64.
     let e = t + ERR.trailing_zeros() as i32 - sw as i32;
     if e >= 0 {
@@ -436,12 +437,13 @@ impl<'p> Grid<'p> {
             + i64::from(o[2]) * i64::from(e[2]);
         // |o|·|e|² and |e|·|proj| are below 2^47.6.
         let l2i = l2 as i64;
-        let perp = [0, 1, 2].map(|k| i64::from(o[k]) * l2i - i64::from(e[k]) * proj);
+        let at = |o: i32, e: i32| i64::from(o) * l2i - i64::from(e) * proj;
+        let perp = [at(o[0], e[0]), at(o[1], e[1]), at(o[2], e[2])];
         if l2 == 0 {
             return;
         }
         if let Some((n, _, _)) = unit(perp) {
-            let w = isqrt(l2) * self.edge_unit * num / den;
+            let w = isqrt(l2) * self.edge_unit * num / den.max(1);
             add_plane(s, n, w);
         }
     }
@@ -797,7 +799,8 @@ pub struct GridFrame {
 impl GridFrame {
     /// The float position of grid position `q`.
     pub fn position(&self, q: [u16; 3]) -> [f32; 3] {
-        [0, 1, 2].map(|k| self.origin[k] + f32::from(q[k]) * self.step)
+        let ([x, y, z], [ox, oy, oz], s) = (q, self.origin, self.step);
+        [ox + f32::from(x) * s, oy + f32::from(y) * s, oz + f32::from(z) * s]
     }
 
     /// The most a position moves by quantisation: half a cell's diagonal, `step · √3 / 2`.
@@ -841,15 +844,15 @@ pub fn quantise(positions: &[[f32; 3]], out: &mut [[u16; 3]]) -> Result<GridFram
     };
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for (v, p) in positions.iter().enumerate() {
-        for k in 0..3 {
-            if !p[k].is_finite() {
+        for ((&x, l), h) in p.iter().zip(lo.iter_mut()).zip(hi.iter_mut()) {
+            if !x.is_finite() {
                 return Err(Error::NonFinitePosition { vertex: v });
             }
-            if p[k] < lo[k] {
-                lo[k] = p[k];
+            if x < *l {
+                *l = x;
             }
-            if p[k] > hi[k] {
-                hi[k] = p[k];
+            if x > *h {
+                *h = x;
             }
         }
     }
@@ -857,9 +860,9 @@ pub fn quantise(positions: &[[f32; 3]], out: &mut [[u16; 3]]) -> Result<GridFram
         (lo, hi) = ([0.0; 3], [0.0; 3]);
     }
     let mut extent = 0.0f32;
-    for k in 0..3 {
-        if hi[k] - lo[k] > extent {
-            extent = hi[k] - lo[k];
+    for (l, h) in lo.iter().zip(hi.iter()) {
+        if h - l > extent {
+            extent = h - l;
         }
     }
     // One cell of slack: the origin snaps down by less than a cell.
@@ -867,11 +870,11 @@ pub fn quantise(positions: &[[f32; 3]], out: &mut [[u16; 3]]) -> Result<GridFram
     let origin = lo.map(|l| floor(l / step) * step);
     let top = f32::from(GRID - 1);
     for (p, q) in positions.iter().zip(out.iter_mut()) {
-        for k in 0..3 {
+        for ((&x, &o), c) in p.iter().zip(origin.iter()).zip(q.iter_mut()) {
             // Round half up; `as` saturates, and the box keeps it in [0, top].
-            let x = (p[k] - origin[k]) / step + 0.5;
+            let x = (x - o) / step + 0.5;
             let x = if x < top { x } else { top };
-            q[k] = x as u16;
+            *c = x as u16;
         }
     }
     Ok(GridFrame { origin, step })

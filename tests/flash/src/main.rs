@@ -7,8 +7,10 @@
 //! the same statics and nothing else, so (image with) - (image without) is the library.
 //! `paper`, `u32-triangles` and `u32-links` change or add instantiations, `fast` calls the fast
 //! mode (`pipeline::FastWorkspace<u16, 512, 1024>`) instead, `lean` the lean mode
-//! (`pipeline::LeanWorkspace<u16, 512, 1024>`); `batched`, `seams` and `parts` compile the
-//! library feature of that name into the default call (see Cargo.toml).
+//! (`pipeline::LeanWorkspace<u16, 512, 1024>`), `fast-integer` and `lean-integer` the same
+//! modes in the integer arithmetic (`pipeline::Integer`) on grid positions, a second static in
+//! flash that `grid` alone adds to the image without the call; `batched`, `seams` and `parts`
+//! compile the library feature of that name into the default call (see Cargo.toml).
 //!
 //! Never run, only linked and measured: `scripts/flash.sh` (and `host-sim qemu --measure`).
 #![no_std]
@@ -36,6 +38,18 @@ static POSITIONS: [[f32; 3]; 6] = [
     [0.0, -1.0, 0.0],
     [0.0, 0.0, 1.0],
     [0.0, 0.0, -1.0],
+];
+
+/// The same octahedron on the integer pipeline's 15-bit grid (where `pipeline::quantise` puts
+/// it), in flash: the integer calls' positions, also in their image without the call.
+#[cfg(feature = "grid")]
+static GRID_POSITIONS: [[u16; 3]; 6] = [
+    [16384, 8192, 8192],
+    [0, 8192, 8192],
+    [8192, 16384, 8192],
+    [8192, 0, 8192],
+    [8192, 8192, 16384],
+    [8192, 8192, 0],
 ];
 
 /// Its 8 triangles, wound outwards.
@@ -115,11 +129,18 @@ fn run(
     let (ws, ws32) = (black_box(ws), black_box(ws32));
     let (tris, tris32) = (black_box(tris), black_box(tris32));
     black_box(&POSITIONS);
+    #[cfg(feature = "grid")]
+    black_box(&GRID_POSITIONS);
 
     #[cfg(feature = "call")]
     {
         // What firmware does with the result: use the triangle count, or the error.
-        #[cfg(not(any(feature = "fast", feature = "lean")))]
+        #[cfg(not(any(
+            feature = "fast",
+            feature = "lean",
+            feature = "fast-integer",
+            feature = "lean-integer"
+        )))]
         let result = ws.simplify(&POSITIONS, &mut *tris, &CONFIG);
         // The fast mode's workspace instead (on the stack: this firmware is only linked).
         #[cfg(feature = "fast")]
@@ -129,6 +150,27 @@ fn run(
         #[cfg(all(feature = "lean", not(feature = "fast")))]
         let result = black_box(tinydecimate::pipeline::LeanWorkspace::<u16, 512, 1024>::new())
             .simplify(&POSITIONS, &mut *tris, &CONFIG);
+        // The fast mode in the integer arithmetic instead, on the grid positions (likewise).
+        #[cfg(all(feature = "fast-integer", not(any(feature = "fast", feature = "lean"))))]
+        let result = black_box(tinydecimate::pipeline::FastWorkspace::<
+            u16,
+            512,
+            1024,
+            tinydecimate::pipeline::Integer,
+        >::new())
+        .simplify(&GRID_POSITIONS, &mut *tris, &CONFIG);
+        // The lean mode in the integer arithmetic instead (likewise).
+        #[cfg(all(
+            feature = "lean-integer",
+            not(any(feature = "fast", feature = "lean", feature = "fast-integer"))
+        ))]
+        let result = black_box(tinydecimate::pipeline::LeanWorkspace::<
+            u16,
+            512,
+            1024,
+            tinydecimate::pipeline::Integer,
+        >::new())
+        .simplify(&GRID_POSITIONS, &mut *tris, &CONFIG);
         let n = match result {
             Ok(report) => report.triangles_out,
             Err(_) => usize::MAX,

@@ -4,7 +4,8 @@
 //! call that can still reach a panic (bounds checks, `unwrap`, overflow checks, `unreachable!`,
 //! slicing, division by zero, ...) refers to it, so the link fails iff a panic path survives
 //! optimisation. Every public entry point is called, with inputs the optimiser cannot see
-//! (`read_volatile`, `black_box`), for both index types and both link types.
+//! (`read_volatile`, `black_box`), for both index types and both link types (the pipeline's
+//! in both arithmetics).
 //!
 //! Run `./check.sh` (from any directory).
 #![no_std]
@@ -24,6 +25,7 @@ use tinydecimate::cost::{
     Placement, Quadric, StoredQuadric, VertexQuadric,
 };
 use tinydecimate::operator::Operator;
+use tinydecimate::pipeline::{quantise, Arithmetic, Float, Integer};
 use tinydecimate::progressive::{Split, Storage};
 use tinydecimate::seam::SeamCorners;
 use tinydecimate::stream::{self, Decoder};
@@ -807,11 +809,14 @@ mod log {
     }
 }
 
-/// The fast mode (`pipeline::FastWorkspace`): its one entry point on opaque input.
-fn run_fast<L: Index, I: Index, const V: usize, const T: usize>() {
-    let mut ws = black_box(tinydecimate::pipeline::FastWorkspace::<L, V, T>::new());
-    black_box(tinydecimate::pipeline::FastWorkspace::<L, V, T>::BYTES);
-    let positions: [[f32; 3]; V] = black_box([[opaque_f32(5); 3]; V]);
+/// The fast mode (`pipeline::FastWorkspace`) in arithmetic `N`: its one entry point on opaque
+/// input (`position` opaque too).
+fn run_fast<L: Index, I: Index, const V: usize, const T: usize, N: Arithmetic>(
+    position: N::Position,
+) {
+    let mut ws = black_box(tinydecimate::pipeline::FastWorkspace::<L, V, T, N>::new());
+    black_box(tinydecimate::pipeline::FastWorkspace::<L, V, T, N>::BYTES);
+    let positions: [N::Position; V] = black_box([position; V]);
     let mut tris: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
     let (np, nt) = (input(3) as usize, input(4) as usize);
     let (Some(p), Some(t)) = (positions.get(..np), tris.get_mut(..nt)) else {
@@ -836,11 +841,14 @@ fn run_fast<L: Index, I: Index, const V: usize, const T: usize>() {
     black_box(&wedges);
 }
 
-/// The lean mode (`pipeline::LeanWorkspace`): its one entry point on opaque input.
-fn run_lean<L: Index, I: Index, const V: usize, const T: usize>() {
-    let mut ws = black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T>::new());
-    black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T>::BYTES);
-    let positions: [[f32; 3]; V] = black_box([[opaque_f32(5); 3]; V]);
+/// The lean mode (`pipeline::LeanWorkspace`) in arithmetic `N`: its one entry point on opaque
+/// input (`position` opaque too).
+fn run_lean<L: Index, I: Index, const V: usize, const T: usize, N: Arithmetic>(
+    position: N::Position,
+) {
+    let mut ws = black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T, N>::new());
+    black_box(tinydecimate::pipeline::LeanWorkspace::<L, V, T, N>::BYTES);
+    let positions: [N::Position; V] = black_box([position; V]);
     let mut tris: [[I; 3]; T] = black_box([[I::ZERO; 3]; T]);
     let (np, nt) = (input(3) as usize, input(4) as usize);
     let (Some(p), Some(t)) = (positions.get(..np), tris.get_mut(..nt)) else {
@@ -863,6 +871,25 @@ fn run_lean<L: Index, I: Index, const V: usize, const T: usize>() {
     }
     black_box(&tris);
     black_box(&wedges);
+}
+
+/// `pipeline::quantise` on opaque positions into an output of opaque length, and the grid it
+/// returns.
+fn run_quantise<const V: usize>() {
+    let positions: [[f32; 3]; V] = black_box([[opaque_f32(5); 3]; V]);
+    let mut grid: [[u16; 3]; V] = black_box([[0; 3]; V]);
+    let (np, ng) = (input(3) as usize, input(4) as usize);
+    let (Some(p), Some(g)) = (positions.get(..np), grid.get_mut(..ng)) else {
+        return;
+    };
+    match quantise(p, g) {
+        Ok(frame) => {
+            black_box(frame.position([input(6) as u16; 3]));
+            black_box(frame.error());
+        }
+        Err(e) => display(&e),
+    }
+    black_box(&grid);
 }
 
 #[entry]
@@ -877,10 +904,16 @@ fn main() -> ! {
     progressive::<u32, 48, 80>();
     run_cluster::<u16, u16, 64>();
     run_cluster::<u32, u32, 64>();
-    run_fast::<u16, u16, 96, 160>();
-    run_fast::<u32, u32, 96, 160>();
-    run_lean::<u16, u16, 96, 160>();
-    run_lean::<u32, u32, 96, 160>();
+    run_fast::<u16, u16, 96, 160, Float>([opaque_f32(5); 3]);
+    run_fast::<u32, u32, 96, 160, Float>([opaque_f32(5); 3]);
+    run_lean::<u16, u16, 96, 160, Float>([opaque_f32(5); 3]);
+    run_lean::<u32, u32, 96, 160, Float>([opaque_f32(5); 3]);
+    // The integer arithmetic: grid coordinates of any value (off the grid too).
+    run_fast::<u16, u16, 96, 160, Integer>([input(5) as u16; 3]);
+    run_fast::<u32, u32, 96, 160, Integer>([input(5) as u16; 3]);
+    run_lean::<u16, u16, 96, 160, Integer>([input(5) as u16; 3]);
+    run_lean::<u32, u32, 96, 160, Integer>([input(5) as u16; 3]);
+    run_quantise::<96>();
     loop {
         black_box(());
     }
