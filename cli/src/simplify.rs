@@ -373,7 +373,7 @@ pub fn simplify_with_attributes(
     tris.truncate(report.triangles_out);
     Ok((
         MeshData {
-            positions: mesh.positions.clone(),
+            positions,
             triangles: tris,
         },
         report,

@@ -1223,7 +1223,11 @@ mod tests {
         assert_eq!(Method::Meshopt.config(), None);
         assert_eq!(Method::Fast.config(), Some(Config::new()));
         assert_eq!(Method::Lean.config(), Some(Config::new()));
-        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 10);
+        assert_eq!(Method::FastInteger.config(), Some(Config::new()));
+        assert_eq!(Method::FastInteger.float(), Method::Fast);
+        assert_eq!(Method::LeanInteger.float(), Method::Lean);
+        assert!(Method::LeanInteger.integer() && !Method::Lean.integer());
+        assert_eq!(Method::ALL.iter().filter(|m| m.is_ours()).count(), 12);
     }
 
     #[test]
