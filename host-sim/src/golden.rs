@@ -235,6 +235,42 @@ mod tests {
         assert!(cases.iter().any(|c| !fits(c)), "a case the micro:bit skips");
     }
 
+    /// Every case of the pipeline in integers has its float case (`Case::float_twin`), which
+    /// `qemu --measure` puts it beside: the same mesh, triangles, target, index type and mode;
+    /// its positions are grid coordinates, exact in the case file's `f32`.
+    #[test]
+    fn integer_cases_stand_beside_their_float_case() {
+        let cases = load_cases(&default_dir()).unwrap();
+        let integer: Vec<&Case> = cases.iter().filter(|c| c.float_twin().is_some()).collect();
+        assert!(integer.len() >= 10, "{} integer cases", integer.len());
+        for c in integer {
+            let twin = c.float_twin().unwrap();
+            let f = cases
+                .iter()
+                .find(|f| f.name == twin)
+                .unwrap_or_else(|| panic!("{}: no float case {twin}", c.name));
+            let (fm, cm) = (f.method.unwrap(), c.method.unwrap());
+            assert!(!fm.integer() && cm.integer(), "{}", c.name);
+            assert!(fm.pipeline().is_some(), "{}", c.name);
+            assert_eq!(fm.pipeline(), cm.pipeline(), "{}", c.name);
+            assert_eq!(f.wedges.len(), 0, "{}", c.name);
+            assert_eq!(
+                (f.index_type, f.config, &f.triangles, f.positions.len()),
+                (c.index_type, c.config, &c.triangles, c.positions.len()),
+                "{}",
+                c.name
+            );
+            assert!(
+                c.positions
+                    .iter()
+                    .flatten()
+                    .all(|&x| x.fract() == 0.0 && (0.0..32_768.0).contains(&x)),
+                "{}: positions off the grid",
+                c.name
+            );
+        }
+    }
+
     #[test]
     fn cases_round_trip_through_the_case_file() {
         for c in load_cases(&default_dir()).unwrap() {

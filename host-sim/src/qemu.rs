@@ -150,14 +150,24 @@ const MICROBIT_SKIPS: &[&str] = &[
     "cow-lean-u16",
     "charts12-fast-wedges-u16",
     "charts12-lean-wedges-u32",
+    "grid12-fast-integer-u16",
+    "box6-fast-integer-u16",
+    "grid8-dirty-fast-integer-u32",
+    "plate-cut-fast-integer-u16",
+    "cow-fast-integer-u16",
+    "box6-lean-integer-u16",
+    "plate-cut-lean-integer-u16",
+    "cow-lean-integer-u16",
     "pm-grid8",
     "pm-cow-quantised",
 ];
 /// No RAM for stored quadrics on the micro:bit and the lm3s6965evb (firmware
 /// `board::QUADRIC_VERTICES` = 0), so none for the bounded cases (they borrow it) or the
 /// energy's samples either, no stack for vertex decimation (`board::VERTEX_DECIMATION`) and
-/// no fast or lean mode (`board::FAST_VERTICES` = 0); the cow's cases need the 4 MB boards or
-/// the 400 KB RISC-V.
+/// no float fast or lean mode (`board::FAST_VERTICES` = 0); the cow's cases need the 4 MB
+/// boards or the 400 KB RISC-V. Both run the pipeline in integers: the lm3s6965evb every small
+/// mesh in either mode, the micro:bit the 12 x 12 and the 8 x 8 grid in the lean mode only
+/// (`board::INT_FAST_VERTICES` = 0, `INT_LEAN_VERTICES`).
 const LM3S_SKIPS: &[&str] = &[
     "cow-new-u16",
     "tray-new-u16",
@@ -190,16 +200,19 @@ const LM3S_SKIPS: &[&str] = &[
     "cow-lean-u16",
     "charts12-fast-wedges-u16",
     "charts12-lean-wedges-u32",
+    "cow-fast-integer-u16",
+    "cow-lean-integer-u16",
     "pm-cow-quantised",
 ];
 
 /// The 400 KB RISC-V board holds every case (its buffers are sized for the cow's stream) but
-/// the cow's fast and lean cases: their workspace holds 2 000 vertices
-/// (`board::FAST_VERTICES`).
+/// the cow's float fast and lean cases: their workspace holds 2 000 vertices
+/// (`board::FAST_VERTICES`); the integer ones hold the cow.
 const RISCV_400K_SKIPS: &[&str] = &["cow-fast-u16", "cow-lean-u16"];
-/// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit);
-/// no RAM for stored quadrics, bounds or the energy's samples, and the plate and the cow are
-/// too big, vertex decimation overflows its stack, and there is no fast or lean mode.
+/// The 32 KB RISC-V board: the micro:bit's list less the 9 x 9 grid's stream (100 splits fit)
+/// and the small meshes in integers; no RAM for stored quadrics, bounds or the energy's
+/// samples, and the plate and the cow are too big, vertex decimation overflows its stack, and
+/// there is no float fast or lean mode. Its integer workspaces hold every mesh but the cow.
 const RISCV_32K_SKIPS: &[&str] = &[
     "plate-new-u16",
     "cow-new-u16",
@@ -233,6 +246,8 @@ const RISCV_32K_SKIPS: &[&str] = &[
     "cow-lean-u16",
     "charts12-fast-wedges-u16",
     "charts12-lean-wedges-u32",
+    "cow-fast-integer-u16",
+    "cow-lean-integer-u16",
     "pm-cow-quantised",
 ];
 
@@ -406,6 +421,10 @@ mod tests {
                 .iter()
                 .find(|(b, _, _)| *b == board)
                 .expect("every board in capacity_tests::FAST");
+            let (_, (ifv, ift), (ilv, ilt)) = *super::capacity_tests::INTEGER
+                .iter()
+                .find(|(b, _, _)| *b == board)
+                .expect("every board in capacity_tests::INTEGER");
             let too_big: Vec<&str> = cases
                 .iter()
                 .filter(|c| {
@@ -419,6 +438,10 @@ mod tests {
                             c.method,
                             Some(golden::case::MethodName::Fast | golden::case::MethodName::Lean)
                         ) && (c.positions.len() > fv || c.triangles.len() > ft))
+                        || (c.method == Some(golden::case::MethodName::FastInteger)
+                            && (c.positions.len() > ifv || c.triangles.len() > ift))
+                        || (c.method == Some(golden::case::MethodName::LeanInteger)
+                            && (c.positions.len() > ilv || c.triangles.len() > ilt))
                         // With wedges, the wedges follow the triangles in the buffer.
                         || (matches!(
                             c.method,
@@ -585,7 +608,22 @@ mod capacity_tests {
         ("riscv32imac-virt-32k", 0, 0),
     ];
 
-    /// [`FAST`] is a copy of the firmware's constants: it must agree with
+    /// A workspace's capacity: vertices, triangles.
+    type Capacity = (usize, usize);
+
+    /// The integer workspaces per board, fast then lean (firmware `board::INT_FAST_VERTICES`,
+    /// `INT_FAST_TRIANGLES`, `INT_LEAN_VERTICES`, `INT_LEAN_TRIANGLES`; 0: no such mode).
+    pub(super) const INTEGER: &[(&str, Capacity, Capacity)] = &[
+        ("microbit", (0, 0), (180, 300)),
+        ("lm3s6965evb", (530, 1_060), (530, 1_060)),
+        ("mps2-an386", (32_000, 64_000), (32_000, 64_000)),
+        ("mps2-an500", (32_000, 64_000), (32_000, 64_000)),
+        ("mps2-an505", (32_000, 64_000), (32_000, 64_000)),
+        ("riscv32imc-virt-400k", (3_000, 6_000), (3_000, 6_000)),
+        ("riscv32imac-virt-32k", (224, 448), (400, 800)),
+    ];
+
+    /// [`FAST`] and [`INTEGER`] are copies of the firmware's constants: they must agree with
     /// host-sim/firmware/src/board.rs for every board there.
     #[test]
     fn fast_capacity_agrees_with_the_firmware() {
@@ -597,6 +635,14 @@ mod capacity_tests {
                 constant(block, "FAST_VERTICES"),
                 constant(block, "FAST_TRIANGLES"),
             );
+            let fast = (
+                constant(block, "INT_FAST_VERTICES"),
+                constant(block, "INT_FAST_TRIANGLES"),
+            );
+            let lean = (
+                constant(block, "INT_LEAN_VERTICES"),
+                constant(block, "INT_LEAN_TRIANGLES"),
+            );
             for name in block
                 .lines()
                 .filter(|l| l.contains("pub const NAME: &str ="))
@@ -604,9 +650,14 @@ mod capacity_tests {
             {
                 boards += 1;
                 assert!(FAST.contains(&(name, v, t)), "{name}: {v} / {t}");
+                assert!(
+                    INTEGER.contains(&(name, fast, lean)),
+                    "{name}: integer {fast:?} {lean:?}"
+                );
             }
         }
         assert_eq!(boards, FAST.len(), "boards in board.rs");
+        assert_eq!(boards, INTEGER.len(), "boards in board.rs");
     }
 
     /// The value of `pub const NAME...: ... = VALUE;` in one board's block of board.rs.

@@ -29,10 +29,19 @@ mod sel {
     /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
+    /// The lean mode in integers (`pipeline::Integer`, `u16` links: 11 B per vertex, 6 B per
+    /// triangle, 2 KB of histogram: 5 828 B) holds the 12 x 12 grid, in the engine's RAM with
+    /// the stream arena's bytes beside the exact engine's ([`Engine`]); the box and the plate's
+    /// corner would need more than both. No fast mode in integers: its run's frames are deeper
+    /// than the lean run's, and the lean run's high-water leaves the stack no room for them.
+    pub const INT_FAST_VERTICES: usize = 0;
+    pub const INT_FAST_TRIANGLES: usize = 0;
+    pub const INT_LEAN_VERTICES: usize = 180;
+    pub const INT_LEAN_TRIANGLES: usize = 300;
     pub type Link = u16;
     /// Progressive streams (`pm-*` cases): 44 vertex splits (704 B) and an 80 B chunk buffer
-    /// (chunks of up to 71 B), taken from the stack's slack; triangles, their links, the list
-    /// heads and the positions reuse the buffers above.
+    /// (chunks of up to 71 B), in the engine's RAM ([`Engine`]); triangles, their links, the
+    /// list heads and the positions reuse the buffers above.
     pub const PM_VERTICES: usize = 44;
     pub const PM_BUFFER: usize = 80;
 }
@@ -54,6 +63,13 @@ mod sel {
     /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
+    /// The integer modes (`pipeline::Integer`, `u16` links: 37 B per vertex for the fast one,
+    /// 11 B for the lean one, 6 B per triangle, 2 KB of histogram): as large a mesh as the fast
+    /// workspace holds in the exact engine's RAM, 2 vertices per triangle (28 018 B), for both.
+    pub const INT_FAST_VERTICES: usize = 530;
+    pub const INT_FAST_TRIANGLES: usize = 1_060;
+    pub const INT_LEAN_VERTICES: usize = 530;
+    pub const INT_LEAN_TRIANGLES: usize = 1_060;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer.
     pub const PM_VERTICES: usize = 100;
@@ -93,6 +109,12 @@ mod sel {
     /// (11 B per vertex: 738 048 B).
     pub const FAST_VERTICES: usize = 32_000;
     pub const FAST_TRIANGLES: usize = 64_000;
+    /// The integer modes (`pipeline::Integer`) with the float modes' capacity: the fast
+    /// workspace takes 37 B per vertex (1 570 048 B), the lean one 11 B (738 048 B).
+    pub const INT_FAST_VERTICES: usize = 32_000;
+    pub const INT_FAST_TRIANGLES: usize = 64_000;
+    pub const INT_LEAN_VERTICES: usize = 32_000;
+    pub const INT_LEAN_TRIANGLES: usize = 64_000;
     pub type Link = u32;
     /// Progressive streams: 3 000 vertex splits (48 000 B: the cow's 2 844 fit) and a 4 KB
     /// chunk buffer. With the quadrics that leaves ~20 KB of stack (the firmware needs ~4 KB).
@@ -122,6 +144,14 @@ mod sel {
     /// the same capacity (11 B per vertex: 48 048 B).
     pub const FAST_VERTICES: usize = 2_000;
     pub const FAST_TRIANGLES: usize = 4_000;
+    /// The integer modes (`pipeline::Integer`, the arithmetic for this core without an FPU):
+    /// room for the cow (2 903 vertices, 5 804 triangles), which the float workspaces lack.
+    /// The fast workspace (37 B per vertex: 149 048 B) is larger than the exact engine's and
+    /// takes the stream arena's bytes too ([`Engine`]); the lean one (71 048 B) is not.
+    pub const INT_FAST_VERTICES: usize = 3_000;
+    pub const INT_FAST_TRIANGLES: usize = 6_000;
+    pub const INT_LEAN_VERTICES: usize = 3_000;
+    pub const INT_LEAN_TRIANGLES: usize = 6_000;
     pub type Link = u16;
     /// Progressive streams: 3 000 vertex splits (48 000 B) and a 4 KB chunk buffer.
     pub const PM_VERTICES: usize = 3_000;
@@ -147,6 +177,13 @@ mod sel {
     /// their cases are skipped here.
     pub const FAST_VERTICES: usize = 0;
     pub const FAST_TRIANGLES: usize = 0;
+    /// The integer modes (`pipeline::Integer`, `u16` links): the fast workspace (37 B per
+    /// vertex: 13 024 B, with the stream arena's bytes, [`Engine`]) holds the small golden
+    /// meshes, the lean one (11 B per vertex: 11 248 B) more.
+    pub const INT_FAST_VERTICES: usize = 224;
+    pub const INT_FAST_TRIANGLES: usize = 448;
+    pub const INT_LEAN_VERTICES: usize = 400;
+    pub const INT_LEAN_TRIANGLES: usize = 800;
     pub type Link = u16;
     /// Progressive streams: 100 vertex splits (1 600 B) and a 272 B chunk buffer, as on the
     /// lm3s6965evb.
@@ -181,6 +218,14 @@ pub const fn capacity(it: IndexType, entry: meshfmt::Entry) -> (usize, usize) {
         meshfmt::Entry::Fast | meshfmt::Entry::Lean => {
             (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t))
         }
+        meshfmt::Entry::FastInteger => (
+            min(INT_FAST_VERTICES, MAX_VERTICES),
+            min(INT_FAST_TRIANGLES, t),
+        ),
+        meshfmt::Entry::LeanInteger => (
+            min(INT_LEAN_VERTICES, MAX_VERTICES),
+            min(INT_LEAN_TRIANGLES, t),
+        ),
         // The wedges follow the triangles in the triangle buffer.
         meshfmt::Entry::FastWedges | meshfmt::Entry::LeanWedges => {
             (min(FAST_VERTICES, MAX_VERTICES), min(FAST_TRIANGLES, t / 2))
@@ -231,26 +276,75 @@ pub type FastWorkspace = tinydecimate::pipeline::FastWorkspace<u16, FAST_VERTICE
 #[cfg(feature = "lib")]
 pub type LeanWorkspace = tinydecimate::pipeline::LeanWorkspace<u16, FAST_VERTICES, FAST_TRIANGLES>;
 
-/// The working memory of a run, one static for every engine: a run is one case, so it needs
-/// the exact engine's workspace, the fast mode's or the lean mode's, never two, and the RAM is
-/// the largest of them rather than their sum (on the 4 MB boards their sum does not fit).
-/// `Exact` is variant 0 and every workspace is all zero, so the static is all zero and sits in
-/// `.bss`; a fast case turns it into `Fast` before its run (`main.rs`, `fast_workspace`), a
-/// lean case into `Lean` (`lean_workspace`). The tag is a
-/// `u32` so that no padding lies between it and the 4-aligned workspace: the switch is then a
-/// store of the tag and a memset of the workspace in place (with a `u8` tag the compiler built
-/// the new value on the stack and copied it, a frame of the workspace's size).
+/// Whether the board runs the fast mode in integers (`MethodCode::FastInteger`); without it
+/// the firmware skips those cases and leaves the code out, as for [`FAST`].
+pub const INT_FAST: bool = INT_FAST_VERTICES > 0;
+
+/// Whether the board runs the lean mode in integers (`MethodCode::LeanInteger`), as
+/// [`INT_FAST`].
+pub const INT_LEAN: bool = INT_LEAN_VERTICES > 0;
+
+/// Whether this image carries the library entry point of `entry` among those a board may
+/// leave out for want of RAM or flash: the float pipeline ([`FAST`]) and each integer mode.
+pub const fn has_mode(entry: meshfmt::Entry) -> bool {
+    match entry {
+        meshfmt::Entry::Fast
+        | meshfmt::Entry::Lean
+        | meshfmt::Entry::FastWedges
+        | meshfmt::Entry::LeanWedges => FAST,
+        meshfmt::Entry::FastInteger => INT_FAST,
+        meshfmt::Entry::LeanInteger => INT_LEAN,
+        _ => true,
+    }
+}
+
+/// The fast mode's workspace in integers (`pipeline::Integer`: `[u16; 3]` grid positions).
 #[cfg(feature = "lib")]
-#[repr(C, u32)]
-// Both variants are large on purpose: the enum is how they share the RAM (no heap to box one).
+pub type FastIntWorkspace = tinydecimate::pipeline::FastWorkspace<
+    u16,
+    INT_FAST_VERTICES,
+    INT_FAST_TRIANGLES,
+    tinydecimate::pipeline::Integer,
+>;
+
+/// The lean mode's workspace in integers.
+#[cfg(feature = "lib")]
+pub type LeanIntWorkspace = tinydecimate::pipeline::LeanWorkspace<
+    u16,
+    INT_LEAN_VERTICES,
+    INT_LEAN_TRIANGLES,
+    tinydecimate::pipeline::Integer,
+>;
+
+/// The working memory of a run, one static for every engine and for the progressive stream's
+/// arena: a run is one case or one stream, so it needs the exact engine's workspace, one of
+/// the pipeline's (fast or lean, in floats or in integers) or the stream arena, never two, and
+/// the RAM is the largest of them rather than their sum (on the 4 MB boards their sum does not
+/// fit). `Exact` is variant 0 and every variant is all zero, so the static is all zero and
+/// sits in `.bss`; a fast case turns it into `Fast` before its run (`main.rs`,
+/// `fast_workspace`), a lean case into `Lean` (`lean_workspace`), an integer case into
+/// `FastInteger` or `LeanInteger`, a stream into `Stream` (`stream_arena`). The tag is a `u64`
+/// so that no padding lies between it and any variant (the arena's vertex splits are
+/// 8-aligned): the switch is then a store of the tag and a memset of the variant in place
+/// (with a `u8` tag the compiler built the new value on the stack and copied it, a frame of
+/// the workspace's size).
+#[cfg(feature = "lib")]
+#[repr(C, u64)]
+// Every variant is large on purpose: the enum is how they share the RAM (no heap to box one).
 #[allow(clippy::large_enum_variant)]
 pub enum Engine {
-    /// `Workspace`, the exact engine (every method but the fast and the lean mode).
+    /// `Workspace`, the exact engine (every method but the pipeline's).
     Exact(Workspace),
     /// `FastWorkspace`, the fast mode.
     Fast(FastWorkspace),
     /// `LeanWorkspace`, the lean mode.
     Lean(LeanWorkspace),
+    /// `FastIntWorkspace`, the fast mode in integers.
+    FastInteger(FastIntWorkspace),
+    /// `LeanIntWorkspace`, the lean mode in integers.
+    LeanInteger(LeanIntWorkspace),
+    /// `PmArena`, a progressive stream's vertex splits and chunk buffer.
+    Stream(PmArena),
 }
 
 // The fast mode adds no RAM: its workspace fits in the exact engine's.
@@ -259,10 +353,29 @@ const _: () = assert!(FastWorkspace::BYTES <= Workspace::BYTES);
 // Nor does the lean mode.
 #[cfg(feature = "lib")]
 const _: () = assert!(LeanWorkspace::BYTES <= Workspace::BYTES);
+/// What the engine may take without adding RAM: the exact engine's workspace and the stream
+/// arena, which would otherwise be two statics side by side.
+#[cfg(feature = "lib")]
+pub const ENGINE_BYTES: usize = Workspace::BYTES + core::mem::size_of::<PmArena>();
+// The integer modes add no RAM: each workspace fits in the exact engine's and the arena's
+// bytes (on the micro:bit and the 400 KB RISC-V it needs both), and so does the engine whole,
+// its tag included.
+#[cfg(feature = "lib")]
+const _: () = assert!(FastIntWorkspace::BYTES <= ENGINE_BYTES);
+#[cfg(feature = "lib")]
+const _: () = assert!(LeanIntWorkspace::BYTES <= ENGINE_BYTES);
+#[cfg(feature = "lib")]
+const _: () = assert!(
+    core::mem::size_of::<Engine>()
+        <= Workspace::BYTES
+            + core::mem::size_of::<PmArena>()
+            + core::mem::size_of::<u64>()
+);
 
 /// What a progressive stream needs beyond the triangle and position buffers (which it reuses:
 /// the triangle bytes hold a list head per vertex, then the triangles and their links): a split
-/// record per vertex and a chunk buffer. All zero, so a `static` of it is in `.bss`.
+/// record per vertex and a chunk buffer. All zero; it lives in the [`Engine`], whose RAM a
+/// stream does not otherwise use.
 #[cfg(feature = "lib")]
 pub struct PmArena {
     pub splits: [tinydecimate::progressive::Split<Link>; PM_VERTICES],

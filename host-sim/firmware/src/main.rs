@@ -58,6 +58,14 @@ static QUADRICS: ConstStaticCell<[[f32; 10]; board::QUADRIC_VERTICES]> =
 /// Triangles of the current case, in the file's index type.
 static TRIANGLES: ConstStaticCell<board::TriangleBytes> =
     ConstStaticCell::new(board::TriangleBytes([0; board::TRIANGLE_BYTES]));
+/// The working memory of the run: the exact engine's workspace, one of the pipeline's, or a
+/// stream's arena (`board::Engine`). `Workspace::new` is `const`, so the workspace is
+/// initialised at compile time. (Building it at run time,
+/// `StaticCell::uninit().write(Workspace::new())`, assembles it on the stack first: a 1.6 MB
+/// frame on the 4 MB boards.) A run takes it once, for its case or its stream.
+#[cfg(feature = "lib")]
+static ENGINE: ConstStaticCell<board::Engine> =
+    ConstStaticCell::new(board::Engine::Exact(board::Workspace::new()));
 
 #[entry]
 fn main() -> ! {
@@ -176,21 +184,21 @@ fn read_case(
     );
     // A board without quadric storage skips every case that borrows it (an empty one too), a
     // board without the stack for vertex decimation every vertex-decimation case, a board
-    // without the fast and lean modes every fast and lean case: `run_library` leaves their code
-    // out of the image.
+    // without a mode of the pipeline (float, integer fast, integer lean) every case of it:
+    // `run_library`, `run_pipeline` and `run_grid` leave their code out of the image.
     let entry = h.entry();
     let (cv, ct) = board::capacity(h.index_type, entry);
     if nv > cv
         || nt > ct
-        || (entry.pipeline() && !board::FAST)
+        || !board::has_mode(entry)
         || (entry.per_vertex_storage() && (nv > board::QUADRIC_VERTICES || !board::HAS_QUADRICS))
         || (entry == meshfmt::Entry::VertexDecimation && !board::VERTEX_DECIMATION)
         || (entry == meshfmt::Entry::Bounded
             && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
                 || !board::HAS_QUADRICS))
     {
-        if entry.pipeline() && !board::FAST {
-            defmt::warn!("no fast or lean mode on this board");
+        if !board::has_mode(entry) {
+            defmt::warn!("no such mode of the pipeline on this board");
         } else {
             defmt::warn!("the mesh does not fit this board");
         }
@@ -230,8 +238,9 @@ fn run_stream(
     positions: &mut [[f32; 3]],
     triangles: &mut [u8],
 ) -> Result<(), IoError> {
-    static ARENA: ConstStaticCell<board::PmArena> = ConstStaticCell::new(board::PmArena::new());
-    let arena = ARENA.take();
+    let Some(arena) = stream_arena(ENGINE.take()) else {
+        return Err(IoError::Read);
+    };
     let (heads, rest) = triangles.split_at_mut(board::PM_HEAD_BYTES);
     let tri_bytes = board::PM_TRIANGLES * 3 * core::mem::size_of::<board::Link>();
     let (tris, rest) = rest.split_at_mut(tri_bytes);
@@ -296,6 +305,22 @@ fn run_stream(
     hostio::write_all(&mut dev.output, &s.to_bytes())?;
     defmt::info!("wrote {=str}", out_path);
     Ok(())
+}
+
+/// Turns the run's working memory into the stream arena (zeroed), in place, as
+/// [`fast_workspace`] does for the fast mode; before the stack is painted, so that the stream's
+/// measured stack is the decoder's alone.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn stream_arena(engine: &mut board::Engine) -> Option<&mut board::PmArena> {
+    const ZEROED: board::PmArena = board::PmArena::new();
+    if !matches!(engine, board::Engine::Stream(_)) {
+        *engine = board::Engine::Stream(ZEROED);
+    }
+    match engine {
+        board::Engine::Stream(arena) => Some(arena),
+        _ => None,
+    }
 }
 
 #[cfg(not(feature = "lib"))]
@@ -374,26 +399,33 @@ fn simplify(
     tri: &mut [u8],
     r: &mut ResultHeader,
 ) {
-    // `Workspace::new` is const, so the workspace is initialised at compile time. (Building it
-    // at run time, `StaticCell::uninit().write(Workspace::new())`, assembles it on the stack
-    // first: a 1.6 MB frame on the 4 MB boards.) The fast and the lean mode's workspaces
-    // share its RAM (`board::Engine`).
-    static ENGINE: ConstStaticCell<board::Engine> =
-        ConstStaticCell::new(board::Engine::Exact(board::Workspace::new()));
     let engine = ENGINE.take();
     let quadrics = QUADRICS.take();
     let config = meshfmt::lib::config(h);
     let entry = h.entry();
 
     let sp = measure::paint();
-    // Not counted: the exact engine's workspace is ready at boot, the fast and the lean one
-    // are zeroed here.
+    // Not counted: the exact engine's workspace is ready at boot, the pipeline's are zeroed
+    // here.
     if matches!(entry, meshfmt::Entry::Fast | meshfmt::Entry::FastWedges) && board::FAST {
         fast_workspace(engine);
     }
     if matches!(entry, meshfmt::Entry::Lean | meshfmt::Entry::LeanWedges) && board::FAST {
         lean_workspace(engine);
     }
+    if entry == meshfmt::Entry::FastInteger && board::INT_FAST {
+        fast_integer_workspace(engine);
+    }
+    if entry == meshfmt::Entry::LeanInteger && board::INT_LEAN {
+        lean_integer_workspace(engine);
+    }
+    // Not counted either: an integer case's grid coordinates become `[u16; 3]` in place (the
+    // float positions are not read after that).
+    let (pos, grid): (&mut [[f32; 3]], &[[u16; 3]]) = if entry.integer() {
+        (&mut [], on_grid(pos))
+    } else {
+        (pos, &[])
+    };
     // The triangles, and after them a wedge case's wedges.
     let (tri, wedges) = tri.split_at_mut(h.triangles_len());
     measure::start(syst);
@@ -407,6 +439,10 @@ fn simplify(
             },
             board::Engine::Fast(ws) => run_either(ws, h.index_type, pos, tri, wedges, &config),
             board::Engine::Lean(ws) => run_either(ws, h.index_type, pos, tri, wedges, &config),
+            board::Engine::FastInteger(ws) => run_grid(ws, h.index_type, grid, tri, &config),
+            board::Engine::LeanInteger(ws) => run_grid(ws, h.index_type, grid, tri, &config),
+            // Not reached: a case never turns the engine into the stream arena.
+            board::Engine::Stream(_) => None,
         };
     let Some(outcome) = outcome else {
         *r = ResultHeader::empty(h.index_type, Status::BadCase, board::BOARD);
@@ -422,7 +458,7 @@ fn simplify(
 /// match arms were, so that no frame of its own lies above the measured call.
 #[cfg(feature = "lib")]
 #[inline(always)]
-fn run_either<P: Pipeline>(
+fn run_either<P: Pipeline<Position = [f32; 3]>>(
     ws: &mut P,
     index_type: IndexType,
     pos: &[[f32; 3]],
@@ -444,6 +480,40 @@ fn run_either<P: Pipeline>(
             .zip(triangles_as::<u32>(wedges))
             .map(|(t, w)| run_pipeline_wedges(ws, pos, t, w, config)),
     }
+}
+
+/// An integer case on workspace `ws` (`FastIntWorkspace` or `LeanIntWorkspace`), on the grid
+/// positions, in the case's index type (`None`: the bytes are not whole triangles). No wedges:
+/// no integer case has them. Inlined into [`simplify`], as [`run_either`] is.
+#[cfg(feature = "lib")]
+#[inline(always)]
+fn run_grid<P: Pipeline<Position = [u16; 3]>>(
+    ws: &mut P,
+    index_type: IndexType,
+    grid: &[[u16; 3]],
+    tri: &mut [u8],
+    config: &tinydecimate::Config,
+) -> Option<Result<tinydecimate::Report, tinydecimate::Error>> {
+    match index_type {
+        IndexType::U16 => triangles_as::<u16>(tri).map(|t| run_pipeline(ws, grid, t, config)),
+        IndexType::U32 => triangles_as::<u32>(tri).map(|t| run_pipeline(ws, grid, t, config)),
+    }
+}
+
+/// An integer case's positions, read as the case file carries them (grid coordinates as
+/// `f32`), turned into `[u16; 3]` in the same buffer (`meshfmt::grid_in_place`): the first
+/// half of its bytes. Empty if the buffer is not 2-aligned, which a `f32` buffer always is.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn on_grid(pos: &mut [[f32; 3]]) -> &[[u16; 3]] {
+    let n = pos.len();
+    let bytes: &mut [u8] = bytemuck::cast_slice_mut(pos);
+    meshfmt::grid_in_place(bytes);
+    let bytes: &[u8] = bytes;
+    bytes
+        .get(..6 * n)
+        .and_then(|b| bytemuck::try_cast_slice(b).ok())
+        .unwrap_or(&[])
 }
 
 /// The triangle bytes as triangles of `I` (`None`: misaligned or not a whole number of them).
@@ -477,6 +547,8 @@ fn write_header(
     r.workspace_bytes = match entry {
         meshfmt::Entry::Fast | meshfmt::Entry::FastWedges => board::FastWorkspace::BYTES as u32,
         meshfmt::Entry::Lean | meshfmt::Entry::LeanWedges => board::LeanWorkspace::BYTES as u32,
+        meshfmt::Entry::FastInteger => board::FastIntWorkspace::BYTES as u32,
+        meshfmt::Entry::LeanInteger => board::LeanIntWorkspace::BYTES as u32,
         _ => board::Workspace::BYTES as u32,
     };
     match outcome {
@@ -514,12 +586,17 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     // A board leaves out the entry points it cannot run (`read_case` skips their cases): the
     // ones that borrow the quadric storage where there is none, vertex decimation where the
     // stack is too small. With all of them the micro:bit's and the lm3s6965evb's images
-    // overflow their 256 KB of flash. A fast or lean case runs on its own workspace
-    // (`run_fast`, `run_lean`), never here.
+    // overflow their 256 KB of flash. A case of the pipeline runs on its own workspace
+    // (`run_pipeline`, `run_pipeline_wedges`), never here.
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
-        Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges => true,
+        Entry::Fast
+        | Entry::Lean
+        | Entry::FastWedges
+        | Entry::LeanWedges
+        | Entry::FastInteger
+        | Entry::LeanInteger => true,
         _ => !board::HAS_QUADRICS,
     };
     if left_out {
@@ -546,9 +623,12 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
         ),
         Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
         Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
-        Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges => {
-            Err(left_out_error(positions.len()))
-        }
+        Entry::Fast
+        | Entry::Lean
+        | Entry::FastWedges
+        | Entry::LeanWedges
+        | Entry::FastInteger
+        | Entry::LeanInteger => Err(left_out_error(positions.len())),
     }
 }
 
@@ -578,18 +658,24 @@ fn fast_workspace(engine: &mut board::Engine) {
     }
 }
 
-/// The pipeline's two workspaces (the fast and the lean mode) as the firmware calls them.
+/// The pipeline's workspaces (the fast and the lean mode, in floats or in integers) as the
+/// firmware calls them.
 #[cfg(feature = "lib")]
 trait Pipeline {
+    /// A position as the workspace's arithmetic takes it.
+    type Position;
+    /// Whether the board has this mode (`board::FAST`, `INT_FAST`, `INT_LEAN`): without it
+    /// the calls return at once and the mode's code is left out of the image.
+    const ON: bool;
     fn plain<I: tinydecimate::Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[Self::Position],
         triangles: &mut [[I; 3]],
         config: &tinydecimate::Config,
     ) -> Result<tinydecimate::Report, tinydecimate::Error>;
     fn welded<I: tinydecimate::Index>(
         &mut self,
-        positions: &[[f32; 3]],
+        positions: &[Self::Position],
         triangles: &mut [[I; 3]],
         wedges: &mut [[I; 3]],
         config: &tinydecimate::Config,
@@ -598,13 +684,15 @@ trait Pipeline {
 
 /// Implements [`Pipeline`] for a workspace type by its inherent methods.
 macro_rules! pipeline {
-    ($ws:ty) => {
+    ($ws:ty, $position:ty, $on:expr) => {
         #[cfg(feature = "lib")]
         impl Pipeline for $ws {
+            type Position = $position;
+            const ON: bool = $on;
             #[inline(always)]
             fn plain<I: tinydecimate::Index>(
                 &mut self,
-                positions: &[[f32; 3]],
+                positions: &[$position],
                 triangles: &mut [[I; 3]],
                 config: &tinydecimate::Config,
             ) -> Result<tinydecimate::Report, tinydecimate::Error> {
@@ -613,7 +701,7 @@ macro_rules! pipeline {
             #[inline(always)]
             fn welded<I: tinydecimate::Index>(
                 &mut self,
-                positions: &[[f32; 3]],
+                positions: &[$position],
                 triangles: &mut [[I; 3]],
                 wedges: &mut [[I; 3]],
                 config: &tinydecimate::Config,
@@ -623,22 +711,24 @@ macro_rules! pipeline {
         }
     };
 }
-pipeline!(board::FastWorkspace);
-pipeline!(board::LeanWorkspace);
+pipeline!(board::FastWorkspace, [f32; 3], board::FAST);
+pipeline!(board::LeanWorkspace, [f32; 3], board::FAST);
+pipeline!(board::FastIntWorkspace, [u16; 3], board::INT_FAST);
+pipeline!(board::LeanIntWorkspace, [u16; 3], board::INT_LEAN);
 
-/// A fast or lean case (`MethodCode::Fast`, `MethodCode::Lean`): `simplify`, positions read.
-/// Never inlined, for the same reason as [`run_bounded`]; a board without the fast and lean
-/// modes never runs it (`read_case` skips their cases), and the constant leaves the pipeline
-/// out of its image.
+/// A fast or lean case, in floats or in integers (`MethodCode::Fast`, `Lean`, `FastInteger`,
+/// `LeanInteger`): `simplify`, positions read. Never inlined, for the same reason as
+/// [`run_bounded`]; a board without the mode never runs it (`read_case` skips its cases), and
+/// the constant leaves the mode out of its image.
 #[cfg(feature = "lib")]
 #[inline(never)]
 fn run_pipeline<P: Pipeline, I: tinydecimate::Index>(
     ws: &mut P,
-    positions: &[[f32; 3]],
+    positions: &[P::Position],
     triangles: &mut [[I; 3]],
     config: &tinydecimate::Config,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    if !board::FAST {
+    if !P::ON {
         return Err(left_out_error(positions.len()));
     }
     ws.plain(positions, triangles, config)
@@ -651,12 +741,12 @@ fn run_pipeline<P: Pipeline, I: tinydecimate::Index>(
 #[inline(never)]
 fn run_pipeline_wedges<P: Pipeline, I: tinydecimate::Index>(
     ws: &mut P,
-    positions: &[[f32; 3]],
+    positions: &[P::Position],
     triangles: &mut [[I; 3]],
     wedges: &mut [[I; 3]],
     config: &tinydecimate::Config,
 ) -> Result<tinydecimate::Report, tinydecimate::Error> {
-    if !board::FAST {
+    if !P::ON {
         return Err(left_out_error(positions.len()));
     }
     ws.welded(positions, triangles, wedges, config)
@@ -670,6 +760,28 @@ fn lean_workspace(engine: &mut board::Engine) {
     const ZEROED: board::LeanWorkspace = board::LeanWorkspace::new();
     if !matches!(engine, board::Engine::Lean(_)) {
         *engine = board::Engine::Lean(ZEROED);
+    }
+}
+
+/// Turns the run's working memory into the fast mode's workspace in integers (zeroed), in
+/// place, as [`fast_workspace`] does.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn fast_integer_workspace(engine: &mut board::Engine) {
+    const ZEROED: board::FastIntWorkspace = board::FastIntWorkspace::new();
+    if !matches!(engine, board::Engine::FastInteger(_)) {
+        *engine = board::Engine::FastInteger(ZEROED);
+    }
+}
+
+/// Turns the run's working memory into the lean mode's workspace in integers (zeroed), in
+/// place, as [`fast_workspace`] does.
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn lean_integer_workspace(engine: &mut board::Engine) {
+    const ZEROED: board::LeanIntWorkspace = board::LeanIntWorkspace::new();
+    if !matches!(engine, board::Engine::LeanInteger(_)) {
+        *engine = board::Engine::LeanInteger(ZEROED);
     }
 }
 

@@ -20,7 +20,7 @@
 //! |     24 | f32     | lambda                                                       |
 //! |     28 | u8      | feature mode: 0 = features off, 1 = paper, 2 = valence-normalized |
 //! |     29 | u8      | feature targets (0/1)                                        |
-//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy, 6 = the fast mode, 7 = the lean mode |
+//! |     30 | u8      | method ([`MethodCode`]): 0 = memoryless quadric, 1 = normal variation W (version 2), 2 = stored quadric with subset placement, 3 = stored quadric with optimal placement, 4 = vertex decimation, 5 = Hoppe's energy, 6 = the fast mode, 7 = the lean mode, 8 and 9 = either with wedges, 10 and 11 = either in integers |
 //! |     31 | u8      | reserved, 0                                                  |
 //! |     32 | u32     | max passes                                                   |
 //! |     36 | f32     | max cost (may be +inf)                                       |
@@ -29,7 +29,7 @@
 //! |     48 | f32     | boundary weight                                              |
 //! |     52 | f32     | max error: the guaranteed bound (`Config::max_error`, input units); 0 = none |
 //! |     56 | [u8; 8] | reserved, 0                                                  |
-//! |     64 | f32     | positions: V × 3                                             |
+//! |     64 | f32     | positions: V × 3 (an integer method's: grid coordinates, [`grid_position`]) |
 //! |        | u16/u32 | triangles: T × 3                                             |
 //!
 //! # Result file (firmware → host), [`RESULT_HEADER_LEN`] = 288 bytes of header
@@ -137,8 +137,8 @@ pub enum ScheduleCode {
 }
 
 /// Method code: the cost and operator a case runs (header byte 30). Codes 0-3 name a cost of
-/// the edge collapse, 4 and 5 a plug-in, 6 and 7 the pipeline (fast and lean mode); the byte was first the
-/// cost alone, so the codes are the ones it had. A new code keeps the case version: a reader
+/// the edge collapse, 4 and 5 a plug-in, 6 to 11 the pipeline (fast and lean mode, with wedges,
+/// in integers); the byte was first the cost alone, so the codes are the ones it had. A new code keeps the case version: a reader
 /// that predates it refuses the case ([`FormatError::Code`]) rather than run another method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MethodCode {
@@ -169,6 +169,14 @@ pub enum MethodCode {
     /// The lean mode on a welded mesh with wedges (`LeanWorkspace::simplify_with_wedges`), as
     /// `FastWedges`.
     LeanWedges = 9,
+    /// The fast mode in integers (`FastWorkspace<_, _, _, pipeline::Integer>::simplify`): the
+    /// case file's positions are grid coordinates below 32 768 written as `f32` (exact), which
+    /// the runner turns into `[u16; 3]` ([`grid_position`]) before the call; the configuration
+    /// as for `Fast`, an error limit in grid cells.
+    FastInteger = 10,
+    /// The lean mode in integers (`LeanWorkspace<_, _, _, pipeline::Integer>::simplify`), as
+    /// `FastInteger`.
+    LeanInteger = 11,
 }
 
 /// The library entry point a case runs: its method and whether it is bounded, decided once
@@ -195,6 +203,10 @@ pub enum Entry {
     FastWedges,
     /// `pipeline::LeanWorkspace::simplify_with_wedges`, positions read.
     LeanWedges,
+    /// `pipeline::FastWorkspace<_, _, _, Integer>::simplify`, grid positions read.
+    FastInteger,
+    /// `pipeline::LeanWorkspace<_, _, _, Integer>::simplify`, grid positions read.
+    LeanInteger,
 }
 
 impl Entry {
@@ -213,12 +225,41 @@ impl Entry {
         matches!(self, Entry::FastWedges | Entry::LeanWedges)
     }
 
-    /// Whether the run is the pipeline's (the fast or the lean mode), on its own workspace.
+    /// Whether the run is the pipeline's in floats (the fast or the lean mode, with or without
+    /// wedges), on its own workspace.
     pub const fn pipeline(self) -> bool {
         matches!(
             self,
             Entry::Fast | Entry::Lean | Entry::FastWedges | Entry::LeanWedges
         )
+    }
+
+    /// Whether the run is the pipeline's in integers (`pipeline::Integer`), on its own
+    /// workspace: the case file's positions are grid coordinates ([`grid_position`]).
+    pub const fn integer(self) -> bool {
+        matches!(self, Entry::FastInteger | Entry::LeanInteger)
+    }
+}
+
+/// A position of an integer case as the library takes it: the case file carries each grid
+/// coordinate as an `f32`, which holds every integer below 2²⁴ exactly, so that the file keeps
+/// one layout for every method; the firmware and the host turn it back with this cast alone.
+#[inline]
+pub fn grid_position(p: [f32; 3]) -> [u16; 3] {
+    p.map(|x| x as u16)
+}
+
+/// [`grid_position`] in place on the positions of an integer case as the firmware reads them
+/// (little-endian `f32`s, 12 bytes a vertex): coordinate `i` is read at byte `4i` and written
+/// as a `u16` at byte `2i`, in increasing `i`, so a write never lands on a coordinate not yet
+/// read and no second buffer is needed. The first half of `bytes` then holds the `[u16; 3]`
+/// positions.
+pub fn grid_in_place(bytes: &mut [u8]) {
+    for i in 0..bytes.len() / 4 {
+        let mut f = [0u8; 4];
+        f.copy_from_slice(&bytes[4 * i..4 * i + 4]);
+        let q = f32::from_le_bytes(f) as u16;
+        bytes[2 * i..2 * i + 2].copy_from_slice(&q.to_le_bytes());
     }
 }
 
@@ -400,6 +441,8 @@ impl CaseHeader {
             7 => MethodCode::Lean,
             8 => MethodCode::FastWedges,
             9 => MethodCode::LeanWedges,
+            10 => MethodCode::FastInteger,
+            11 => MethodCode::LeanInteger,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -445,6 +488,8 @@ impl CaseHeader {
             MethodCode::Lean => Entry::Lean,
             MethodCode::FastWedges => Entry::FastWedges,
             MethodCode::LeanWedges => Entry::LeanWedges,
+            MethodCode::FastInteger => Entry::FastInteger,
+            MethodCode::LeanInteger => Entry::LeanInteger,
         }
     }
 
@@ -770,7 +815,9 @@ pub mod lib {
                 | MethodCode::Fast
                 | MethodCode::Lean
                 | MethodCode::FastWedges
-                | MethodCode::LeanWedges => CostKind::Quadric,
+                | MethodCode::LeanWedges
+                | MethodCode::FastInteger
+                | MethodCode::LeanInteger => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c = c.with_features(h.feature_mode != FeatureCode::Off);
@@ -1166,6 +1213,8 @@ mod tests {
             (MethodCode::Lean, 7, Entry::Lean),
             (MethodCode::FastWedges, 8, Entry::FastWedges),
             (MethodCode::LeanWedges, 9, Entry::LeanWedges),
+            (MethodCode::FastInteger, 10, Entry::FastInteger),
+            (MethodCode::LeanInteger, 11, Entry::LeanInteger),
         ];
         for (method, code, entry) in cases {
             let mut h = case();
@@ -1183,13 +1232,37 @@ mod tests {
             );
             assert_eq!(entry.wedges(), matches!(code, 8 | 9), "{method:?}");
             assert_eq!(entry.pipeline(), matches!(code, 6..=9), "{method:?}");
+            assert_eq!(entry.integer(), matches!(code, 10 | 11), "{method:?}");
             // The bound comes first, as the firmware has always run it.
             h.max_error = 0.25;
             assert_eq!(h.entry(), Entry::Bounded);
         }
         let mut b = case().to_bytes();
-        b[30] = 10;
+        b[30] = 12;
         assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
+    }
+
+    /// The in-place conversion of an integer case's positions gives the positions the host
+    /// converts one by one.
+    #[test]
+    fn grid_positions_convert_in_place() {
+        let pos = [[0.0, 1.0, 32767.0], [5.0, 1234.0, 2.0], [7.0, 0.0, 16384.0]];
+        let mut bytes: std::vec::Vec<u8> = pos
+            .iter()
+            .flatten()
+            .flat_map(|x: &f32| x.to_le_bytes())
+            .collect();
+        grid_in_place(&mut bytes);
+        let got: std::vec::Vec<[u16; 3]> = bytes[..18]
+            .chunks_exact(6)
+            .map(|c| {
+                let f = |k: usize| u16::from_le_bytes([c[2 * k], c[2 * k + 1]]);
+                [f(0), f(1), f(2)]
+            })
+            .collect();
+        let want: std::vec::Vec<[u16; 3]> = pos.iter().map(|&p| grid_position(p)).collect();
+        assert_eq!(got, want);
+        assert_eq!(want[0], [0, 1, 32767]);
     }
 
     #[test]

@@ -6,7 +6,12 @@
 //! emulated instructions per collapse, and its outputs must be byte-identical too (exit 1 if
 //! not). A board without the fast mode, or whose fast workspace the mesh does not fit, says so
 //! in its row instead. Then the same again with the lean mode (`pipeline::LeanWorkspace`, case
-//! method `Lean`): its rows say "lean mode".
+//! method `Lean`): its rows say "lean mode". Then both modes in integers (`pipeline::Integer`,
+//! case methods `FastInteger` and `LeanInteger`, the mesh put on the 15-bit grid): their rows
+//! say "fast mode, integer" and "lean mode, integer", their outputs must be byte-identical
+//! too, and a mesh beyond the board's integer workspace is cut to its first triangles that fit
+//! it (and says so). Last, one line per path with its instructions per collapse on the board,
+//! float and integer; a board without the float modes says so and prints the integer lines.
 //!
 //! On a fresh machine it first makes sure the tools are there ([`qemu::preflight`]): a missing
 //! Rust target is installed with `rustup target add`; a missing `qemu-system-arm` is installed
@@ -165,34 +170,63 @@ pub fn run(a: &Args) -> Result<ExitCode> {
     );
     let exact = compare(&case, backend, &host, &device)?;
     sha_row("output sha256", &exact);
-    // 4. The fast mode, then the lean mode: the same mesh, target and board.
+    // 4. The fast mode, then the lean mode, in floats and then in integers: the same mesh,
+    // target and board.
     let mut modes = Vec::new();
-    for mode in [Pipeline::Fast, Pipeline::Lean] {
-        let mode_case = pipeline_case(&case, mode);
-        let (mode_device, mode_run) =
-            qemu::run_case(board, &elf, &mode_case, Duration::from_secs(a.timeout))?;
-        if a.verbose {
-            crate::outln!("{}", mode_run.describe());
+    for integer in [false, true] {
+        for mode in [Pipeline::Fast, Pipeline::Lean] {
+            let path = Path { mode, integer };
+            let mut mode_case = if integer {
+                integer_case(&case, mode)?
+            } else {
+                pipeline_case(&case, mode)
+            };
+            let timeout = Duration::from_secs(a.timeout);
+            let (mut mode_device, mut mode_run) = qemu::run_case(board, &elf, &mode_case, timeout)?;
+            // An integer workspace smaller than the mesh: its first triangles that fit.
+            if let (true, Some(d)) = (integer, &mode_device) {
+                let (v, t) = (
+                    d.header.capacity_vertices as usize,
+                    d.header.capacity_triangles as usize,
+                );
+                if d.header.status == Status::TooBig && v > 0 {
+                    mode_case = subset_that_fits(&mode_case, v, t);
+                    crate::outln!(
+                        "\n{}: the workspace of the {} holds {v} / {t}: its first {} triangles ({} vertices)",
+                        board.name,
+                        path.noun(),
+                        mode_case.triangles.len(),
+                        mode_case.positions.len()
+                    );
+                    (mode_device, mode_run) = qemu::run_case(board, &elf, &mode_case, timeout)?;
+                }
+            }
+            if a.verbose {
+                crate::outln!("{}", mode_run.describe());
+            }
+            let t0 = Instant::now();
+            let mode_host = golden::reference(&mode_case)?;
+            let mode_wall = t0.elapsed();
+            let c = pipeline_rows(
+                board,
+                backend,
+                &mode_case,
+                path,
+                (&mode_host, mode_wall),
+                (mode_device.as_ref(), &mode_run),
+            )?;
+            let line = per_collapse_line(board, &mode_case, path, mode_device.as_ref());
+            modes.push((path, c, line));
         }
-        let t0 = Instant::now();
-        let mode_host = golden::reference(&mode_case)?;
-        let mode_wall = t0.elapsed();
-        let c = pipeline_rows(
-            board,
-            backend,
-            &mode_case,
-            mode,
-            (&mode_host, mode_wall),
-            (mode_device.as_ref(), &mode_run),
-        )?;
-        modes.push((mode, c));
     }
+    crate::outln!();
+    per_collapse_lines(board, &modes);
     crate::outln!();
     let ok = verdict("byte-identical", &exact);
     let mut modes_ok = true;
-    for (mode, c) in &modes {
+    for (path, c, _) in &modes {
         if let Some(c) = c {
-            modes_ok &= verdict(&format!("byte-identical, {} mode", mode.name()), c);
+            modes_ok &= verdict(&format!("byte-identical, {}", path.label()), c);
         }
     }
     Ok(if ok && modes_ok {
@@ -250,6 +284,121 @@ fn pipeline_case(case: &Case, mode: Pipeline) -> Case {
             Pipeline::Lean => MethodName::Lean,
         }),
         ..case.clone()
+    }
+}
+
+/// The run of `case` in the pipeline's `mode` in integers: the same mesh put on the 15-bit
+/// grid, index type and configuration, method `FastInteger` or `LeanInteger`.
+fn integer_case(case: &Case, mode: Pipeline) -> Result<Case> {
+    Ok(Case {
+        name: format!("{}-{}-integer", case.name, mode.name()),
+        mesh: format!("{}, on the 15-bit grid", case.mesh),
+        positions: crate::golden::case::grid_positions(&case.positions)?,
+        method: Some(match mode {
+            Pipeline::Fast => MethodName::FastInteger,
+            Pipeline::Lean => MethodName::LeanInteger,
+        }),
+        ..case.clone()
+    })
+}
+
+/// A path of the pipeline the demo runs: a mode, in floats or in integers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Path {
+    mode: Pipeline,
+    integer: bool,
+}
+
+impl Path {
+    /// "fast mode" or "fast mode, integer": the end of its rows' labels.
+    fn label(self) -> String {
+        if self.integer {
+            format!("{} mode, integer", self.mode.name())
+        } else {
+            format!("{} mode", self.mode.name())
+        }
+    }
+
+    /// "fast mode" or "fast mode in integers": the path in a sentence.
+    fn noun(self) -> String {
+        if self.integer {
+            format!("{} mode in integers", self.mode.name())
+        } else {
+            format!("{} mode", self.mode.name())
+        }
+    }
+}
+
+/// The line of the last block for one path's device run: its instructions per collapse and
+/// the mesh it ran on, or why there is none. `None`: the board has no such mode at all.
+fn per_collapse_line(
+    board: &qemu::Board,
+    case: &Case,
+    path: Path,
+    device: Option<&Outcome>,
+) -> Option<String> {
+    let Some(d) = device.map(|o| &o.header) else {
+        return Some("no result from the firmware".into());
+    };
+    if d.status == Status::TooBig {
+        return (d.capacity_vertices > 0).then(|| {
+            format!(
+                "- (the mesh does not fit the workspace of the {}: {} V / {} T)",
+                path.noun(),
+                d.capacity_vertices,
+                d.capacity_triangles
+            )
+        });
+    }
+    if d.status != Status::Ok || d.collapses == 0 {
+        return Some(format!("- ({})", status_text(d)));
+    }
+    let instr = board.instructions(d.ticks);
+    Some(format!(
+        "{} ({} instructions, {} collapses; {} vertices, {} triangles)",
+        crate::qemu::measure::spaced(instr / u64::from(d.collapses)),
+        crate::qemu::measure::spaced(instr),
+        crate::qemu::measure::spaced(d.collapses.into()),
+        crate::qemu::measure::spaced(case.positions.len() as u64),
+        crate::qemu::measure::spaced(case.triangles.len() as u64)
+    ))
+}
+
+/// The last block: per path, one line of instructions per collapse on the board, each integer
+/// one saying "integer"; a mode the board lacks is said once instead of its line.
+fn per_collapse_lines(board: &qemu::Board, modes: &[(Path, Option<Comparison>, Option<String>)]) {
+    crate::outln!(
+        "instructions per collapse on {} ({}):",
+        board.name,
+        board.core
+    );
+    let lacks = |integer: bool| {
+        modes
+            .iter()
+            .filter(|(p, _, l)| p.integer == integer && l.is_none())
+            .map(|(p, _, _)| p.mode.name())
+            .collect::<Vec<_>>()
+    };
+    let float = lacks(false);
+    if !float.is_empty() {
+        crate::outln!(
+            "  {} has no float {} mode: the integer path only",
+            board.name,
+            float.join(" or ")
+        );
+    }
+    let integer = lacks(true);
+    if !integer.is_empty() {
+        crate::outln!(
+            "  {} has no {} mode in integers",
+            board.name,
+            integer.join(" or ")
+        );
+    }
+    for (path, _, line) in modes {
+        if let Some(line) = line {
+            crate::outln!("  {:<20} {line}", path.label());
+        }
     }
 }
 
@@ -413,24 +562,25 @@ fn instructions_text(board: &qemu::Board, d: &meshfmt::ResultHeader) -> String {
     )
 }
 
-/// The rows of the fast or the lean mode (`mode`): the host's and the device's run of `case`
-/// (method `Fast` or `Lean`), each label ending in "fast mode" or "lean mode". Returns their
-/// comparison, or `None` when the device did not run it because the mesh does not fit the
-/// mode's workspace or the board has none (the row says which).
+/// The rows of a path of the pipeline (the fast or the lean mode, in floats or in integers):
+/// the host's and the device's run of `case` (method `Fast`, `Lean`, `FastInteger` or
+/// `LeanInteger`), each label ending in the path's ("fast mode", "lean mode, integer").
+/// Returns their comparison, or `None` when the device did not run it because the mesh does
+/// not fit the mode's workspace or the board has none (the row says which).
 fn pipeline_rows(
     board: &qemu::Board,
     backend: Backend,
     case: &Case,
-    mode: Pipeline,
+    path: Path,
     (host, host_wall): (&Outcome, Duration),
     (device, run): (Option<&Outcome>, &qemu::Run),
 ) -> Result<Option<Comparison>> {
     crate::outln!();
-    let name = mode.name();
+    let name = path.label();
     let h = &host.header;
     let Some(device) = device else {
         row(
-            &format!("{name} mode"),
+            &name,
             status_text(h),
             format!("no result: {}", run.describe()),
         );
@@ -443,34 +593,27 @@ fn pipeline_rows(
     let d = &device.header;
     if d.status == Status::TooBig {
         let why = if d.capacity_vertices == 0 {
-            format!("{} has no {name} mode", board.name)
+            format!("{} has no {}", board.name, path.noun())
         } else {
             format!(
-                "does not fit the {name} workspace ({} V / {} T)",
-                d.capacity_vertices, d.capacity_triangles
+                "does not fit the workspace of the {} ({} V / {} T)",
+                path.noun(),
+                d.capacity_vertices,
+                d.capacity_triangles
             )
         };
-        row(&format!("{name} mode"), status_text(h), why);
+        row(&name, status_text(h), why);
         return Ok(None);
     }
+    row(&format!("status, {name}"), status_text(h), status_text(d));
+    run_rows(&format!(", {name}"), board, (h, d), host_wall, run.wall);
     row(
-        &format!("status, {name} mode"),
-        status_text(h),
-        status_text(d),
-    );
-    run_rows(
-        &format!(", {name} mode"),
-        board,
-        (h, d),
-        host_wall,
-        run.wall,
-    );
-    row(
-        &format!("workspace RAM, {name} mode"),
+        &format!("workspace RAM, {name}"),
         format!(
+            // An integer workspace takes the float one's bytes: its quadric is 24 B too.
             "{} B (sized to the mesh)",
             crate::qemu::measure::spaced(crate::simplify::pipeline_bytes(
-                mode,
+                path.mode,
                 case.positions.len(),
                 case.triangles.len()
             ) as u64),
@@ -483,7 +626,7 @@ fn pipeline_rows(
         ),
     );
     row(
-        &format!("stack high-water, {name} mode"),
+        &format!("stack high-water, {name}"),
         "-".into(),
         format!(
             "{} B (library: {} B)",
@@ -492,13 +635,13 @@ fn pipeline_rows(
         ),
     );
     let c = compare(case, backend, host, device)?;
-    sha_row(&format!("output sha256, {name} mode"), &c);
+    sha_row(&format!("output sha256, {name}"), &c);
     Ok(Some(c))
 }
 
-/// One line of the side-by-side table.
+/// One line of the side-by-side table (the longest label: an integer path's instructions).
 fn row(k: &str, x: String, y: String) {
-    crate::outln!("{k:<32} {x:<46} {y}");
+    crate::outln!("{k:<41} {x:<46} {y}");
 }
 
 /// The host's and the device's outputs of one case, as golden files, and how they compare.
@@ -655,6 +798,50 @@ mod tests {
             instructions_text(board, &d),
             crate::qemu::measure::spaced(instr)
         );
+    }
+
+    /// The demo's integer runs are cases of method `FastInteger` (code 10) and `LeanInteger`
+    /// (code 11) on the mesh put on the grid, whose host reference is the library's integer
+    /// workspace on those grid positions; their labels say "integer".
+    #[test]
+    fn the_integer_runs_are_the_integer_modes() {
+        let m = meshfmt::golden::bumpy_grid(10);
+        let case = Case {
+            name: "g".into(),
+            mesh: "grid 10".into(),
+            positions: m.positions,
+            triangles: m.triangles,
+            wedges: Vec::new(),
+            index_type: IndexType::U16,
+            config: Config::new(),
+            stored: None,
+            method: None,
+        };
+        let mut want = vec![[0u16; 3]; case.positions.len()];
+        tinydecimate::pipeline::quantise(&case.positions, &mut want).unwrap();
+        for (mode, code) in [(Pipeline::Fast, 10), (Pipeline::Lean, 11)] {
+            let c = integer_case(&case, mode).unwrap();
+            assert_eq!(c.encode().unwrap()[30], code);
+            assert_eq!(c.triangles, case.triangles);
+            let grid: Vec<[u16; 3]> = c
+                .positions
+                .iter()
+                .map(|&p| meshfmt::grid_position(p))
+                .collect();
+            assert_eq!(grid, want);
+            let host = golden::reference(&c).unwrap();
+            let mut t = case.triangles.clone();
+            let r = crate::simplify::pipeline_run_grid(mode, &grid, &mut t, &case.config).unwrap();
+            t.truncate(r.triangles_out);
+            assert_eq!(host.triangles, t);
+            assert_eq!(host.header.collapses as usize, r.collapses);
+            let label = Path {
+                mode,
+                integer: true,
+            }
+            .label();
+            assert_eq!(label, format!("{} mode, integer", mode.name()));
+        }
     }
 
     #[test]

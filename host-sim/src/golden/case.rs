@@ -83,6 +83,13 @@ pub enum MethodName {
     FastWedges,
     /// The lean mode with wedges (`LeanWorkspace::simplify_with_wedges`), as `FastWedges`.
     LeanWedges,
+    /// The fast mode in integers (`FastWorkspace<_, _, _, pipeline::Integer>::simplify`): the
+    /// host puts the mesh on the 15-bit grid (`pipeline::quantise`), the case file carries the
+    /// grid coordinates.
+    FastInteger,
+    /// The lean mode in integers (`LeanWorkspace<_, _, _, pipeline::Integer>::simplify`), as
+    /// `FastInteger`.
+    LeanInteger,
 }
 
 impl MethodName {
@@ -95,6 +102,27 @@ impl MethodName {
             MethodName::Lean => MethodCode::Lean,
             MethodName::FastWedges => MethodCode::FastWedges,
             MethodName::LeanWedges => MethodCode::LeanWedges,
+            MethodName::FastInteger => MethodCode::FastInteger,
+            MethodName::LeanInteger => MethodCode::LeanInteger,
+        }
+    }
+
+    /// Whether the method runs in integers on grid positions.
+    pub fn integer(self) -> bool {
+        matches!(self, MethodName::FastInteger | MethodName::LeanInteger)
+    }
+
+    /// The pipeline's mode of a fast or lean method (`None` for the other methods).
+    pub fn pipeline(self) -> Option<crate::simplify::Pipeline> {
+        use crate::simplify::Pipeline;
+        match self {
+            MethodName::Fast | MethodName::FastWedges | MethodName::FastInteger => {
+                Some(Pipeline::Fast)
+            }
+            MethodName::Lean | MethodName::LeanWedges | MethodName::LeanInteger => {
+                Some(Pipeline::Lean)
+            }
+            MethodName::VertexDecimation | MethodName::Energy => None,
         }
     }
 }
@@ -152,8 +180,9 @@ pub struct CaseSpec {
     pub quadric: Option<QuadricName>,
     /// Optional: `vertex-decimation` (the operator `VertexDecimation`), `energy` (the cost
     /// `cost::Energy`), `fast` (the fast mode, `pipeline::FastWorkspace`), `lean` (the lean
-    /// mode, `pipeline::LeanWorkspace`), or `fast-wedges` / `lean-wedges` (either on the mesh
-    /// welded by position with its wedges); none with `quadric` or `max_error`.
+    /// mode, `pipeline::LeanWorkspace`), `fast-wedges` / `lean-wedges` (either on the mesh
+    /// welded by position with its wedges), or `fast-integer` / `lean-integer` (either in
+    /// integers, on the mesh put on the 15-bit grid); none with `quadric` or `max_error`.
     #[serde(default)]
     pub method: Option<MethodName>,
     /// Optional: the guaranteed error bound (the control points of Zhu, Wang and Meng 2007,
@@ -229,6 +258,14 @@ pub fn load_mesh(name: &str, spec: &str) -> Result<meshfmt::golden::Mesh> {
             }
         }
     })
+}
+
+/// `positions` put on the 15-bit grid (`pipeline::quantise`), each grid coordinate as the
+/// `f32` an integer case file carries (exact: below 2¹⁵).
+pub fn grid_positions(positions: &[[f32; 3]]) -> Result<Vec<[f32; 3]>> {
+    let mut grid = vec![[0u16; 3]; positions.len()];
+    tinydecimate::pipeline::quantise(positions, &mut grid).map_err(|e| anyhow!("quantise: {e}"))?;
+    Ok(grid.iter().map(|q| q.map(f32::from)).collect())
 }
 
 /// A mesh and how to simplify it.
@@ -317,6 +354,15 @@ impl Case {
             .map_err(|e| anyhow!("case {name}: weld: {e}"))?;
             let _ = write!(desc, ", welded by position with its wedges");
         }
+        // An integer method gets the mesh on the 15-bit grid, each grid coordinate written as an
+        // `f32` (exact): the case file keeps its layout and the firmware converts in place
+        // (`meshfmt::grid_position`). The configuration carries no error limit, so none needs
+        // converting to grid cells.
+        if spec.method.is_some_and(MethodName::integer) {
+            mesh.positions =
+                grid_positions(&mesh.positions).with_context(|| format!("case {name}"))?;
+            let _ = write!(desc, ", on the 15-bit grid (pipeline::quantise)");
+        }
         Ok(Case {
             name: name.clone(),
             mesh: desc,
@@ -353,6 +399,17 @@ impl Case {
             h.method = m.code();
         }
         h
+    }
+
+    /// A case of the pipeline in integers stands beside the float case of the same mesh,
+    /// target and mode: its name without "-integer" (`cow-fast-integer-u16` beside
+    /// `cow-fast-u16`). `None` for any other case.
+    pub fn float_twin(&self) -> Option<String> {
+        if !self.method.is_some_and(MethodName::integer) {
+            return None;
+        }
+        let (head, tail) = self.name.split_once("-integer")?;
+        Some(format!("{head}{tail}"))
     }
 
     /// Whether the run borrows one `[f32; 10]` per vertex (stored quadrics, the energy's
@@ -448,16 +505,37 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
             .map(|[a, b, c]| Ok([a?, b?, c?]))
             .collect()
     };
+    // An integer case's positions as the firmware converts them.
+    let grid: Vec<[u16; 3]> = if entry.integer() {
+        positions
+            .iter()
+            .map(|&p| meshfmt::grid_position(p))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let (outcome, tris): (_, Vec<[u32; 3]>) = match case.index_type {
         IndexType::U16 => {
             let (mut t, mut w) = (narrow(&case.triangles)?, narrow(&case.wedges)?);
-            let r = run_reference(ws, &mut positions, (&mut t, &mut w), &config, entry);
+            let r = run_reference(
+                ws,
+                (&mut positions, &grid),
+                (&mut t, &mut w),
+                &config,
+                entry,
+            );
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             (r, t[..n].iter().map(|t| t.map(u32::from)).collect())
         }
         IndexType::U32 => {
             let (mut t, mut w) = (case.triangles.clone(), case.wedges.clone());
-            let r = run_reference(ws, &mut positions, (&mut t, &mut w), &config, entry);
+            let r = run_reference(
+                ws,
+                (&mut positions, &grid),
+                (&mut t, &mut w),
+                &config,
+                entry,
+            );
             let n = r.as_ref().map_or(0, |r| r.triangles_out);
             t.truncate(n);
             (r, t)
@@ -473,10 +551,11 @@ fn reference_with(ws: &mut HostWorkspace, case: &Case) -> Result<Outcome> {
     })
 }
 
-/// The library call a case asks for, as the firmware makes it.
+/// The library call a case asks for, as the firmware makes it (`grid`: an integer case's
+/// positions).
 fn run_reference<I: tinydecimate::Index>(
     ws: &mut HostWorkspace,
-    positions: &mut [[f32; 3]],
+    (positions, grid): (&mut [[f32; 3]], &[[u16; 3]]),
     (triangles, wedges): (&mut [[I; 3]], &mut [[I; 3]]),
     config: &Config,
     entry: Entry,
@@ -557,5 +636,17 @@ fn run_reference<I: tinydecimate::Index>(
             };
             crate::simplify::pipeline_run_wedges(mode, positions, (triangles, wedges), config)?
         }
+        Entry::FastInteger => crate::simplify::pipeline_run_grid(
+            crate::simplify::Pipeline::Fast,
+            grid,
+            triangles,
+            config,
+        )?,
+        Entry::LeanInteger => crate::simplify::pipeline_run_grid(
+            crate::simplify::Pipeline::Lean,
+            grid,
+            triangles,
+            config,
+        )?,
     })
 }

@@ -157,6 +157,14 @@ impl Golden {
                 w,
                 "method = \"the lean mode with wedges (LeanWorkspace::simplify_with_wedges)\""
             )?,
+            Some(super::case::MethodName::FastInteger) => writeln!(
+                w,
+                "method = \"the fast mode in integers (FastWorkspace<_, _, _, Integer>)\""
+            )?,
+            Some(super::case::MethodName::LeanInteger) => writeln!(
+                w,
+                "method = \"the lean mode in integers (LeanWorkspace<_, _, _, Integer>)\""
+            )?,
             None => {}
         }
         if case.config.max_error().is_finite() {
@@ -329,6 +337,10 @@ pub fn judge(
                 " (the fast mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
             } else if case.method == Some(super::case::MethodName::Lean) {
                 " (the lean mode's workspace: the firmware's FAST_VERTICES and FAST_TRIANGLES, 0 without it)"
+            } else if case.method == Some(super::case::MethodName::FastInteger) {
+                " (the integer fast mode's workspace: the firmware's INT_FAST_VERTICES and INT_FAST_TRIANGLES, 0 without it)"
+            } else if case.method == Some(super::case::MethodName::LeanInteger) {
+                " (the integer lean mode's workspace: the firmware's INT_LEAN_VERTICES and INT_LEAN_TRIANGLES, 0 without it)"
             } else if case.config.max_error().is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {

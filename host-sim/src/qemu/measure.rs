@@ -110,6 +110,9 @@ pub struct CaseMeasurement {
     pub verdict: &'static str,
     /// Why it was skipped or failed.
     pub note: String,
+    /// For a case of the pipeline in integers, the float case it stands beside
+    /// ([`Case::float_twin`]).
+    pub float_twin: Option<String>,
 }
 
 /// The largest mesh a board simplifies, found by bisection.
@@ -277,6 +280,7 @@ pub fn measure(
                 stack_high_water: 0,
                 verdict: "FAILED",
                 note: run.describe(),
+                float_twin: case.float_twin(),
             });
             continue;
         };
@@ -304,6 +308,7 @@ pub fn measure(
                 Verdict::Diff(d) => d.join("; "),
                 Verdict::Identical => String::new(),
             },
+            float_twin: case.float_twin(),
         });
     }
     let mut largest = Vec::new();
@@ -447,6 +452,17 @@ pub fn print_measurement(m: &Measurement) {
             c.verdict
         );
     }
+    for (integer, float) in integer_beside_float(m) {
+        crate::outln!(
+            "  {:<26} {:>11} instr/coll in integers; {} {}",
+            integer.name,
+            per_collapse_of(integer).map_or("-".into(), |p| p.to_string()),
+            float.map_or("-", |f| f.name.as_str()),
+            float
+                .and_then(per_collapse_of)
+                .map_or("not run here".into(), |p| format!("{p} in floats"))
+        );
+    }
     for l in &m.largest {
         let it = if l.index_type == IndexType::U16 {
             "u16"
@@ -549,6 +565,24 @@ pub fn print_summary(ms: &[Measurement]) {
     }
 }
 
+/// Instructions per collapse of a case the board ran identically (`None`: skipped, failed,
+/// or no collapse).
+fn per_collapse_of(c: &CaseMeasurement) -> Option<u64> {
+    (c.verdict == "identical" && c.collapses > 0).then(|| c.instructions / u64::from(c.collapses))
+}
+
+/// The board's integer cases, each with its float case's measurement on the same board (if the
+/// manifest has it).
+fn integer_beside_float(m: &Measurement) -> Vec<(&CaseMeasurement, Option<&CaseMeasurement>)> {
+    m.cases
+        .iter()
+        .filter_map(|c| {
+            let twin = c.float_twin.as_deref()?;
+            Some((c, m.cases.iter().find(|f| f.name == twin)))
+        })
+        .collect()
+}
+
 /// The least and the most instructions per collapse over the cases a board ran.
 fn per_collapse(m: &Measurement) -> Option<(u64, u64)> {
     let per = m
@@ -643,6 +677,42 @@ pub fn markdown(ms: &[Measurement]) -> String {
                 spaced(c.instructions),
                 spaced(per),
                 spaced(u64::from(c.stack_bytes))
+            );
+        }
+    }
+    // The integer path beside the float path: per integer case its float case on the same
+    // board (the boards without an FPU run both in software) and on the reference board.
+    let reference = ms.iter().find(|m| m.board.name == super::REFERENCE_BOARD);
+    let _ = write!(
+        s,
+        "\n## Integer path\n\nEvery case of the pipeline in integers (`pipeline::Integer`, the mesh \
+         on the 15-bit grid) beside its float case (the same mesh and target): instructions per \
+         collapse on the board, of the float case on the same board (- where the board has no \
+         float mode or skips it) and on {} (Cortex-M4F, FPU).\n\n\
+         | board | integer case | per collapse | float case | float per collapse | float on {} |\n\
+         |---|---|---:|---|---:|---:|\n",
+        super::REFERENCE_BOARD,
+        super::REFERENCE_BOARD
+    );
+    for m in ms {
+        for (integer, float) in integer_beside_float(m) {
+            let Some(per) = per_collapse_of(integer) else {
+                continue;
+            };
+            let twin = integer.float_twin.as_deref().unwrap_or("-");
+            let cell = |c: Option<&CaseMeasurement>| {
+                c.and_then(per_collapse_of).map_or("-".into(), spaced)
+            };
+            let on_reference = reference.and_then(|r| r.cases.iter().find(|f| f.name == twin));
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} | {} |",
+                m.board.name,
+                integer.name,
+                spaced(per),
+                twin,
+                cell(float),
+                cell(on_reference)
             );
         }
     }
