@@ -1319,10 +1319,11 @@ mod tests {
                 .count();
             // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table,
             // one in the whole-run error table and one per run that stopped short in the
-            // stopped-short table.
+            // stopped-short table; an integer mode one more in the integer-against-float table.
             let extra = if method.is_ours() {
                 QUICK_RATIOS.len()
                     + 1
+                    + usize::from(method.integer())
                     + r.rows
                         .iter()
                         .filter(|x| x.method == method && !x.target_reached)

@@ -2,7 +2,33 @@
 //! `integer`).
 
 use super::{bump_end, set_end};
+use crate::error::Capacity;
 use crate::index::Index;
+use crate::Error;
+
+/// The mesh's vertices and triangles against the workspace's capacities: the first check of
+/// either arithmetic's validation, before anything is written.
+#[inline]
+pub(super) fn fits(
+    (vertices, triangles): (usize, usize),
+    (cv, ct): (usize, usize),
+) -> Result<(), Error> {
+    if vertices > cv {
+        return Err(Error::Capacity {
+            what: Capacity::Vertices,
+            needed: vertices,
+            available: cv,
+        });
+    }
+    if triangles > ct {
+        return Err(Error::Capacity {
+            what: Capacity::Triangles,
+            needed: triangles,
+            available: ct,
+        });
+    }
+    Ok(())
+}
 
 /// Fan lists of the first `nt` triangles (a counting sort of their corners by vertex, as
 /// meshoptimizer's `buildTriangleAdjacency`), from the corner counts that compact left in

@@ -14,7 +14,7 @@
 
 use super::geometry::{Float, Geometry, Goal};
 use super::{fan, flag, flags_of, link, others, tri, Arithmetic, BINS};
-use crate::error::{Capacity, Error};
+use crate::error::Error;
 use crate::index::Index;
 use crate::legality::Reject;
 use crate::math::{self, V3};
@@ -55,20 +55,7 @@ fn validate<'p, I: Index>(
     (vertices, capacity): (usize, usize),
     used: &mut [u8],
 ) -> Result<Frame<'p>, Error> {
-    if positions.len() > vertices {
-        return Err(Error::Capacity {
-            what: Capacity::Vertices,
-            needed: positions.len(),
-            available: vertices,
-        });
-    }
-    if triangles.len() > capacity {
-        return Err(Error::Capacity {
-            what: Capacity::Triangles,
-            needed: triangles.len(),
-            available: capacity,
-        });
-    }
+    super::build::fits((positions.len(), triangles.len()), (vertices, capacity))?;
     // Each used vertex's position is read once (marked in its flag byte), not once per
     // corner; the first bad index or coordinate in corner order, which the error names, is
     // searched for only when there is one (`x * 0.0` is zero exactly when `x` is finite).

@@ -120,20 +120,7 @@ fn validate<'p, I: Index>(
     (vertices, capacity): (usize, usize),
     used: &mut [u8],
 ) -> Result<Grid<'p>, Error> {
-    if positions.len() > vertices {
-        return Err(Error::Capacity {
-            what: Capacity::Vertices,
-            needed: positions.len(),
-            available: vertices,
-        });
-    }
-    if triangles.len() > capacity {
-        return Err(Error::Capacity {
-            what: Capacity::Triangles,
-            needed: triangles.len(),
-            available: capacity,
-        });
-    }
+    super::build::fits((positions.len(), triangles.len()), (vertices, capacity))?;
     let used = used.get_mut(..positions.len()).unwrap_or(&mut []);
     used.fill(0);
     let (mut lo, mut hi) = ([u16::MAX; 3], [0u16; 3]);
@@ -259,30 +246,9 @@ fn dot14(a: [i32; 3], b: [i32; 3]) -> i32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `⌊√x⌋` of a `u32`, digit by digit (the reference [`root`] is tested against).
-#[cfg(test)]
-#[inline]
-fn isqrt32(x: u32) -> u32 {
-    let (mut x, mut r) = (x, 0u32);
-    let mut b = 1u32 << 30;
-    while b > x {
-        b >>= 2;
-    }
-    while b != 0 {
-        if x >= r + b {
-            x -= r + b;
-            r = (r >> 1) + b;
-        } else {
-            r >>= 1;
-        }
-        b >>= 2;
-    }
-    r
-}
-
 /// `⌊√x⌋` for `x` in `[2²⁶, 3·2²⁸]` (a shifted normal's squared length): two Newton steps
 /// from a line through the ends of the range (within 13 %) and a last correction, so exactly
-/// [`isqrt32`]'s floor (over the whole range: checked exhaustively once, sampled by the unit
+/// [`isqrt`]'s floor (over the whole range: checked exhaustively once, sampled by the unit
 /// test) in fewer operations where a core divides in one instruction. Exact, not near: the
 /// pipeline's order on flat CAD regions turns on the last bits of the planes.
 #[inline]
@@ -800,7 +766,11 @@ impl GridFrame {
     /// The float position of grid position `q`.
     pub fn position(&self, q: [u16; 3]) -> [f32; 3] {
         let ([x, y, z], [ox, oy, oz], s) = (q, self.origin, self.step);
-        [ox + f32::from(x) * s, oy + f32::from(y) * s, oz + f32::from(z) * s]
+        [
+            ox + f32::from(x) * s,
+            oy + f32::from(y) * s,
+            oz + f32::from(z) * s,
+        ]
     }
 
     /// The most a position moves by quantisation: half a cell's diagonal, `step · √3 / 2`.
@@ -888,10 +858,10 @@ mod tests {
     fn the_root_of_a_shifted_length_is_the_floor() {
         let mut x = 1u32 << 26;
         for y in [(1u32 << 26) + 1, 3 << 28, (1 << 28) - 1, 1 << 28] {
-            assert_eq!(root(y), isqrt32(y), "{y}");
+            assert_eq!(u64::from(root(y)), isqrt(u64::from(y)), "{y}");
         }
         while x <= 3 << 28 {
-            assert_eq!(root(x), isqrt32(x), "{x}");
+            assert_eq!(u64::from(root(x)), isqrt(u64::from(x)), "{x}");
             x += 9_973;
         }
     }

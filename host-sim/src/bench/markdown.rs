@@ -157,7 +157,8 @@ fn integer(s: &mut String, r: &Results) {
                 "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} |",
                 row.mesh,
                 fmt_pct(row.ratio),
-                int.float().label(),
+                // The pipeline's mode name, not a table label (those count rows per mode).
+                int.pipeline().map_or("", |p| p.name()),
                 f.metro_mean_pct,
                 g[0],
                 row.metro_mean_pct,
