@@ -32,21 +32,7 @@ static LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072, Integer>> = Mutex::new(Le
 static FLOAT_FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
 static FLOAT_LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
 
-/// The pipeline's modes.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Mode {
-    Fast,
-    Lean,
-}
-
-/// Both modes, or the one `PIPELINE_MODE` (`fast` or `lean`) names, as in tests/pipeline.rs.
-fn modes() -> Vec<Mode> {
-    match std::env::var("PIPELINE_MODE").as_deref() {
-        Ok("fast") => vec![Mode::Fast],
-        Ok("lean") => vec![Mode::Lean],
-        _ => vec![Mode::Fast, Mode::Lean],
-    }
-}
+use common::{modes, Mode};
 
 /// A mesh on the grid: the grid positions the run reads, and the same mesh on their float
 /// positions (`GridFrame::position`), which the checker reads.

@@ -13,22 +13,7 @@ use tinydecimate::{Capacity, Config, Error, Report, Stop};
 static BIG_FAST: Mutex<FastWorkspace<u32, 65_536, 131_072>> = Mutex::new(FastWorkspace::new());
 static BIG_LEAN: Mutex<LeanWorkspace<u32, 65_536, 131_072>> = Mutex::new(LeanWorkspace::new());
 
-/// The pipeline's modes.
-#[derive(Clone, Copy, Debug)]
-enum Mode {
-    Fast,
-    Lean,
-}
-
-/// Both modes, or the one `PIPELINE_MODE` (`fast` or `lean`) names: with a rule switched off
-/// (`PIPELINE_RULE_OFF`), each mode alone must fail.
-fn modes() -> Vec<Mode> {
-    match std::env::var("PIPELINE_MODE").as_deref() {
-        Ok("fast") => vec![Mode::Fast],
-        Ok("lean") => vec![Mode::Lean],
-        _ => vec![Mode::Fast, Mode::Lean],
-    }
-}
+use common::{modes, Mode};
 
 fn fixtures() -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(shared_meshes())

@@ -447,3 +447,20 @@ pub fn kept_of(input: &MeshData, output: &MeshData, part: &std::ops::Range<u32>)
     let kept = output.triangles.iter().filter(|t| inside(t)).count();
     (kept, total)
 }
+
+/// The pipeline's modes (tests/pipeline.rs, tests/integer.rs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mode {
+    Fast,
+    Lean,
+}
+
+/// Both pipeline modes, or the one `PIPELINE_MODE` (`fast` or `lean`) names: with a rule
+/// switched off (`PIPELINE_RULE_OFF`), each mode alone must fail.
+pub fn modes() -> Vec<Mode> {
+    match std::env::var("PIPELINE_MODE").as_deref() {
+        Ok("fast") => vec![Mode::Fast],
+        Ok("lean") => vec![Mode::Lean],
+        _ => vec![Mode::Fast, Mode::Lean],
+    }
+}
