@@ -412,43 +412,111 @@ impl Config {
         use crate::{ConfigField as F, Error};
         let bad = |field| Err(Error::InvalidConfig { field });
         if let Target::Ratio(r) = self.target {
-            if !(0.0..=1.0).contains(&r) {
+            if !(le(0.0, r) && le(r, 1.0)) {
                 return bad(F::Target);
             }
         }
-        if self.max_cost.is_nan() || self.max_cost < 0.0 {
+        if !le(0.0, self.max_cost) {
             return bad(F::MaxCost);
         }
         if self.max_passes == 0 {
             return bad(F::MaxPasses);
         }
-        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+        if !(finite(self.lambda) && le(0.0, self.lambda)) {
             return bad(F::Lambda);
         }
-        if !(self.max_normal_turn_deg > 0.0 && self.max_normal_turn_deg < 180.0) {
+        if !(lt(0.0, self.max_normal_turn_deg) && lt(self.max_normal_turn_deg, 180.0)) {
             return bad(F::MaxNormalTurn);
         }
-        if !(self.min_quality >= 0.0 && self.min_quality < 1.0) {
+        if !(le(0.0, self.min_quality) && lt(self.min_quality, 1.0)) {
             return bad(F::MinQuality);
         }
-        if !(self.boundary_weight.is_finite() && self.boundary_weight >= 0.0) {
+        if !(finite(self.boundary_weight) && le(0.0, self.boundary_weight)) {
             return bad(F::BoundaryWeight);
         }
-        if self.max_error.is_nan() || self.max_error < 0.0 {
+        if !le(0.0, self.max_error) {
             return bad(F::MaxError);
         }
-        if self.error_limit.is_nan() || self.error_limit < 0.0 {
+        if !le(0.0, self.error_limit) {
             return bad(F::ErrorLimit);
         }
-        if !(self.control_angle_deg > 0.0 && self.control_angle_deg < 180.0) {
+        if !(lt(0.0, self.control_angle_deg) && lt(self.control_angle_deg, 180.0)) {
             return bad(F::ControlAngle);
         }
         Ok(())
     }
 }
 
+// The configuration is checked with integer compares on the floats' bits: on a core without
+// an FPU every float compare is a library call, and the integer pipeline would carry them for
+// this alone.
+
+/// Whether `x` is NaN.
+const fn nan(x: f32) -> bool {
+    x.to_bits() & 0x7fff_ffff > 0x7f80_0000
+}
+
+/// Whether `x` is finite.
+const fn finite(x: f32) -> bool {
+    x.to_bits() & 0x7fff_ffff < 0x7f80_0000
+}
+
+/// `x`'s place in `f32`'s order as an `i32`, `-0` and `+0` together (NaN excluded by callers).
+const fn order(x: f32) -> i32 {
+    let b = x.to_bits() as i32;
+    if b < 0 {
+        -(b & i32::MAX)
+    } else {
+        b
+    }
+}
+
+/// `a <= b`, false with a NaN.
+const fn le(a: f32, b: f32) -> bool {
+    !nan(a) && !nan(b) && order(a) <= order(b)
+}
+
+/// `a < b`, false with a NaN.
+const fn lt(a: f32, b: f32) -> bool {
+    !nan(a) && !nan(b) && order(a) < order(b)
+}
+
 impl Default for Config {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_integer_compares_agree_with_the_float_ones() {
+        let mut values = [0.0f32, -0.0, 1.0, -1.0, 180.0, 1e-45, -1e-45, 0.5, f32::MAX].to_vec();
+        values.extend([
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+            179.99998,
+        ]);
+        let mut x = 0x1234_5678u32;
+        for _ in 0..2_000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            values.push(f32::from_bits(x));
+        }
+        for &a in &values {
+            assert_eq!(nan(a), a.is_nan(), "{a}");
+            assert_eq!(finite(a), a.is_finite(), "{a}");
+            for &b in values.iter().take(40) {
+                assert_eq!(le(a, b), a <= b, "{a} <= {b}");
+                assert_eq!(lt(a, b), a < b, "{a} < {b}");
+                assert_eq!(le(b, a), b <= a, "{b} <= {a}");
+                assert_eq!(lt(b, a), b < a, "{b} < {a}");
+            }
+        }
     }
 }

@@ -379,6 +379,11 @@ impl Geometry for Frame<'_> {
     }
 
     #[inline]
+    fn target(target: crate::Target, valid: usize) -> usize {
+        target.triangles(valid)
+    }
+
+    #[inline]
     fn limit(&self, distance: f32) -> f32 {
         // A squared distance in the unit frame.
         let l = distance * self.scale;

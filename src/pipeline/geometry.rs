@@ -150,6 +150,8 @@ pub trait Geometry {
     /// The counting sort's bin of a stored price (below `super::BINS`, monotone).
     fn key(bits: u32) -> usize;
 
+    /// [`Target::triangles`](crate::Target::triangles): the triangle count a run stops at.
+    fn target(target: crate::Target, valid: usize) -> usize;
     /// The error limit (a distance in the positions' units) as an error.
     fn limit(&self, distance: f32) -> Self::Err;
     /// Whether error `e` is over `limit` (NaN is).

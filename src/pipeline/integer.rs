@@ -18,7 +18,7 @@
 //! (`s < 2³⁴`): the float rule's `|n|² > 10⁻⁸ s²` with `2⁻²⁶` for `10⁻⁸`.
 //!
 //! **Quadrics.** A plane's unit normal in Q15 (from the shifted normal, its length by an
-//! integer square root and one division) and its weight in [`AREA`] units (1/16 grid cell):
+//! integer square root and one reciprocal) and its weight in [`AREA`] units (1/16 grid cell):
 //! an area below `2^30.8` cells (`|c| < √3·2³¹`), times 16, times the border weight 10, is
 //! below `2^38.2`; `n nᵀ` in Q22 (below `2²²`) times a weight fits `i64` (`< 2^60.2`), and a
 //! fan's sum of at most 32 faces and its border and seam planes is below `2⁴⁴`. Summed in
@@ -33,6 +33,14 @@
 //! weight over the fan's area, as the float cost), up to `2⁸⁴`, so it is stored as a
 //! [`pack`]ed `u32`: a 6-bit exponent and 26 bits of mantissa, ordered as the value (as an
 //! `f32`'s bits are), and binned by its top 10 bits.
+//!
+//! **Cores without a divide, a long multiply or a count of leading zeros** (the Cortex-M0,
+//! `cfg(armv6m)` from `build.rs`): the same numbers from routines without them ([`wide`],
+//! [`root_by_table`], [`reciprocal_by_newton`], [`leading_zeros`]), each checked against the
+//! native operation by the unit tests; elsewhere the native operation, fewer instructions.
+//!
+//! **The configuration** is read from its floats' bits ([`ratio_of`], `limit`): the run has
+//! no float operation at all.
 
 use super::geometry::{Geometry, Goal, Integer};
 use super::{Arithmetic, BINS};
@@ -49,9 +57,9 @@ const AREA: u32 = 16;
 const ERR: u64 = 256;
 
 /// meshoptimizer's `kEdgeWeightBorder`, as in the float pipeline.
-const BORDER_WEIGHT: u64 = 10;
+const BORDER_WEIGHT: u32 = 10;
 /// The seam planes' weight, the float pipeline's 0.1 (a division by 10).
-const SEAM_DIVISOR: u64 = 10;
+const SEAM_DIVISOR: u16 = 10;
 /// The fold limit `0.89²` in Q16 (rounded up: refuses a hair more than the float test).
 const FOLD2_Q16: u64 = 51_911;
 /// The sliver preference's `quality² = 12 |n|² / s²` floor, `0.05²`, as `12 |n|² · 4800 < s²`
@@ -70,7 +78,7 @@ pub struct Grid<'p> {
     /// `AREA · E`, with `E` the power of two with the grid extent over `E` in `[1, 2)`: the
     /// float pipeline's edge weight `10 · length` in its unit frame is `10 · length · E` cells²
     /// here.
-    edge_unit: u64,
+    edge_unit: u32,
 }
 
 /// A quadric being summed: the six entries of `Σ w n nᵀ` in [`AREA`] units.
@@ -154,35 +162,164 @@ fn validate<'p, I: Index>(
     let e = if extent == 0 {
         1
     } else {
-        1u64 << (15 - extent.leading_zeros())
+        1u64 << (31 - leading_zeros(u32::from(extent)))
     };
     Ok(Grid {
         positions,
-        edge_unit: u64::from(AREA) * e,
+        edge_unit: AREA * e as u32,
     })
 }
 
 /// Bits of `x` (0 for 0).
 #[inline]
 fn bits(x: u64) -> u32 {
-    64 - x.leading_zeros()
+    let high = (x >> 32) as u32;
+    if high != 0 {
+        64 - leading_zeros(high)
+    } else {
+        32 - leading_zeros(x as u32)
+    }
 }
 
-/// `⌊√x⌋`, digit by digit (no division: a Cortex-M0 has none).
+/// `x.leading_zeros()`: the core's instruction, or on a core without one (a Cortex-M0, where
+/// it is a library call; an RV32 core without Zbb, where the compiler spells it out at every
+/// use) a binary search, one copy.
+#[inline(always)]
+fn leading_zeros(x: u32) -> u32 {
+    #[cfg(any(armv6m, all(target_arch = "riscv32", not(target_feature = "zbb"))))]
+    return zeros_by_halving(x);
+    #[cfg(not(any(armv6m, all(target_arch = "riscv32", not(target_feature = "zbb")))))]
+    return x.leading_zeros();
+}
+
+/// [`leading_zeros`] by halving the window: 16, 8, 4, 2 and 1 bits.
+#[cfg(any(armv6m, target_arch = "riscv32", test))]
 #[inline(never)]
-fn isqrt(x: u64) -> u64 {
-    let (mut x, mut r) = (x, 0u64);
-    let mut b = 1u64 << ((bits(x).saturating_sub(1)) & !1);
-    while b != 0 {
-        if x >= r + b {
-            x -= r + b;
-            r = (r >> 1) + b;
-        } else {
-            r >>= 1;
-        }
-        b >>= 2;
+fn zeros_by_halving(x: u32) -> u32 {
+    if x == 0 {
+        return 32;
     }
-    r
+    let (mut x, mut n) = (x, 0);
+    for w in [16, 8, 4, 2] {
+        if x >> (32 - w) == 0 {
+            n += w;
+            x <<= w;
+        }
+    }
+    n + (!x >> 31)
+}
+
+/// Defines `⌊√x⌋` for one unsigned type, two bits at a time from the highest power of four the
+/// type holds (no division: a Cortex-M0 has none; `const`, for the tables).
+macro_rules! digit_root {
+    ($(#[$attr:meta])* $name:ident: $t:ty) => {
+        $(#[$attr])*
+        const fn $name(x: $t) -> $t {
+            let (mut x, mut r, mut b) = (x, 0, 1 << (<$t>::BITS - 2));
+            while b != 0 {
+                if x >= r + b {
+                    x -= r + b;
+                    r = (r >> 1) + b;
+                } else {
+                    r >>= 1;
+                }
+                b >>= 2;
+            }
+            r
+        }
+    };
+}
+
+digit_root!(
+    /// `⌊√x⌋` of a `u64` (an error, once per run).
+    #[inline(never)]
+    isqrt: u64
+);
+
+digit_root!(
+    /// `⌊√x⌋` in 32 bits (an edge's length; the tables' roots, at compile time).
+    #[inline]
+    root_by_digits: u32
+);
+
+/// `⌊a / d⌋` for a divisor below `2¹⁶`, by 16-bit digits: four 32-bit divisions (a 64-bit one
+/// is a library call of a kilobyte on a 32-bit core).
+#[inline]
+fn div_short(a: u64, d: u16) -> u64 {
+    let d = u32::from(d.max(1));
+    let (mut q, mut r) = (0u64, 0u32);
+    for shift in [48, 32, 16, 0] {
+        // r < d < 2¹⁶: the digit fits.
+        let x = (r << 16) | ((a >> shift) as u32 & 0xffff);
+        q = (q << 16) | u64::from(x / d);
+        r = x % d;
+    }
+    q
+}
+
+/// `⌊a / d⌋` for any `u32` divisor, a bit at a time (once per pass: the mean triangle area).
+#[inline(never)]
+fn div_long(a: u64, d: u32) -> u64 {
+    let d = u64::from(d.max(1));
+    let (mut q, mut r) = (0u64, 0u64);
+    for i in (0..64).rev() {
+        // r < d < 2³² before the shift.
+        r = (r << 1) | ((a >> i) & 1);
+        if r >= d {
+            r -= d;
+            q |= 1 << i;
+        }
+    }
+    q
+}
+
+/// `a · b` in 64 bits, written out: the core's long multiply, or on a Cortex-M0, which has none
+/// (an `i64` product there is a 64 × 64 library call), [`by_halves`]. For the two loops a run
+/// spends most in (a plane's sum, a price); elsewhere [`wide`].
+#[inline(always)]
+fn wide_inline(a: i32, b: i32) -> i64 {
+    #[cfg(armv6m)]
+    return by_halves(a, b);
+    #[cfg(not(armv6m))]
+    return i64::from(a) * i64::from(b);
+}
+
+/// [`wide_inline`], one called copy on a Cortex-M0 (flash), written out elsewhere.
+#[cfg_attr(armv6m, inline(never))]
+#[cfg_attr(not(armv6m), inline(always))]
+fn wide(a: i32, b: i32) -> i64 {
+    wide_inline(a, b)
+}
+
+/// [`wide`] for unsigned factors.
+#[cfg_attr(armv6m, inline(never))]
+#[cfg_attr(not(armv6m), inline(always))]
+fn wide_u(a: u32, b: u32) -> u64 {
+    #[cfg(armv6m)]
+    return by_halves_u(a, b);
+    #[cfg(not(armv6m))]
+    return u64::from(a) * u64::from(b);
+}
+
+/// `a · b` from four products of 16-bit halves, `a = a₁·2¹⁶ + a₀` with `a₀` unsigned: every
+/// partial product fits 32 bits (`|a₁ b₀| < 2³¹`, `a₁ b₁ ≤ 2³⁰`, `a₀ b₀ < 2³²` unsigned).
+#[cfg(any(armv6m, test))]
+#[inline(always)]
+fn by_halves(a: i32, b: i32) -> i64 {
+    let (a1, a0) = (a >> 16, a & 0xffff);
+    let (b1, b0) = (b >> 16, b & 0xffff);
+    let mid = i64::from(a1 * b0) + i64::from(a0 * b1);
+    (i64::from(a1 * b1) << 32) + (mid << 16) + i64::from(a0 as u32 * b0 as u32)
+}
+
+/// [`by_halves`] for unsigned factors.
+#[cfg(any(armv6m, test))]
+#[inline(always)]
+fn by_halves_u(a: u32, b: u32) -> u64 {
+    let (a1, a0) = (a >> 16, a & 0xffff);
+    let (b1, b0) = (b >> 16, b & 0xffff);
+    let mid = u64::from(a1 * b0) + u64::from(a0 * b1);
+    (u64::from(a1 * b1) << 32) + (mid << 16) + u64::from(a0 * b0)
 }
 
 #[inline]
@@ -203,15 +340,13 @@ fn cross(a: P, b: P) -> P {
 /// `|v|²` of an `i32` vector, exact (`< 3·2⁶²`).
 #[inline]
 fn len2(v: P) -> u64 {
-    v.iter()
-        .map(|&x| (i64::from(x) * i64::from(x)) as u64)
-        .sum()
+    v.iter().map(|&x| wide(x, x) as u64).sum()
 }
 
-/// `|e|²` of an edge (`< 3·2³⁰`).
+/// `|e|²` of an edge (`< 3·2³⁰`): each square below `2³⁰`, in 32 bits.
 #[inline]
 fn edge2(e: P) -> u64 {
-    len2(e)
+    e.iter().map(|&x| u64::from((x * x) as u32)).sum()
 }
 
 /// `v` shifted (a per-vector exponent) so that its largest component is in `[2¹³, 2¹⁴)`, and
@@ -219,12 +354,13 @@ fn edge2(e: P) -> u64 {
 #[inline]
 fn norm14(v: [i64; 3]) -> ([i32; 3], i32) {
     let m = v.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0);
-    if m == 0 {
-        return ([0; 3], 0);
+    if m < 1 << 31 {
+        return norm14_32(v.map(|x| x as i32));
     }
+    // |vᵢ| < 2⁴⁷ (an edge plane's): a fixed shift by 16 into `i32`, then the rest (s ≥ 18),
+    // the same floor as one shift by s, without a 64-bit shift by a variable.
     let s = bits(m) as i32 - 14;
-    let f = |x: i64| (if s >= 0 { x >> s } else { x << -s }) as i32;
-    (v.map(f), s)
+    (v.map(|x| ((x >> 16) as i32) >> (s - 16)), s)
 }
 
 /// A normal shifted for the rules, and its squared length (`< 3·2²⁸`).
@@ -236,7 +372,7 @@ pub struct Normal {
 
 #[inline]
 fn shifted(c: P) -> Normal {
-    let (n, _) = norm14(c.map(i64::from));
+    let (n, _) = norm14_32(c);
     let l2 = n.iter().map(|&x| (x * x) as u32).sum();
     Normal { n, l2 }
 }
@@ -246,41 +382,143 @@ fn dot14(a: [i32; 3], b: [i32; 3]) -> i32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// `⌊√x⌋` for `x` in `[2²⁶, 3·2²⁸]` (a shifted normal's squared length): two Newton steps
-/// from a line through the ends of the range (within 13 %) and a last correction, so exactly
-/// [`isqrt`]'s floor (over the whole range: checked exhaustively once, sampled by the unit
-/// test) in fewer operations where a core divides in one instruction. Exact, not near: the
-/// pipeline's order on flat CAD regions turns on the last bits of the planes.
+/// `⌊√x⌋` for `x` in `[2²⁶, 3·2²⁸]` (a shifted normal's squared length), exactly
+/// [`isqrt`]'s floor, not near: the pipeline's order on flat CAD regions turns on the last bits
+/// of the planes. Where a core divides in one instruction, two Newton steps from a line through
+/// the ends of the range (within 13 %) and a last correction (checked exhaustively once,
+/// sampled by the unit test); on a Cortex-M0, which has no divide, [`root_by_table`].
 #[inline]
 fn root(x: u32) -> u32 {
-    let y = (x >> 15) + 6_144;
-    let y = (y + x / y) >> 1;
-    let y = (y + x / y) >> 1;
-    y - u32::from(y * y > x)
+    #[cfg(armv6m)]
+    return root_by_table(x);
+    #[cfg(not(armv6m))]
+    {
+        let y = (x >> 15) + 6_144;
+        let y = (y + x / y) >> 1;
+        let y = (y + x / y) >> 1;
+        y - u32::from(y * y > x)
+    }
+}
+
+/// `⌊√(i·2²⁵)⌋` for `i` in `0..=32`: [`root_by_table`]'s chords.
+#[cfg(any(armv6m, test))]
+const CHORDS: [u16; 33] = {
+    let mut t = [0; 33];
+    let mut i = 0;
+    while i < 33 {
+        t[i] = root_by_digits((i as u32) << 25) as u16;
+        i += 1;
+    }
+    t
+};
+
+/// `2²⁶ / √((i + ½)·2²⁵)`, that is `√(2²⁸ / (2i + 1))`, for `i` in `8..32`:
+/// [`root_by_table`]'s Newton step on chord `i` (in Q27).
+#[cfg(any(armv6m, test))]
+const SLOPES: [u16; 32] = {
+    let mut t = [0; 32];
+    let mut i = 8;
+    while i < 32 {
+        t[i] = root_by_digits((1 << 28) / (2 * i as u32 + 1)) as u16;
+        i += 1;
+    }
+    t
+};
+
+/// [`root`] without a divide: `x` times 4 if below `2²⁸` (`⌊√(4x)⌋ / 2 = ⌊√x⌋`), so in
+/// `[2²⁸, 2³⁰)`; the chord of `√` over its 1/32 of `[0, 2³⁰)` ([`CHORDS`]); one Newton step
+/// `y += (x - y²) / 2y` with `1 / 2y` taken at the chord's middle ([`SLOPES`]); then corrected
+/// to the floor. Over the whole range (checked exhaustively once, sampled by the unit test)
+/// the step's residual is below `2^18.3` (so its product with a slope below `2¹²` fits `i32`)
+/// and the correction one unit at most.
+#[cfg(any(armv6m, test))]
+#[inline]
+fn root_by_table(x: u32) -> u32 {
+    let quarter = x < 1 << 28;
+    let x = if quarter { x << 2 } else { x };
+    // Below 32 (x < 2³⁰); the mask says so to the compiler: no bounds check.
+    let i = (x >> 25) as usize & 31;
+    let (t0, t1) = (u32::from(CHORDS[i]), u32::from(CHORDS[i + 1]));
+    let y = t0 + ((((x & ((1 << 25) - 1)) >> 13) * (t1 - t0)) >> 12);
+    let e = x.wrapping_sub(y * y) as i32;
+    let y = (y as i32 + ((e * i32::from(SLOPES[i])) >> 27)) as u32;
+    let y = y - u32::from(y * y > x);
+    let y = y + u32::from((y + 1) * (y + 1) <= x);
+    if quarter {
+        y >> 1
+    } else {
+        y
+    }
+}
+
+/// `⌊2²⁹ / ℓ⌋` for `ℓ` in `[2¹³, 2¹⁵)` (a shifted normal's length): the core's divide, or on a
+/// Cortex-M0 [`reciprocal_by_newton`].
+#[inline]
+fn reciprocal(l: u32) -> u32 {
+    #[cfg(armv6m)]
+    return reciprocal_by_newton(l);
+    #[cfg(not(armv6m))]
+    return (1 << 29) / l;
+}
+
+/// [`reciprocal`] with 32-bit multiplies: `ℓ` doubled into `x` in `[2¹⁴, 2¹⁵)` if below
+/// `2¹⁴`, `2³⁰ / x` from the line `95 484 - 2x` (within 6.1 %, the minimax line of `1/t` on
+/// `[1, 2)`), two Newton steps `y += y (2³⁰ - x y) / 2³⁰` (the residual cut by 2¹² so that the
+/// product fits `i32`: `|y| < 2^16.1` and, from 6.1 % down, `|2³⁰ - x y| < 2^26.9`), then
+/// raised to the floor (the steps, from below, end at most 2 under it); checked against the
+/// division for every `ℓ` by the unit test.
+#[cfg(any(armv6m, test))]
+#[inline]
+fn reciprocal_by_newton(l: u32) -> u32 {
+    let (x, half) = if l < 1 << 14 {
+        (l << 1, false)
+    } else {
+        (l, true)
+    };
+    let mut y = 95_484 - 2 * x as i32;
+    for _ in 0..2 {
+        let e = (1u32 << 30).wrapping_sub(x * y as u32) as i32;
+        y += (y * (e >> 12)) >> 18;
+    }
+    let y = y as u32;
+    let y = y + u32::from(x * (y + 1) <= 1 << 30);
+    let y = y + u32::from(x * (y + 1) <= 1 << 30);
+    // ⌊2³⁰ / 2ℓ⌋ = ⌊2²⁹ / ℓ⌋; for ℓ = x, ⌊⌊2³⁰ / x⌋ / 2⌋.
+    if half {
+        y >> 1
+    } else {
+        y
+    }
 }
 
 /// The unit vector of `v` in Q15 and `|v|` as `(ℓ, s)` with `|v| ≈ ℓ·2ˢ`, `ℓ < 2¹⁵`;
 /// `None` for zero.
-#[inline(never)]
+#[inline]
 fn unit(v: [i64; 3]) -> Option<([i32; 3], u64, i32)> {
     let (c, s) = norm14(v);
     unit_of(c, s)
 }
 
-/// [`unit`] of a cross product of two edges (an `i32` vector): 32-bit operations only.
-#[inline(never)]
-fn unit32(v: [i32; 3]) -> Option<([i32; 3], u64, i32)> {
+/// [`norm14`] of a cross product of two edges (`|vᵢ| < 2³¹`), in 32 bits.
+#[inline]
+fn norm14_32(v: [i32; 3]) -> ([i32; 3], i32) {
     let m = v.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0);
     if m == 0 {
-        return None;
+        return ([0; 3], 0);
     }
-    let s = (32 - m.leading_zeros()) as i32 - 14;
-    let c = v.map(|x| if s >= 0 { x >> s } else { x << -s });
+    let s = (32 - leading_zeros(m)) as i32 - 14;
+    (v.map(|x| if s >= 0 { x >> s } else { x << -s }), s)
+}
+
+/// [`unit`] of a cross product of two edges (an `i32` vector): 32-bit operations only.
+#[inline]
+fn unit32(v: [i32; 3]) -> Option<([i32; 3], u64, i32)> {
+    let (c, s) = norm14_32(v);
     unit_of(c, s)
 }
 
 /// The unit vector of the shifted `c` (largest component in `[2¹³, 2¹⁴)`), with shift `s`.
-#[inline(always)]
+#[inline(never)]
 fn unit_of(c: [i32; 3], s: i32) -> Option<([i32; 3], u64, i32)> {
     // Below 3·2²⁸.
     let l2: u32 = c.iter().map(|&x| (x * x) as u32).sum();
@@ -290,14 +528,15 @@ fn unit_of(c: [i32; 3], s: i32) -> Option<([i32; 3], u64, i32)> {
     // ℓ in [2¹³, 2^14.8): r = 2²⁹/ℓ below 2¹⁶, and |cᵢ| ≤ ℓ (to the root's precision) keeps
     // cᵢ·r near 2²⁹.
     let l = root(l2);
-    let r = (1i32 << 29) / l as i32;
+    let r = reciprocal(l) as i32;
     Some((c.map(|x| (x * r) >> 14), u64::from(l), s))
 }
 
 /// `ℓ·2ˢ`, a length or area held as in [`unit`], times `m` (rounded down; saturating).
 #[inline]
-fn scaled(l: u64, s: i32, m: u64) -> u64 {
-    let x = l.saturating_mul(m);
+fn scaled(l: u64, s: i32, m: u32) -> u64 {
+    // ℓ < 2¹⁵.
+    let x = wide_u(l as u32, m);
     if s >= 0 {
         x.checked_shl(s as u32).unwrap_or(u64::MAX)
     } else {
@@ -312,15 +551,20 @@ fn add_plane(s: &mut Sum, n: [i32; 3], w: u64) {
     let [x, y, z] = n;
     // Q30 to Q22 (below 2²²), times w: below 2^60.2. Written out: no index to check.
     let nn = [x * x, x * y, x * z, y * y, y * z, z * z];
+    // A weight below 2³¹ (all but the largest triangles): 32 × 32 bits.
+    let short = i32::try_from(w).ok();
     for (e, p) in s.iter_mut().zip(nn) {
-        *e += (i64::from(p >> 8) * w) >> 22;
+        *e += match short {
+            Some(w) => wide_inline(p >> 8, w),
+            None => i64::from(p >> 8) * w,
+        } >> 22;
     }
 }
 
 /// Packs a non-negative value into an ordered `u32`: below 2²⁵ as it is, above as a 6-bit
 /// exponent and 25 bits of mantissa below the leading one (an `f32`'s layout), so that the
 /// `u32`s order as the values; `x · 2^sh` for any `sh`.
-#[inline]
+#[inline(never)]
 pub(crate) fn pack(x: u64, sh: u32) -> u32 {
     let b = bits(x) + sh;
     if b <= 25 {
@@ -355,7 +599,7 @@ fn unpack(c: u32) -> (u64, u32) {
 #[inline]
 fn pack_mul(a: u64, b: u64) -> u32 {
     let (sa, sb) = (bits(a).saturating_sub(32), bits(b).saturating_sub(32));
-    pack((a >> sa) * (b >> sb), sa + sb)
+    pack(wide_u((a >> sa) as u32, (b >> sb) as u32), sa + sb)
 }
 
 /// The error of `raw` against trace `w` (`raw ≤ w · 3·2³⁰`): `raw / w` in [`ERR`] units, with
@@ -389,38 +633,41 @@ impl<'p> Grid<'p> {
     pub(crate) fn new(positions: &'p [[u16; 3]], extent_power: u64) -> Self {
         Grid {
             positions,
-            edge_unit: u64::from(AREA) * extent_power,
+            edge_unit: AREA * extent_power as u32,
         }
     }
 
     /// The plane through edge `e` (from the quadric's vertex) perpendicular to the triangle
     /// whose third vertex is at `o`, weighted by the edge's length times `num / den`.
     #[inline(never)]
-    fn edge_plane(&self, s: &mut Sum, e: P, o: P, (num, den): (u64, u64)) {
+    fn edge_plane(&self, s: &mut Sum, e: P, o: P, (num, den): (u32, u16)) {
         let l2 = edge2(e);
-        let proj = i64::from(o[0]) * i64::from(e[0])
-            + i64::from(o[1]) * i64::from(e[1])
-            + i64::from(o[2]) * i64::from(e[2]);
-        // |o|·|e|² and |e|·|proj| are below 2^47.6.
-        let l2i = l2 as i64;
-        let at = |o: i32, e: i32| i64::from(o) * l2i - i64::from(e) * proj;
-        let perp = [at(o[0], e[0]), at(o[1], e[1]), at(o[2], e[2])];
         if l2 == 0 {
             return;
         }
+        // o |e|² - e (o·e), as e × (o × e): `o × e` is exact in `i32`, and each product of
+        // the outer cross below 2⁴⁶.
+        let c = cross(o, e);
+        let perp = [
+            wide(e[1], c[2]) - wide(e[2], c[1]),
+            wide(e[2], c[0]) - wide(e[0], c[2]),
+            wide(e[0], c[1]) - wide(e[1], c[0]),
+        ];
         if let Some((n, _, _)) = unit(perp) {
-            let w = isqrt(l2) * self.edge_unit * num / den.max(1);
+            // ℓ < 2^15.8, and the unit times the border weight below 2²⁴.
+            let w = wide_u(root_by_digits(l2 as u32), self.edge_unit * num);
+            let w = if den > 1 { div_short(w, den) } else { w };
             add_plane(s, n, w);
         }
     }
 
     /// The plane of triangle `p` weighted by its area times `m`.
     #[inline]
-    fn plane(&self, s: &mut Sum, [p0, p1, p2]: [P; 3], m: u64) {
+    fn plane(&self, s: &mut Sum, [p0, p1, p2]: [P; 3], m: u32) {
         let c = cross(sub(p1, p0), sub(p2, p0));
         if let Some((n, l, sh)) = unit32(c) {
             // Area = |c| / 2, in AREA units.
-            add_plane(s, n, scaled(l, sh, u64::from(AREA) / 2 * m));
+            add_plane(s, n, scaled(l, sh, AREA / 2 * m));
         }
     }
 }
@@ -497,7 +744,7 @@ impl Geometry for Grid<'_> {
     fn face_area(&self, [p0, p1, p2]: [P; 3]) -> u64 {
         let c = cross(sub(p1, p0), sub(p2, p0));
         match unit32(c) {
-            Some((_, l, sh)) => scaled(l, sh, u64::from(AREA) / 2),
+            Some((_, l, sh)) => scaled(l, sh, AREA / 2),
             None => 0,
         }
     }
@@ -509,19 +756,23 @@ impl Geometry for Grid<'_> {
 
     #[inline(always)]
     fn mean_area(total: u64, triangles: usize) -> u64 {
-        total / (triangles.max(1) as u64)
+        div_long(total, u32::try_from(triangles).unwrap_or(u32::MAX))
     }
 
     #[inline]
     fn raw(&self, q: &Quadric, from: P, to: P) -> u64 {
-        let d = sub(to, from).map(i64::from);
+        // |dᵢ dⱼ| < 2³⁰ and, the diagonal entries being non-negative parts of the trace,
+        // |zz| ≤ W' < 2²⁶: every factor in 32 bits.
+        let d = sub(to, from);
         let (w, _) = q.weight();
-        let [xx, xy, xz, yy, yz] = q.s.map(i64::from);
-        let zz = w as i64 - xx - yy;
-        let e = xx * (d[0] * d[0])
-            + yy * (d[1] * d[1])
-            + zz * (d[2] * d[2])
-            + 2 * (xy * (d[0] * d[1]) + xz * (d[0] * d[2]) + yz * (d[1] * d[2]));
+        let [xx, xy, xz, yy, yz] = q.s;
+        let zz = (w as i32).wrapping_sub(xx).wrapping_sub(yy);
+        let e = wide_inline(xx, d[0] * d[0])
+            + wide_inline(yy, d[1] * d[1])
+            + wide_inline(zz, d[2] * d[2])
+            + 2 * (wide_inline(xy, d[0] * d[1])
+                + wide_inline(xz, d[0] * d[2])
+                + wide_inline(yz, d[1] * d[2]));
         if e > 0 {
             e as u64
         } else {
@@ -553,11 +804,13 @@ impl Geometry for Grid<'_> {
             return cost;
         }
         let (m, sh) = unpack(cost);
+        // m < 2²⁶: the products fit 32 bits.
+        let m = m as u32;
         let m = match goal {
             Goal::Error => m * 9 / 10,
             Goal::Tail => m * 3 / 2,
         };
-        pack(m, sh)
+        pack(u64::from(m), sh)
     }
 
     #[inline(always)]
@@ -582,14 +835,21 @@ impl Geometry for Grid<'_> {
         }
     }
 
+    fn target(target: crate::Target, valid: usize) -> usize {
+        match target {
+            crate::Target::Ratio(r) => ratio_of(r, valid),
+            crate::Target::Triangles(n) => n,
+        }
+    }
+
     #[inline]
     fn limit(&self, distance: f32) -> u64 {
-        // The one float operation of a run: the configuration's limit, in grid cells.
-        if !distance.is_finite() {
+        // ⌊d² · ERR⌋ from d's bits (its sign squared away); an infinite or NaN limit is none.
+        let Some((m, e)) = parts(f32::from_bits(distance.to_bits() & 0x7fff_ffff)) else {
             return u64::MAX;
-        }
+        };
         // A finite limit stays finite (errors are measured under it), however large.
-        ((distance * distance * ERR as f32) as u64).min(u64::MAX - 1)
+        shift_floor(wide_u(m, m), 2 * e + ERR.trailing_zeros() as i32).min(u64::MAX - 1)
     }
 
     #[inline(always)]
@@ -610,7 +870,7 @@ impl Geometry for Grid<'_> {
     #[inline]
     fn distance(&self, e: u64) -> f32 {
         // √(e / 256): in 1/16 cells.
-        isqrt(e) as f32 / 16.0
+        sixteenths(isqrt(e))
     }
 
     #[inline]
@@ -652,10 +912,7 @@ impl Geometry for Grid<'_> {
         }
         let (n0, n1) = (shifted(c0), shifted(c1));
         let ndp = dot14(n0.n, n1.n);
-        if flip
-            && (ndp <= 0
-                || (ndp as u64) * (ndp as u64) <= (u64::from(n0.l2) * u64::from(n1.l2)) >> 4)
-        {
+        if flip && (ndp <= 0 || wide_u(ndp as u32, ndp as u32) <= wide_u(n0.l2, n1.l2) >> 4) {
             return Err(Reject::NormalTurn);
         }
         if thin && thinner(abd, s, len2(c0), [px, py, pa]) {
@@ -675,9 +932,7 @@ impl Geometry for Grid<'_> {
             return true;
         }
         let d = dot14(a.n, b.n);
-        d < 0
-            && (d as i64 * d as i64) as u64
-                > ((u64::from(a.l2) * u64::from(b.l2)) >> 16) * FOLD2_Q16
+        d < 0 && wide(d, d) as u64 > (wide_u(a.l2, b.l2) >> 16) * FOLD2_Q16
     }
 
     #[inline(always)]
@@ -713,6 +968,79 @@ impl Geometry for Grid<'_> {
         }
         None
     }
+}
+
+/// A non-negative finite `x` as `(m, e)` with `x = m·2ᵉ`, `m < 2²⁴`, read from its bits (the
+/// configuration's floats enter the run this way: a float operation is a library call on a
+/// core without an FPU); `None` for a negative, infinite or NaN one.
+#[inline]
+fn parts(x: f32) -> Option<(u32, i32)> {
+    let b = x.to_bits();
+    let (exponent, fraction) = ((b >> 23) as i32, b & 0x7f_ffff);
+    match exponent {
+        0 => Some((fraction, -149)),
+        1..=254 => Some((fraction | 0x80_0000, exponent - 150)),
+        _ => None,
+    }
+}
+
+/// `⌊x · 2ᵗ⌋`, saturating at `u64::MAX`.
+#[inline]
+fn shift_floor(x: u64, t: i32) -> u64 {
+    if x == 0 || t <= -64 {
+        0
+    } else if t <= 0 {
+        x >> -t
+    } else if bits(x) as i32 + t > 64 {
+        u64::MAX
+    } else {
+        x << t
+    }
+}
+
+/// `x` rounded to 24 significant bits, ties to even (an `f32`'s rounding), as `(m, e)`:
+/// `m·2ᵉ` with `m < 2²⁴`.
+#[inline(never)]
+fn round24(x: u64) -> (u64, i32) {
+    let b = bits(x);
+    if b <= 24 {
+        return (x, 0);
+    }
+    let sh = b - 24;
+    let (q, rest, half) = (x >> sh, x & ((1 << sh) - 1), 1u64 << (sh - 1));
+    let q = q + u64::from(rest > half || (rest == half && q & 1 == 1));
+    // Rounded up to 2²⁴: one bit fewer, exactly.
+    if q >> 24 != 0 {
+        (q >> 1, sh as i32 + 1)
+    } else {
+        (q, sh as i32)
+    }
+}
+
+/// `(r * n as f32) as usize` (a target ratio's count) for a ratio in `[0, 1]` (validated), the
+/// same number without a float operation: `n` and the product each rounded as an `f32` is, the
+/// product floored (at most `n` rounded as an `f32`); 0 for a NaN or negative ratio.
+fn ratio_of(r: f32, n: usize) -> usize {
+    let Some((mr, er)) = parts(r) else {
+        return 0;
+    };
+    let (mn, en) = round24(n as u64);
+    // mr, mn < 2²⁴: exact in 48 bits.
+    let (q, sh) = round24(wide_u(mr, mn as u32));
+    usize::try_from(shift_floor(q, sh + er + en)).unwrap_or(usize::MAX)
+}
+
+/// `r / 16` as the nearest `f32` (ties to even), built from its bits.
+#[inline]
+fn sixteenths(r: u64) -> f32 {
+    if r == 0 {
+        return 0.0;
+    }
+    let (m, e) = round24(r);
+    // m·2ᵉ with m in [2²³, 2²⁴) after the shift below; the f32 is m·2^(E - 150).
+    let up = 24 - bits(m) as i32;
+    let (m, e) = (m << up, e - up - 4);
+    f32::from_bits((((e + 150) as u32) << 23) | (m as u32 & 0x7f_ffff))
 }
 
 /// `l₀·l₁·l₂ < r₀·r₁·r₂` for `u64`s, each cut to 21 bits first (for the sliver preference's
@@ -864,6 +1192,142 @@ mod tests {
             assert_eq!(u64::from(root(x)), isqrt(u64::from(x)), "{x}");
             x += 9_973;
         }
+    }
+
+    #[test]
+    fn the_cortex_m0_routines_give_the_same_numbers() {
+        for l in 1u32 << 13..1 << 15 {
+            assert_eq!(reciprocal_by_newton(l), (1 << 29) / l, "{l}");
+        }
+        let mut x = 1u32 << 26;
+        while x <= 3 << 28 {
+            for y in [x, x + 1, x - 1] {
+                assert_eq!(root_by_digits(y), root(y), "{y}");
+                assert_eq!(root_by_table(y), root(y), "{y}");
+            }
+            let r = root(x);
+            assert_eq!(root_by_digits(r * r), r);
+            assert_eq!(root_by_digits(r * r - 1), r - 1);
+            x += 4_999;
+        }
+        for x in (0..=u32::MAX).step_by(65_521).chain([0, 1, 2, 3, u32::MAX]) {
+            assert_eq!(zeros_by_halving(x), x.leading_zeros(), "{x}");
+            assert_eq!(root_by_digits(x), isqrt(u64::from(x)) as u32, "{x}");
+        }
+        let wides = [
+            0u64,
+            1,
+            9,
+            10,
+            65_535,
+            1 << 35,
+            (1 << 38) + 12_345,
+            u64::MAX,
+        ];
+        for a in wides {
+            for d in [1u16, 2, 10, 7_919, u16::MAX] {
+                assert_eq!(div_short(a, d), a / u64::from(d), "{a} / {d}");
+            }
+            for d in [1u32, 3, 10, 65_536, 1_000_003, u32::MAX] {
+                assert_eq!(div_long(a, d), a / u64::from(d), "{a} / {d}");
+            }
+        }
+        let edges = [
+            0,
+            1,
+            -1,
+            0xffff,
+            0x1_0000,
+            -0x1_0000,
+            12_345_678,
+            -98_765,
+            i32::MAX,
+            i32::MIN,
+        ];
+        for a in edges {
+            for b in edges {
+                assert_eq!(by_halves(a, b), i64::from(a) * i64::from(b), "{a} {b}");
+                let (a, b) = (a as u32, b as u32);
+                assert_eq!(by_halves_u(a, b), u64::from(a) * u64::from(b), "{a} {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_wide_normal_is_shifted_as_by_one_floor() {
+        let reference = |v: [i64; 3]| {
+            let m = v.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0);
+            if m == 0 {
+                return ([0; 3], 0);
+            }
+            let s = bits(m) as i32 - 14;
+            (v.map(|x| (if s >= 0 { x >> s } else { x << -s }) as i32), s)
+        };
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for k in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            // Magnitudes of every width up to 2⁴⁷, either sign; some of the form -(2ᵏ - 1).
+            let w = 1 + k % 47;
+            let f = |r: u64| {
+                let m = (r & ((1 << w) - 1)) as i64;
+                if r >> 63 == 1 {
+                    -m
+                } else {
+                    m
+                }
+            };
+            let v = [f(x), f(x.rotate_left(21)), -((1i64 << w) - 1)];
+            assert_eq!(norm14(v), reference(v), "{v:?}");
+        }
+    }
+
+    #[test]
+    fn the_configuration_floats_are_read_as_the_float_operations_give_them() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let specials = [
+            0.0f32,
+            -0.0,
+            1.0,
+            0.7,
+            0.1,
+            0.5,
+            1e-40,
+            -0.3,
+            f32::NAN,
+            -f32::INFINITY,
+        ];
+        for k in 0..40_000 {
+            // Every ratio a run takes (in [0, 1]), and NaN and negative ones.
+            let r = match k % 4 {
+                0 => (next() % 1001) as f32 / 1000.0,
+                1 => f32::from_bits(next() as u32 % 0x3f80_0001),
+                2 => -f32::from_bits(next() as u32 % 0x3f80_0001),
+                _ => specials[k / 4 % specials.len()],
+            };
+            let n = match k % 3 {
+                0 => (next() % 5000) as usize,
+                1 => (next() % (1 << 26)) as usize,
+                _ => next() as u32 as usize,
+            };
+            assert_eq!(ratio_of(r, n), (r * n as f32) as usize, "{r:e} x {n}");
+            let e = next() >> (next() % 64);
+            assert_eq!(sixteenths(e), e as f32 / 16.0, "{e}");
+        }
+        let grid = Grid::new(&[], 1);
+        for d in [0.0f32, 1.0, 0.75, 3.5e-3, 1.5e9, 1e30] {
+            let exact = (f64::from(d) * f64::from(d) * 256.0).floor();
+            assert_eq!(grid.limit(d), (exact as u64).min(u64::MAX - 1), "{d}");
+        }
+        assert_eq!(grid.limit(f32::INFINITY), u64::MAX);
+        assert_eq!(grid.limit(f32::NAN), u64::MAX);
     }
 
     #[test]

@@ -731,7 +731,7 @@ fn run<'p, I: Index, L: Index, N: Arithmetic, Q: fill::Quadrics<N::Frame<'p>>, c
     // The limit as an error: a squared distance in the run's frame.
     let limit = frame.limit(config.error_limit);
 
-    let target_triangles = config.target.triangles(valid);
+    let target_triangles = <N::Frame<'p> as Geometry>::target(config.target, valid);
     let mut stats = Stats::default();
     let mut passes = 0u32;
     // The input's area, for the price's mean triangle area.
@@ -841,7 +841,8 @@ fn run<'p, I: Index, L: Index, N: Arithmetic, Q: fill::Quadrics<N::Frame<'p>>, c
             *t = *w;
         }
     }
-    let collapse_error = if config.error_limit.is_finite() {
+    // A finite limit, by its bits (a float compare is a library call on a core without FPU).
+    let collapse_error = if config.error_limit.to_bits() & 0x7fff_ffff < 0x7f80_0000 {
         frame.distance(stats.worst)
     } else {
         0.0
