@@ -454,6 +454,11 @@ pub struct Row {
     /// difference.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub float_on_grid: Option<[f64; 2]>,
+    /// An integer mode only: its float mode on the grid mesh mirrored (x negated, winding
+    /// reversed; the output mirrored back, all exact), the same figures: how far the float path
+    /// itself moves when only its rounding changes, the floor of a row's comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub float_mirrored: Option<[f64; 2]>,
 }
 
 impl Row {
@@ -893,13 +898,19 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                 };
                 let run = run_method(input, method, ratio, target, opts.reps, opts.prune)
                     .with_context(|| format!("{name} at {ratio}, {}", method.label()))?;
-                let float_on_grid = match &grid {
+                let (float_on_grid, float_mirrored) = match &grid {
                     Some(g) => {
                         let f = run_method(g, method.float(), ratio, target, 1, opts.prune)?;
                         let m = metro(mesh, &f.out, &metro_opts);
-                        Some([m.symmetric_mean_pct, m.hausdorff_pct])
+                        let fm =
+                            run_method(&mirror(g), method.float(), ratio, target, 1, opts.prune)?;
+                        let mm = metro(mesh, &mirror(&fm.out), &metro_opts);
+                        (
+                            Some([m.symmetric_mean_pct, m.hausdorff_pct]),
+                            Some([mm.symmetric_mean_pct, mm.hausdorff_pct]),
+                        )
                     }
-                    None => None,
+                    None => (None, None),
                 };
                 // Ours welded seams: checked welded (no crack), as `tinydecimate simplify` does.
                 // Ours may prune parts: a part gone whole is allowed, one cut in part is not.
@@ -936,6 +947,7 @@ pub fn bench(opts: &Options, command: &str) -> Result<Results> {
                     validity,
                     same_count: None,
                     float_on_grid,
+                    float_mirrored,
                 });
                 bar.inc(1);
             }
@@ -1026,6 +1038,15 @@ fn on_grid(mesh: &MeshData) -> Result<MeshData> {
         positions: grid.iter().map(|&q| frame.position(q)).collect(),
         triangles: mesh.triangles.clone(),
     })
+}
+
+/// `mesh` mirrored in x, its triangles' winding reversed so that they face as before: the same
+/// surface, exactly (negation is exact), in other floats. Its own inverse.
+fn mirror(mesh: &MeshData) -> MeshData {
+    MeshData {
+        positions: mesh.positions.iter().map(|&[x, y, z]| [-x, y, z]).collect(),
+        triangles: mesh.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+    }
 }
 
 /// Geometric mean of the finite, positive values (NaN if there are none).
@@ -1319,11 +1340,17 @@ mod tests {
                 .count();
             // One row per mesh and ratio, plus (ours) one per ratio in the worst-error table,
             // one in the whole-run error table and one per run that stopped short in the
-            // stopped-short table; an integer mode one more in the integer-against-float table.
+            // stopped-short table; an integer mode one more in the integer-against-float table,
+            // and its float mode one in that section's floor table.
             let extra = if method.is_ours() {
                 QUICK_RATIOS.len()
                     + 1
                     + usize::from(method.integer())
+                    + usize::from(
+                        Method::ALL
+                            .iter()
+                            .any(|m| m.integer() && m.float() == method),
+                    )
                     + r.rows
                         .iter()
                         .filter(|x| x.method == method && !x.target_reached)

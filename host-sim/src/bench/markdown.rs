@@ -125,7 +125,12 @@ fn integer(s: &mut String, r: &Results) {
     };
     let mut lines = Vec::new();
     let mut totals = Vec::new();
+    let mut floors = Vec::new();
     for int in [Method::FastInteger, Method::LeanInteger] {
+        // The float run mirrored over the float run: the geometric mean of each ratio and the
+        // largest spread either way.
+        let (mut mirror_logs, mut spread) =
+            ([0.0f64; 2], [(0.0f64, String::new()), (0.0, String::new())]);
         // Ratios: mean and max over the float run, then over the float run on the grid.
         let mut logs = [0.0f64; 4];
         let mut worst = [
@@ -146,6 +151,16 @@ fn integer(s: &mut String, r: &Results) {
                 row.metro_max_pct / g[1],
             ];
             let at = format!("{} {}", row.mesh, fmt_pct(row.ratio));
+            let m = row
+                .float_mirrored
+                .map_or([f64::NAN; 2], |m| [m[0] / g[0], m[1] / g[1]]);
+            for k in 0..2 {
+                mirror_logs[k] += m[k].ln();
+                let far = m[k].max(1.0 / m[k]);
+                if far > spread[k].0 {
+                    spread[k] = (far, at.clone());
+                }
+            }
             for k in 0..4 {
                 logs[k] += q[k].ln();
                 if q[k] > worst[k].0 {
@@ -154,7 +169,7 @@ fn integer(s: &mut String, r: &Results) {
             }
             n += 1;
             lines.push(format!(
-                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} |",
+                "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {} | {} | {} |",
                 row.mesh,
                 fmt_pct(row.ratio),
                 // The pipeline's mode name, not a table label (those count rows per mode).
@@ -164,22 +179,21 @@ fn integer(s: &mut String, r: &Results) {
                 row.metro_mean_pct,
                 fmt_x(q[0]),
                 fmt_x(q[2]),
+                fmt_x(m[0]),
                 f.metro_max_pct,
                 g[1],
                 row.metro_max_pct,
                 fmt_x(q[1]),
-                fmt_x(q[3])
+                fmt_x(q[3]),
+                fmt_x(m[1])
             ));
         }
         if n > 0 {
-            let cell = |k: usize| {
-                format!(
-                    "{} | {} ({})",
-                    fmt_x((logs[k] / n as f64).exp()),
-                    fmt_x(worst[k].0),
-                    worst[k].1
-                )
+            // A geometric mean from its sum of logs, then the worst ratio and its run.
+            let summary = |log: f64, (x, at): &(f64, String)| {
+                format!("{} | {} ({at})", fmt_x((log / n as f64).exp()), fmt_x(*x))
             };
+            let cell = |k: usize| summary(logs[k], &worst[k]);
             totals.push(format!(
                 "| {} | {} | {} | {} | {} | {} |",
                 int.label(),
@@ -188,6 +202,14 @@ fn integer(s: &mut String, r: &Results) {
                 cell(3),
                 cell(0),
                 cell(1)
+            ));
+            let mirrored = |k: usize| summary(mirror_logs[k], &spread[k]);
+            floors.push(format!(
+                "| {} | {} | {} | {} |",
+                int.float().label(),
+                n,
+                mirrored(0),
+                mirrored(1)
             ));
         }
     }
@@ -213,11 +235,26 @@ fn integer(s: &mut String, r: &Results) {
     }
     let _ = writeln!(
         s,
-        "\n| mesh | ratio | mode | float mean % | float on the grid | integer | × float | × on the grid | float max % | float on the grid | integer | × float | × on the grid |"
+        "\nThe floor of a row's comparison: the float run on the grid mesh mirrored (x negated, \
+         winding reversed, the output mirrored back: the same surface, exactly, in other floats) \
+         against the float run on the grid mesh. Geometric mean of the ratio, and the largest \
+         ratio either way (the larger of x and 1/x) and its run.\n"
     );
     let _ = writeln!(
         s,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "| float mode | runs | mean × unmirrored | largest either way | max × unmirrored | largest either way |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---|---:|---|");
+    for f in floors {
+        let _ = writeln!(s, "{f}");
+    }
+    let _ = writeln!(
+        s,
+        "\n| mesh | ratio | mode | float mean % | float on the grid | integer | × float | × on the grid | mirrored × on the grid | float max % | float on the grid | integer | × float | × on the grid | mirrored × on the grid |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for l in lines {
         let _ = writeln!(s, "{l}");
