@@ -37,7 +37,7 @@
 //! **Cores without a divide, a long multiply or a count of leading zeros** (the Cortex-M0,
 //! `cfg(armv6m)` from `build.rs`): the same numbers from routines without them ([`wide`],
 //! [`root_by_table`], [`reciprocal_by_newton`], [`leading_zeros`]), each checked against the
-//! native operation by the unit tests; elsewhere the native operation, fewer instructions.
+//! native operation by the unit tests; where the core has the instruction, the instruction.
 //!
 //! **The configuration** is read from its floats' bits ([`ratio_of`], `limit`): the run has
 //! no float operation at all.
