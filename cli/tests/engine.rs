@@ -305,3 +305,58 @@ fn engine_json(
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     serde_json::from_str(&text(&o.stdout)).unwrap()
 }
+
+/// `--integer` on the cow, with each engine: the summary names the grid's cell, every output
+/// coordinate is a whole number of cells (the grid's positions, its origin a multiple of the
+/// cell), the output is valid; with the exact engine it is refused.
+#[test]
+fn integer_runs_name_their_grid_and_write_its_positions() {
+    let d = tempfile::tempdir().unwrap();
+    let input = fixture("cow.obj");
+    let out = d.path().join("cow.obj");
+    for (engine, _) in ENGINES {
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.25",
+            "--engine",
+            engine,
+            "--integer",
+        ]);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{engine}: {so}");
+        assert!(so.contains("=> VALID"), "{engine}: {so}");
+        let cell: f64 = so
+            .split("15-bit grid (cell ")
+            .nth(1)
+            .and_then(|rest| rest.split(';').next())
+            .and_then(|c| c.parse().ok())
+            .unwrap_or_else(|| panic!("{engine}: no grid cell in {so}"));
+        let written = std::fs::read_to_string(&out).unwrap();
+        let mut coordinates = 0;
+        for line in written.lines().filter(|l| l.starts_with("v ")) {
+            for x in line.split_whitespace().skip(1) {
+                let k = f64::from(x.parse::<f32>().unwrap()) / cell;
+                assert_eq!(
+                    k,
+                    k.round(),
+                    "{engine}: {line} is off the grid of cell {cell}"
+                );
+                coordinates += 1;
+            }
+        }
+        assert!(coordinates > 3 * 700, "{engine}: {coordinates} coordinates");
+    }
+    let o = run(&[
+        "simplify",
+        s(&input),
+        s(&out),
+        "--integer",
+        "--engine",
+        "exact",
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(text(&o.stderr).contains("--integer"), "{}", text(&o.stderr));
+}

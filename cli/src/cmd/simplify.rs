@@ -461,10 +461,10 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = EngineArg::Auto)]
     pub engine: EngineArg,
     /// The fast or lean engine in integers (`pipeline::Integer`, for cores without an FPU):
-    /// the positions put on a 15-bit grid over the bounding box's largest extent
-    /// (`pipeline::quantise`: one cell is that extent / 32 767, and a position moves by at
-    /// most half a cell's diagonal, 0.87 cell), every decision in fixed point on the grid; the
-    /// output's vertices keep their input positions.
+    /// the positions put on a 15-bit grid over the bounding box (`pipeline::quantise`: a cell
+    /// is the power of two at or above the largest extent / 32 766, and a position moves by at
+    /// most half a cell's diagonal, 0.87 cell; the run's summary prints both), every decision
+    /// in fixed point on the grid; the output's vertices are the grid's positions.
     #[arg(long)]
     pub integer: bool,
     /// Collapse schedule.
@@ -863,12 +863,20 @@ pub(crate) fn refuse_exact_only(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// ", in integers" and the grid, with `--integer`.
-fn integer_words(args: &Args) -> &'static str {
-    if args.integer {
-        ", in integers on a 15-bit grid"
-    } else {
-        ""
+/// ", in integers" and the grid the input was put on (its cell and the most a position
+/// moved), with `--integer`.
+fn integer_words(args: &Args, positions: &[[f32; 3]]) -> String {
+    if !args.integer {
+        return String::new();
+    }
+    let mut grid = vec![[0u16; 3]; positions.len()];
+    match tinydecimate::pipeline::quantise(positions, &mut grid) {
+        Ok(frame) => format!(
+            ", in integers on a 15-bit grid (cell {:e}; a position moved by at most {:e})",
+            frame.step,
+            frame.error()
+        ),
+        Err(_) => ", in integers on a 15-bit grid".to_string(),
     }
 }
 
@@ -908,14 +916,14 @@ fn run_text(args: &Args, run: &Run) -> String {
             text,
             "  engine                 fast (meshoptimizer's pipeline: stored quadrics, sorted \
              passes, subset placement){}",
-            integer_words(args)
+            integer_words(args, &mesh.positions)
         );
     } else if pipeline == Some(crate::simplify::Pipeline::Lean) {
         let _ = writeln!(
             text,
             "  engine                 lean (meshoptimizer's pipeline: quadrics from each \
              vertex's fan, sorted passes, subset placement){}",
-            integer_words(args)
+            integer_words(args, &mesh.positions)
         );
     } else if *stored {
         let _ =
