@@ -360,3 +360,95 @@ fn integer_runs_name_their_grid_and_write_its_positions() {
     assert_ne!(o.status.code(), Some(0));
     assert!(text(&o.stderr).contains("--integer"), "{}", text(&o.stderr));
 }
+
+/// `--integer` on meshes with attributes: an OBJ with texture coordinates and vertex colours, a
+/// PLY with colours and the glTF truck all simplify valid; the OBJ's positions are written as
+/// the grid's (whole cells, the cell the power of two at or above the extent / 32 766), with
+/// each `v` line's colour kept.
+#[test]
+fn integer_runs_carry_attributes_and_write_the_grid() {
+    let d = tempfile::tempdir().unwrap();
+    let n = 10;
+    let (mut obj, mut ply_vertices, mut faces) = (String::new(), String::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 * 0.37, j as f32 * 0.41);
+            let z = 0.3 * (i as f32 * 0.7).sin() * (j as f32 * 0.5).cos();
+            obj.push_str(&format!("v {x} {y} {z} 0.5 0.25 0.125\n"));
+            ply_vertices.push_str(&format!("{x} {y} {z} {} {} 7\n", i * 20, j * 20));
+        }
+    }
+    for j in 0..=n {
+        for i in 0..=n {
+            obj.push_str(&format!(
+                "vt {} {}\n",
+                i as f32 / n as f32,
+                j as f32 / n as f32
+            ));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            faces.push([a, a + 1, a + n + 2]);
+            faces.push([a, a + n + 2, a + n + 1]);
+        }
+    }
+    for f in &faces {
+        let [a, b, c] = f.map(|v| v + 1);
+        obj.push_str(&format!("f {a}/{a} {b}/{b} {c}/{c}\n"));
+    }
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\n\
+         property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n{ply_vertices}",
+        (n + 1) * (n + 1),
+        faces.len()
+    );
+    for [a, b, c] in &faces {
+        ply.push_str(&format!("3 {a} {b} {c}\n"));
+    }
+    let (obj_in, ply_in) = (d.path().join("in.obj"), d.path().join("in.ply"));
+    std::fs::write(&obj_in, obj).unwrap();
+    std::fs::write(&ply_in, ply).unwrap();
+    let truck = fixture("CesiumMilkTruck.glb");
+    for (input, out) in [
+        (obj_in.clone(), d.path().join("out.obj")),
+        (ply_in, d.path().join("out.ply")),
+        (truck, d.path().join("out.glb")),
+    ] {
+        let o = run(&[
+            "simplify",
+            s(&input),
+            s(&out),
+            "--ratio",
+            "0.25",
+            "--integer",
+        ]);
+        let so = text(&o.stdout);
+        assert_eq!(o.status.code(), Some(0), "{}: {so}", input.display());
+        assert!(
+            so.contains("in integers: the positions put on a 15-bit grid"),
+            "{so}"
+        );
+        assert!(!so.contains("NOT valid"), "{so}");
+    }
+    // The input's largest extent is 10 · 0.41 (y): the cell is 2⁻¹², the power of two at or
+    // above 4.1 / 32 766.
+    let cell = (4.1f64 / 32_766.0).log2().ceil().exp2();
+    let written = std::fs::read_to_string(d.path().join("out.obj")).unwrap();
+    let lines: Vec<&str> = written.lines().filter(|l| l.starts_with("v ")).collect();
+    assert!(lines.len() > 20, "{written}");
+    for line in lines {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(
+            t[4..],
+            ["0.5", "0.25", "0.125"],
+            "{line}: the colour is kept"
+        );
+        for x in &t[1..4] {
+            let k = f64::from(x.parse::<f32>().unwrap()) / cell;
+            assert_eq!(k, k.round(), "{line} is off the grid of cell {cell}");
+        }
+    }
+}

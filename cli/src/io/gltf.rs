@@ -43,7 +43,8 @@ const UNSIGNED_BYTE: u32 = 5121;
 const SHORT: u32 = 5122;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
-const FLOAT: u32 = 5126;
+/// `FLOAT` (public: `--integer` writes grid positions only into a float `POSITION`).
+pub const FLOAT: u32 = 5126;
 
 /// Extensions that refer to no accessor and no buffer view: with only these, accessors and
 /// views the old primitives alone used are dropped.

@@ -77,14 +77,89 @@ fn gltf_out(args: &Args) -> bool {
 
 /// Runs `simplify` here when the input or output is glTF, or the input is an OBJ with texture
 /// coordinates or normals written to OBJ; `None` leaves the run to the plain path.
-/// `--integer` on a mesh with attributes: refused (the integer pipeline takes positions alone).
-fn refuse_integer(args: &Args) -> Result<()> {
-    if args.integer {
-        bail!(
-            "{}: --integer runs on positions alone: give a mesh without texture coordinates or \
-             normals (STL, PLY, OBJ without vt/vn)",
-            args.input.display()
-        );
+/// `--integer`: `positions` put on the grid the run will see, in place (`pipeline::quantise`
+/// over all of them: one frame), so that the run, its check and the file written all have the
+/// grid's positions; with the input's a fold the grid's rounding hid could show. The run's
+/// own quantisation of a part of them is then exact: its cell divides this one.
+fn onto_grid(positions: &mut [[f32; 3]]) -> Result<()> {
+    let mut grid = vec![[0u16; 3]; positions.len()];
+    let frame =
+        tinydecimate::pipeline::quantise(positions, &mut grid).map_err(|e| anyhow!("{e}"))?;
+    for (p, &q) in positions.iter_mut().zip(&grid) {
+        *p = frame.position(q);
+    }
+    Ok(())
+}
+
+/// `--integer` on an OBJ with attributes: its `v` positions on the grid, the text of each
+/// `v` line rewritten (what follows x, y and z, a vertex colour, kept).
+fn obj_onto_grid(f: &mut crate::io::objattr::ObjFile) -> Result<()> {
+    onto_grid(&mut f.positions)?;
+    for (text, p) in f.v_text.iter_mut().zip(&f.positions) {
+        let rest: Vec<&str> = text.split_whitespace().skip(3).collect();
+        let mut line = format!("{} {} {}", p[0], p[1], p[2]);
+        for r in rest {
+            line.push(' ');
+            line.push_str(r);
+        }
+        *text = line;
+    }
+    Ok(())
+}
+
+/// `--integer` on a PLY with vertex properties: its positions on the grid, written into each
+/// vertex's `x`, `y`, `z` (float or double; integer coordinates cannot hold the grid's).
+fn ply_onto_grid(f: &mut crate::io::plyattr::PlyFile) -> Result<()> {
+    use ply_rs_bw::ply::Property;
+    onto_grid(&mut f.mesh.positions)?;
+    for (v, p) in f.vertices.iter_mut().zip(&f.mesh.positions) {
+        for (name, x) in ["x", "y", "z"].into_iter().zip(p) {
+            match v.get_mut(name) {
+                Some(Property::Float(c)) => *c = *x,
+                Some(Property::Double(c)) => *c = f64::from(*x),
+                _ => bail!("--integer: the PLY's {name} is not a float property"),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `--integer` on glTF: each mesh's positions (all its primitives, one frame: they are one
+/// run) on the grid, in the primitives and in their `POSITION` data (float only: a quantised
+/// `POSITION` cannot hold another grid).
+fn gltf_onto_grid(f: &mut crate::io::gltf::GltfFile) -> Result<()> {
+    let meshes = f
+        .primitives
+        .iter()
+        .map(|p| p.mesh)
+        .max()
+        .map_or(0, |m| m + 1);
+    for m in 0..meshes {
+        let mut all: Vec<[f32; 3]> = f
+            .primitives
+            .iter()
+            .filter(|p| p.mesh == m)
+            .flat_map(|p| p.positions.iter().copied())
+            .collect();
+        onto_grid(&mut all)?;
+        let mut next = all.into_iter();
+        for p in f.primitives.iter_mut().filter(|p| p.mesh == m) {
+            for q in p.positions.iter_mut() {
+                *q = next.next().unwrap_or(*q);
+            }
+            let label = crate::io::gltf::label(p);
+            let Some(s) = p.attributes.iter_mut().find(|s| s.semantic == "POSITION") else {
+                continue;
+            };
+            if s.component_type != crate::io::gltf::FLOAT || s.elem != 12 {
+                bail!("--integer: {label}'s POSITION is not float: it cannot hold the grid");
+            }
+            for (d, q) in s.data.chunks_exact_mut(12).zip(&p.positions) {
+                for (b, x) in d.chunks_exact_mut(4).zip(q) {
+                    b.copy_from_slice(&x.to_le_bytes());
+                }
+            }
+        }
     }
     Ok(())
 }
@@ -117,7 +192,6 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
             std::fs::File::create(o).map_err(|e| anyhow!("{}: cannot create: {e}", o.display()))?;
             let _ = std::fs::remove_file(o);
         }
-        refuse_integer(args)?;
         return run_gltf(args).map(Some);
     }
     let is_obj = |p: &Path| {
@@ -137,7 +211,6 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         let bytes = std::fs::read(i).map_err(|e| anyhow!("{}: cannot read: {e}", i.display()))?;
         if crate::io::objattr::has_attributes(&bytes) {
             refuse_optimal(args)?;
-            refuse_integer(args)?;
             return run_obj(args, &bytes, t0).map(Some);
         }
     }
@@ -159,7 +232,6 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
         let extra = crate::io::plyattr::extra_properties(&bytes);
         if !extra.is_empty() {
             refuse_optimal(args)?;
-            refuse_integer(args)?;
             return run_ply(args, &bytes, &extra, t0).map(Some);
         }
     }
@@ -167,8 +239,11 @@ pub fn run_if_attributes(args: &Args) -> Result<Option<ExitCode>> {
 }
 
 fn run_ply(args: &Args, bytes: &[u8], extra: &[String], t0: Instant) -> Result<ExitCode> {
-    let file =
+    let mut file =
         crate::io::plyattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    if args.integer {
+        ply_onto_grid(&mut file)?;
+    }
     let parts = vec![("vertex element".to_string(), file.mesh.clone(), None, None)];
     let mut times = Times {
         read: t0.elapsed(),
@@ -669,6 +744,13 @@ fn finish(
         crate::outln!("{}", serde_json::to_string_pretty(&j)?);
     } else {
         let mut text = head;
+        if args.integer {
+            let _ = writeln!(
+                text,
+                "  in integers: the positions put on a 15-bit grid before the run (one per \
+                 glTF mesh, or per file), and written as the grid's"
+            );
+        }
         for p in parts {
             let _ = writeln!(text, "{}", p.line);
         }
@@ -705,7 +787,10 @@ fn finish(
 
 fn run_gltf(args: &Args) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let file = crate::io::gltf::load(&args.input)?;
+    let mut file = crate::io::gltf::load(&args.input)?;
+    if args.integer {
+        gltf_onto_grid(&mut file)?;
+    }
     let mut times = Times {
         read: t0.elapsed(),
         ..Times::default()
@@ -875,8 +960,11 @@ fn obj_texture_coordinates(file: &crate::io::objattr::ObjFile, g: usize) -> Opti
 }
 
 fn run_obj(args: &Args, bytes: &[u8], t0: Instant) -> Result<ExitCode> {
-    let file =
+    let mut file =
         crate::io::objattr::parse(bytes).map_err(|e| anyhow!("{}: {e}", args.input.display()))?;
+    if args.integer {
+        obj_onto_grid(&mut file)?;
+    }
     let mut times = Times {
         read: t0.elapsed(),
         ..Times::default()
