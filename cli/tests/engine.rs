@@ -433,6 +433,31 @@ fn integer_runs_carry_attributes_and_write_the_grid() {
         );
         assert!(!so.contains("NOT valid"), "{so}");
     }
+    // A PLY with integer coordinates cannot hold the grid's positions: refused, named.
+    let int_ply = d.path().join("int.ply");
+    std::fs::write(
+        &int_ply,
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty int x\nproperty int y\n\
+         property int z\nproperty uchar red\nelement face 2\n\
+         property list uchar int vertex_indices\nend_header\n0 0 0 1\n3 0 0 1\n3 3 1 1\n\
+         0 3 0 1\n3 0 1 2\n3 0 2 3\n",
+    )
+    .unwrap();
+    let int_out = d.path().join("int-out.ply");
+    let o = run(&[
+        "simplify",
+        s(&int_ply),
+        s(&int_out),
+        "--ratio",
+        "0.5",
+        "--integer",
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(
+        text(&o.stderr).contains("not a float property"),
+        "{}",
+        text(&o.stderr)
+    );
     // The input's largest extent is 10 · 0.41 (y): the cell is 2⁻¹², the power of two at or
     // above 4.1 / 32 766.
     let cell = (4.1f64 / 32_766.0).log2().ceil().exp2();

@@ -125,8 +125,9 @@ fn ply_onto_grid(f: &mut crate::io::plyattr::PlyFile) -> Result<()> {
 }
 
 /// `--integer` on glTF: each mesh's positions (all its primitives, one frame: they are one
-/// run) on the grid, in the primitives and in their `POSITION` data (float only: a quantised
-/// `POSITION` cannot hold another grid).
+/// run) on the grid, in the primitives and in their `POSITION` data (float, as core glTF has
+/// it; the loader refuses `KHR_mesh_quantization`, and a quantised one could not hold another
+/// grid).
 fn gltf_onto_grid(f: &mut crate::io::gltf::GltfFile) -> Result<()> {
     let meshes = f
         .primitives
