@@ -193,7 +193,11 @@ fn leading_zeros(x: u32) -> u32 {
 }
 
 /// [`leading_zeros`] by halving the window: 16, 8, 4, 2 and 1 bits.
-#[cfg(any(armv6m, target_arch = "riscv32", test))]
+#[cfg(any(
+    armv6m,
+    all(target_arch = "riscv32", not(target_feature = "zbb")),
+    test
+))]
 #[inline(never)]
 fn zeros_by_halving(x: u32) -> u32 {
     if x == 0 {
