@@ -729,13 +729,10 @@ mod tests {
         assert!(status_text(&e).starts_with("TooBig"));
     }
 
-    /// The demo's fast run is a case of method `Fast` (code 6 in the case file) whose host
-    /// reference is the library's fast mode, its lean run one of method `Lean` (code 7) with
-    /// the lean mode; the instructions row divides by the collapses.
-    #[test]
-    fn the_fast_and_lean_runs_are_those_modes() {
+    /// A bumpy 10 x 10 grid as a plain case (u16, `Config::new()`).
+    fn grid_case() -> Case {
         let m = meshfmt::golden::bumpy_grid(10);
-        let case = Case {
+        Case {
             name: "g".into(),
             mesh: "grid 10".into(),
             positions: m.positions,
@@ -745,7 +742,15 @@ mod tests {
             config: Config::new(),
             stored: None,
             method: None,
-        };
+        }
+    }
+
+    /// The demo's fast run is a case of method `Fast` (code 6 in the case file) whose host
+    /// reference is the library's fast mode, its lean run one of method `Lean` (code 7) with
+    /// the lean mode; the instructions row divides by the collapses.
+    #[test]
+    fn the_fast_and_lean_runs_are_those_modes() {
+        let case = grid_case();
         let fast = pipeline_case(&case, Pipeline::Fast);
         assert_eq!(fast.header().method, meshfmt::MethodCode::Fast);
         assert_eq!(fast.encode().unwrap()[30], 6);
@@ -805,18 +810,7 @@ mod tests {
     /// workspace on those grid positions; their labels say "integer".
     #[test]
     fn the_integer_runs_are_the_integer_modes() {
-        let m = meshfmt::golden::bumpy_grid(10);
-        let case = Case {
-            name: "g".into(),
-            mesh: "grid 10".into(),
-            positions: m.positions,
-            triangles: m.triangles,
-            wedges: Vec::new(),
-            index_type: IndexType::U16,
-            config: Config::new(),
-            stored: None,
-            method: None,
-        };
+        let case = grid_case();
         let mut want = vec![[0u16; 3]; case.positions.len()];
         tinydecimate::pipeline::quantise(&case.positions, &mut want).unwrap();
         for (mode, code) in [(Pipeline::Fast, 10), (Pipeline::Lean, 11)] {
@@ -846,18 +840,7 @@ mod tests {
 
     #[test]
     fn subset_fits_and_is_compact() {
-        let m = meshfmt::golden::bumpy_grid(10);
-        let case = Case {
-            name: "g".into(),
-            mesh: "grid 10".into(),
-            positions: m.positions,
-            triangles: m.triangles,
-            wedges: Vec::new(),
-            index_type: IndexType::U16,
-            config: Config::new(),
-            stored: None,
-            method: None,
-        };
+        let case = grid_case();
         let s = subset_that_fits(&case, 30, 1000);
         assert!(s.positions.len() <= 30);
         assert!(!s.triangles.is_empty());

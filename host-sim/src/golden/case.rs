@@ -616,37 +616,26 @@ fn run_reference<I: tinydecimate::Index>(
                 EdgeCollapse,
             )?
             .run(),
-        Entry::Fast => crate::simplify::pipeline_run(
-            crate::simplify::Pipeline::Fast,
-            positions,
-            triangles,
-            config,
-        )?,
-        Entry::Lean => crate::simplify::pipeline_run(
-            crate::simplify::Pipeline::Lean,
-            positions,
-            triangles,
-            config,
-        )?,
-        Entry::FastWedges | Entry::LeanWedges => {
-            let mode = if entry == Entry::FastWedges {
-                crate::simplify::Pipeline::Fast
-            } else {
-                crate::simplify::Pipeline::Lean
-            };
-            crate::simplify::pipeline_run_wedges(mode, positions, (triangles, wedges), config)?
+        Entry::Fast | Entry::Lean => {
+            crate::simplify::pipeline_run(pipeline_of(entry), positions, triangles, config)?
         }
-        Entry::FastInteger => crate::simplify::pipeline_run_grid(
-            crate::simplify::Pipeline::Fast,
-            grid,
-            triangles,
+        Entry::FastWedges | Entry::LeanWedges => crate::simplify::pipeline_run_wedges(
+            pipeline_of(entry),
+            positions,
+            (triangles, wedges),
             config,
         )?,
-        Entry::LeanInteger => crate::simplify::pipeline_run_grid(
-            crate::simplify::Pipeline::Lean,
-            grid,
-            triangles,
-            config,
-        )?,
+        Entry::FastInteger | Entry::LeanInteger => {
+            crate::simplify::pipeline_run_grid(pipeline_of(entry), grid, triangles, config)?
+        }
     })
+}
+
+/// The pipeline mode of a fast or lean entry (float, with wedges or in integers); the lean
+/// mode for any other.
+fn pipeline_of(entry: Entry) -> crate::simplify::Pipeline {
+    match entry {
+        Entry::Fast | Entry::FastWedges | Entry::FastInteger => crate::simplify::Pipeline::Fast,
+        _ => crate::simplify::Pipeline::Lean,
+    }
 }
