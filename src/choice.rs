@@ -31,7 +31,7 @@
 //! # Ok::<(), tinydecimate::Error>(())
 //! ```
 
-use crate::bound::{Controls, NoBound};
+use crate::bound::{Controls, Envelope, NoBound};
 use crate::cost::{AttributeQuadric, Builtin, Energy, StoredQuadric};
 use crate::operator::{EdgeCollapse, TriangleCollapse, VertexDecimation};
 use crate::{Config, Error, Index, Positions, Report, Storage};
@@ -54,6 +54,8 @@ pub enum ChosenBound<'a, I: Index> {
     None,
     /// The guaranteed bound at control points ([`Config::with_max_error`]).
     Controls(Controls<'a, I, u32>),
+    /// The two-sided bound of simplification envelopes ([`Config::with_max_error`]).
+    Envelope(Envelope<'a, I, u32>),
 }
 
 /// The operator of a run, chosen at run time.
@@ -193,6 +195,7 @@ impl<'a, L: Index> Storage<'a, L> {
                 match bound {
                     ChosenBound::None => with_operator!($cost, NoBound),
                     ChosenBound::Controls(c) => with_operator!($cost, c),
+                    ChosenBound::Envelope(e) => with_operator!($cost, e),
                 }
             };
         }

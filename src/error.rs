@@ -17,6 +17,9 @@ pub enum Capacity {
     /// Fewer control links than [`bound::control_len`](crate::bound::control_len), or more control points than the
     /// link type numbers ([`Controls`](crate::Controls)).
     Controls,
+    /// Fewer shell pairs than positions, or fewer index words than `2·T + 2`
+    /// ([`Envelope`](crate::Envelope)).
+    Envelope,
 }
 
 impl core::fmt::Display for Capacity {
@@ -26,6 +29,7 @@ impl core::fmt::Display for Capacity {
             Capacity::Triangles => "triangles",
             Capacity::Quadrics => "stored quadrics",
             Capacity::Controls => "control links",
+            Capacity::Envelope => "envelope storage",
         })
     }
 }
@@ -123,7 +127,7 @@ impl core::fmt::Display for Error {
                 let holds = match what {
                     Capacity::Vertices | Capacity::Triangles => "the workspace holds",
                     Capacity::Quadrics => "there are",
-                    Capacity::Controls => "there are",
+                    Capacity::Controls | Capacity::Envelope => "there are",
                 };
                 write!(f, "mesh needs {needed} {what} but {holds} {available}")?;
                 if matches!(what, Capacity::Vertices | Capacity::Triangles)

@@ -122,6 +122,7 @@ pub mod cluster;
 mod config;
 mod engine;
 mod error;
+mod exact;
 mod index;
 mod math;
 mod mesh;
@@ -153,7 +154,7 @@ pub use workspace::{Positions, Storage, Workspace};
 // Shortcuts to the items of the public modules a run names most: each has one home (its
 // module), where the documentation shows it.
 #[doc(no_inline)]
-pub use bound::{Controls, NoBound};
+pub use bound::{Controls, Envelope, NoBound};
 #[doc(no_inline)]
 pub use cost::{Builtin, Placement, StoredQuadric};
 #[doc(no_inline)]
@@ -175,3 +176,8 @@ pub struct ReadmeDoctests;
 #[cfg(all(doctest, feature = "fast"))]
 #[doc = include_str!("../docs/integer.md")]
 pub struct IntegerDoctests;
+
+/// docs/envelope.md's example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/envelope.md")]
+pub struct EnvelopeDoctests;

@@ -184,7 +184,7 @@ impl<'a, L: Index> Storage<'a, L> {
             });
         }
         if (!matches!(O::KIND, Kind::Edge) && config.schedule != Schedule::Greedy)
-            || (matches!(O::KIND, Kind::Removal) && B::ON)
+            || (matches!(O::KIND, Kind::Removal) && B::ON && !B::FILLS)
         {
             return Err(Error::InvalidConfig {
                 field: ConfigField::Operator,

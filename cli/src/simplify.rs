@@ -6,7 +6,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, Result};
-use tinydecimate::bound::Controls;
+use tinydecimate::bound::{Controls, Envelope};
 use tinydecimate::choice::{Chosen, ChosenBound, ChosenCost, ChosenOperator};
 use tinydecimate::cost::{
     AttributeQuadric, AttributeState, Energy, Placement, Samples, StoredQuadric, VertexQuadric,
@@ -92,6 +92,9 @@ pub struct Run {
     /// The error bound (control points in a `u32` link slice; the bound itself is
     /// `config.max_error`).
     pub bounded: bool,
+    /// With `bounded`: the two-sided bound of simplification envelopes (`bound::Envelope`: a
+    /// shell pair per position and `bound::index_len` `u32` words) instead of control points.
+    pub envelope: bool,
     /// Step with a progress bar.
     pub progress: bool,
     /// Weld seams first (`tinydecimate::seam::weld`: the vertices at one position collapse
@@ -221,6 +224,7 @@ pub fn simplify_with_attributes(
         operator,
         placement,
         bounded,
+        envelope,
         progress,
         weld,
         lock_seam_corners,
@@ -263,12 +267,19 @@ pub fn simplify_with_attributes(
     let mut quadrics: Vec<VertexQuadric> = vec![[0.0; 10]; n];
     let mut states =
         vec![AttributeState::<ATTRIBUTES>::ZERO; if attributes.is_some() { n } else { 0 }];
-    let n = if bounded {
+    let n = if bounded && !envelope {
         tinydecimate::bound::control_len(tris.len(), positions.len())
     } else {
         0
     };
     let mut links = vec![0u32; n];
+    let (ns, ni) = if bounded && envelope {
+        (positions.len(), tinydecimate::bound::index_len(tris.len()))
+    } else {
+        (0, 0)
+    };
+    let mut shell = vec![[[0.0f32; 3]; 2]; ns];
+    let mut index = vec![0u32; ni];
     let mut samples: Vec<Samples> =
         vec![[0.0; 10]; if energy.is_some() { positions.len() } else { 0 }];
     let mut ws = HostWorkspace::for_mesh(mesh);
@@ -311,7 +322,9 @@ pub fn simplify_with_attributes(
             VertexDecimation::new().with_fill(tinydecimate::Fill::Shape),
         ),
     };
-    let bound = if bounded {
+    let bound = if bounded && envelope {
+        ChosenBound::Envelope(Envelope::new(original, &mut shell, &mut index))
+    } else if bounded {
         ChosenBound::Controls(Controls::new(original, &mut links))
     } else {
         ChosenBound::None

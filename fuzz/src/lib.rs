@@ -1120,3 +1120,138 @@ pub fn check_mesh_data(m: &tinydecimate_cli::io::MeshData) {
     }
     let _ = m.bbox_diagonal();
 }
+
+impl Case {
+    /// The envelope bound (`bound::Envelope`) on the case's mesh, with the edge collapse and
+    /// with vertex decimation: a documented error, or a valid output whose sampled distance to
+    /// the input, both ways, is within the bound.
+    pub fn check_envelope(&self) {
+        match (self.workspace, self.wide) {
+            (0, false) => envelope::<u16, u16, 64, 64>(self),
+            (0, true) => envelope::<u16, u32, 64, 64>(self),
+            (1, false) => envelope::<u16, u16, 512, 512>(self),
+            (1, true) => envelope::<u16, u32, 512, 512>(self),
+            (_, false) => envelope::<u32, u16, 512, 1024>(self),
+            (_, true) => envelope::<u32, u32, 512, 1024>(self),
+        }
+    }
+}
+
+fn envelope<L: Index + 'static, I: Idx, const V: usize, const T: usize>(case: &Case) {
+    use tinydecimate::bound::{bounding_diagonal, index_len, Envelope};
+    use tinydecimate::{Builtin, VertexDecimation};
+    let input: Vec<[I; 3]> = case.triangles.iter().map(|t| t.map(I::from_u32)).collect();
+    if expected_error::<L, I, V, T>(&case.positions, &input, &case.config).is_some() {
+        // The errors before a bound's are the `simplify` target's.
+        return;
+    }
+    let step = case.budgets.first().copied().unwrap_or(0) % 16;
+    let eps = bounding_diagonal(&case.positions) * (0.005 + 0.004 * step as f32);
+    let config = Config::new().with_ratio(0.0).with_max_error(eps);
+    let inp: Vec<[u32; 3]> = input.iter().map(|t| t.map(I::to_u32)).collect();
+    let view = engine_view(&case.positions, &inp);
+    for removal in [false, true] {
+        let mut buf = input.clone();
+        let mut shell = vec![[[0.0f32; 3]; 2]; case.positions.len()];
+        let mut index = vec![0u32; index_len(input.len())];
+        let bound = Envelope::new(&input, &mut shell, &mut index);
+        let mut ws = Box::new(Workspace::<L, V, T>::new());
+        let p = Positions::Read(&case.positions);
+        let r = if removal {
+            ws.as_storage()
+                .start(p, &mut buf, &config, Builtin::new(), bound, VertexDecimation::new())
+                .map(|s| s.run())
+        } else {
+            ws.as_storage()
+                .start(p, &mut buf, &config, Builtin::new(), bound, EdgeCollapse)
+                .map(|s| s.run())
+        };
+        let report = match r {
+            Err(e) => {
+                assert!(
+                    matches!(e, Error::InvalidConfig { .. }),
+                    "envelope: unexpected error {e:?}"
+                );
+                assert!(buf == input, "envelope: buffer modified on error {e:?}");
+                continue;
+            }
+            Ok(r) => r,
+        };
+        check_output(case, &input, &buf, &report, &view, "envelope");
+        let out: Vec<[u32; 3]> = buf[..report.triangles_out]
+            .iter()
+            .map(|t| t.map(I::to_u32))
+            .collect();
+        let bound = f64::from(eps) * 1.0001;
+        let d = sampled_distance(&case.positions, &out, &inp)
+            .max(sampled_distance(&case.positions, &inp, &out));
+        assert!(d <= bound, "envelope: sampled distance {d:e} above the bound {bound:e}");
+    }
+}
+
+/// The largest distance from points sampled on `from` (corners, edge midpoints, centroids and
+/// the points halfway from each corner to the centroid) to the triangles of `to`, in f64.
+fn sampled_distance(pos: &[[f32; 3]], from: &[[u32; 3]], to: &[[u32; 3]]) -> f64 {
+    let p = |v: u32| pos[v as usize].map(f64::from);
+    let to: Vec<[[f64; 3]; 3]> = to.iter().map(|t| t.map(p)).collect();
+    let mut worst = 0.0f64;
+    for t in from {
+        let [a, b, c] = t.map(p);
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            continue;
+        }
+        let g = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+        let mid = |x: [f64; 3], y: [f64; 3]| [0, 1, 2].map(|k| (x[k] + y[k]) / 2.0);
+        for q in [a, b, c, mid(a, b), mid(b, c), mid(c, a), g, mid(a, g), mid(b, g), mid(c, g)] {
+            let d = to
+                .iter()
+                .map(|&s| point_triangle(q, s))
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d);
+        }
+    }
+    worst
+}
+
+/// Distance from `p` to the triangle `t` (Ericson, "Real-Time Collision Detection" §5.1.5).
+fn point_triangle(p: [f64; 3], t: [[f64; 3]; 3]) -> f64 {
+    let sub = |x: [f64; 3], y: [f64; 3]| [x[0] - y[0], x[1] - y[1], x[2] - y[2]];
+    let dot = |x: [f64; 3], y: [f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+    let at = |o: [f64; 3], u: [f64; 3], s: f64| [o[0] + u[0] * s, o[1] + u[1] * s, o[2] + u[2] * s];
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let q = if d1 <= 0.0 && d2 <= 0.0 {
+        a
+    } else {
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        let cp = sub(p, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        let vc = d1 * d4 - d3 * d2;
+        let vb = d5 * d2 - d1 * d6;
+        let va = d3 * d6 - d5 * d4;
+        if d3 >= 0.0 && d4 <= d3 {
+            b
+        } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            at(a, ab, d1 / (d1 - d3))
+        } else if d6 >= 0.0 && d5 <= d6 {
+            c
+        } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            at(a, ac, d2 / (d2 - d6))
+        } else if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+            at(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)))
+        } else {
+            let s = va + vb + vc;
+            if s > 0.0 {
+                at(at(a, ab, vb / s), ac, vc / s)
+            } else {
+                // Degenerate: its corners.
+                let e = [a, b, c].map(|x| dot(sub(p, x), sub(p, x)));
+                return e[0].min(e[1]).min(e[2]).sqrt();
+            }
+        }
+    };
+    let d = sub(p, q);
+    dot(d, d).sqrt()
+}

@@ -249,6 +249,9 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         if let Some(c) = self.bound.controls_mut() {
             c.enrol(&self.mesh, d);
         }
+        if let Some(e) = self.bound.envelope_mut() {
+            e.enrol(&self.mesh, d);
+        }
     }
 
     /// Runs at most `budget` operations and returns `true` once the run is finished.

@@ -32,6 +32,11 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
                     return Err(crate::Reject::Bound);
                 }
             }
+            if let Some(e) = self.bound.envelope() {
+                if !e.allows(&self.mesh, from, to) {
+                    return Err(crate::Reject::Bound);
+                }
+            }
         }
         Ok(())
     }

@@ -103,6 +103,13 @@ impl<'a, L: Index, I: Index, C: Cost, B: Bound<'a, I>, O: Operator> Simplifier<'
         for (t, s) in tris.iter_mut().zip(new) {
             *t = s.map(|k| fan.ring().get(k as usize).copied().unwrap_or(NIL));
         }
+        if B::ON && on!(Bound) {
+            if let Some(e) = self.bound.envelope() {
+                if !e.allows_fill(&self.mesh, v, tris.get(..n).unwrap_or(&[])) {
+                    return self.rejected.count(legality::Reject::Bound);
+                }
+            }
+        }
         if self.mesh.replace_fan(v, tris.get(..n).unwrap_or(&[])) == 0 {
             // Nothing was replaced (cannot happen after `classify`): the vertex stays out.
             return;

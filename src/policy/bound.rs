@@ -33,6 +33,23 @@ pub const fn control_len(triangles: usize, vertices: usize) -> usize {
     triangles.saturating_mul(2).saturating_add(vertices)
 }
 
+/// A bound's original triangles against the ones to simplify: equal, else
+/// [`Error::OriginalMismatch`](crate::Error::OriginalMismatch) at the first that differs.
+pub(crate) fn same_triangles<I: Index>(
+    original: &[[I; 3]],
+    triangles: &[[I; 3]],
+) -> Result<(), crate::Error> {
+    if original.len() != triangles.len() {
+        return Err(crate::Error::OriginalMismatch {
+            triangle: original.len().min(triangles.len()),
+        });
+    }
+    match original.iter().zip(triangles).position(|(a, b)| a != b) {
+        Some(t) => Err(crate::Error::OriginalMismatch { triangle: t }),
+        None => Ok(()),
+    }
+}
+
 /// The length of the bounding-box diagonal of `positions` (the finite ones), for a bound given
 /// as a fraction of it ([`Config::with_relative_max_error`](crate::Config::with_relative_max_error)).
 pub fn bounding_diagonal(positions: &[[f32; 3]]) -> f32 {
@@ -140,10 +157,13 @@ mod sealed {
     pub trait Sealed {}
     impl Sealed for super::NoBound {}
     impl<I: crate::Index, K: crate::Index> Sealed for super::Controls<'_, I, K> {}
+    impl<I: crate::Index, K: crate::Index> Sealed for super::Envelope<'_, I, K> {}
 }
 
-/// What the engine checks collapses against: [`NoBound`] (the default, which costs nothing) or
-/// [`Controls`]. Sealed.
+pub use super::envelope::{index_len, Envelope};
+
+/// What the engine checks operations against: [`NoBound`] (the default, which costs nothing),
+/// [`Controls`] or [`Envelope`]. Sealed.
 pub trait Bound<'a, I: Index>: sealed::Sealed + 'a {
     /// The link type of the control slice.
     #[doc(hidden)]
@@ -157,6 +177,22 @@ pub trait Bound<'a, I: Index>: sealed::Sealed + 'a {
     /// The control points, if any.
     #[doc(hidden)]
     fn controls_mut(&mut self) -> Option<&mut Controls<'a, I, Self::K>>;
+    /// Whether the bound can judge a vertex removal's fill (so runs with
+    /// [`VertexDecimation`](crate::VertexDecimation)).
+    #[doc(hidden)]
+    const FILLS: bool = false;
+    /// The envelope, if any.
+    #[doc(hidden)]
+    #[inline(always)]
+    fn envelope(&self) -> Option<&Envelope<'a, I, Self::K>> {
+        None
+    }
+    /// The envelope, if any.
+    #[doc(hidden)]
+    #[inline(always)]
+    fn envelope_mut(&mut self) -> Option<&mut Envelope<'a, I, Self::K>> {
+        None
+    }
     /// Checks the bound's storage and configuration when the run starts, before anything is
     /// written: `triangles` are the ones to simplify, `vertices` the number of positions.
     #[doc(hidden)]
@@ -166,6 +202,36 @@ pub trait Bound<'a, I: Index>: sealed::Sealed + 'a {
         vertices: usize,
         config: &crate::Config,
     ) -> Result<(), crate::Error>;
+}
+
+impl<'a, I: Index, K: Index> Bound<'a, I> for Envelope<'a, I, K> {
+    type K = K;
+    const ON: bool = true;
+    const FILLS: bool = true;
+    #[inline(always)]
+    fn controls(&self) -> Option<&Controls<'a, I, K>> {
+        None
+    }
+    #[inline(always)]
+    fn controls_mut(&mut self) -> Option<&mut Controls<'a, I, K>> {
+        None
+    }
+    #[inline(always)]
+    fn envelope(&self) -> Option<&Envelope<'a, I, K>> {
+        Some(self)
+    }
+    #[inline(always)]
+    fn envelope_mut(&mut self) -> Option<&mut Envelope<'a, I, K>> {
+        Some(self)
+    }
+    fn prepare(
+        &mut self,
+        triangles: &[[I; 3]],
+        vertices: usize,
+        config: &crate::Config,
+    ) -> Result<(), crate::Error> {
+        Envelope::prepare(self, triangles, vertices, config)
+    }
 }
 
 /// No error bound (the default engine): [`Config::max_error`](crate::Config::max_error) must
@@ -218,15 +284,7 @@ impl<'a, I: Index, K: Index> Bound<'a, I> for Controls<'a, I, K> {
         config: &crate::Config,
     ) -> Result<(), crate::Error> {
         use crate::{Capacity, Error};
-        let original = self.original;
-        if original.len() != triangles.len() {
-            return Err(Error::OriginalMismatch {
-                triangle: original.len().min(triangles.len()),
-            });
-        }
-        if let Some(t) = original.iter().zip(triangles).position(|(a, b)| a != b) {
-            return Err(Error::OriginalMismatch { triangle: t });
-        }
+        same_triangles(self.original, triangles)?;
         let need = control_len(triangles.len(), vertices);
         let available = if need > K::COUNT {
             K::COUNT

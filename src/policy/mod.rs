@@ -3,5 +3,6 @@
 
 pub mod bound;
 pub mod cost;
+mod envelope;
 pub(crate) mod feature;
 pub mod legality;

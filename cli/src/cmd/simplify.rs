@@ -209,6 +209,16 @@ impl std::fmt::Display for MaxError {
     }
 }
 
+/// What `--max-error` bounds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum BoundArg {
+    /// Control points (Zhu, Wang and Meng 2007): original centroids and feature vertices.
+    #[default]
+    Controls,
+    /// Simplification envelopes (Cohen et al.): every point, both ways.
+    Envelope,
+}
+
 /// `P%` or a distance.
 pub fn parse_max_error(v: &str) -> std::result::Result<MaxError, String> {
     let v = v.trim();
@@ -446,6 +456,14 @@ pub struct Args {
     /// one-sided maximum from the input to the result.
     #[arg(long, group = "target", allow_negative_numbers = true, value_parser = parse_max_error)]
     pub max_error: Option<MaxError>,
+    /// What --max-error bounds: `controls` (the default), the control points above; or
+    /// `envelope`, simplification envelopes (Cohen et al. 1996): every point of
+    /// the result within the bound of the original and every original point within it of
+    /// the result, for a closed manifold input (docs/envelope.md: borders are kept, and
+    /// vertices where the envelope cannot be built stay). With --operator edge (subset
+    /// placement) or vertex-decimation.
+    #[arg(long, value_enum, default_value_t = BoundArg::Controls, requires = "max_error")]
+    pub bound: BoundArg,
     /// Error limit (`Config::error_limit`): a collapse whose own error (the RMS distance from
     /// the kept vertex to the planes it replaces, plus any boundary retreat) is above it is not
     /// made, so the run stops short of the target (`stop: ErrorLimit`) rather than cut a corner
@@ -814,6 +832,7 @@ fn simplify_file(args: &Args, out_format: Format) -> Result<Run> {
         operator: args.operator,
         placement,
         bounded,
+        envelope: args.bound == BoundArg::Envelope,
         progress: true,
         weld: args.seams == SeamsArg::Weld,
         // No attribute is carried here, so a seam corner has nothing to tear.

@@ -544,6 +544,7 @@ pub enum ErrorKind {
     CapacityControls = 7,
     OriginalMismatch = 8,
     OffGrid = 9,
+    CapacityEnvelope = 10,
 }
 
 /// Which board produced a result (0 for the host).
@@ -710,6 +711,7 @@ impl ResultHeader {
             7 => ErrorKind::CapacityControls,
             8 => ErrorKind::OriginalMismatch,
             9 => ErrorKind::OffGrid,
+            10 => ErrorKind::CapacityEnvelope,
             _ => return Err(FormatError::Code),
         };
         let hash = [r.u8(), r.u8(), r.u8()];
@@ -956,6 +958,7 @@ pub mod lib {
                             tinydecimate::Capacity::Triangles => ErrorKind::CapacityTriangles,
                             tinydecimate::Capacity::Quadrics => ErrorKind::CapacityQuadrics,
                             tinydecimate::Capacity::Controls => ErrorKind::CapacityControls,
+                            tinydecimate::Capacity::Envelope => ErrorKind::CapacityEnvelope,
                         },
                         narrow(needed),
                         narrow(available),

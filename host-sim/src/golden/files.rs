@@ -104,6 +104,9 @@ fn error_text(h: &ResultHeader) -> String {
         ErrorKind::InvalidConfig => format!("invalid config: field {a}"),
         ErrorKind::CapacityQuadrics => format!("capacity: {a} quadrics needed, {b} available"),
         ErrorKind::CapacityControls => format!("capacity: {a} control links needed, {b} available"),
+        ErrorKind::CapacityEnvelope => {
+            format!("capacity: {a} envelope words needed, {b} available")
+        }
         ErrorKind::OriginalMismatch => format!("original triangle {a} differs"),
         ErrorKind::OffGrid => format!("off the grid: vertex {a}"),
     }
