@@ -96,6 +96,36 @@ impl Grid {
     fn id(&self, c: [usize; 3]) -> usize {
         (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
     }
+
+    /// Calls `f` on each cell from `l` to `h` (corners included); stops when `f` returns
+    /// `true` and returns whether it did.
+    fn each_cell(
+        &self,
+        l: [usize; 3],
+        h: [usize; 3],
+        mut f: impl FnMut([usize; 3]) -> bool,
+    ) -> bool {
+        for z in l[2]..=h[2] {
+            for y in l[1]..=h[1] {
+                for x in l[0]..=h[0] {
+                    if f([x, y, z]) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
+/// A unit's points: for each corner of its original triangle, the position and the outer and
+/// inner envelope points (normalised units). Read once per visit, for its box and triangles.
+type Unit = [[V3; 3]; 3];
+
+/// The box of a unit's envelope and surface.
+fn unit_box(u: &Unit) -> Box3 {
+    let [a, b, c] = *u;
+    bbox(&[a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]])
 }
 
 /// An axis-aligned box.
@@ -224,34 +254,25 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
             .map_or([NIL; 3], |x| x.map(|v| v.to_usize()))
     }
 
-    /// `v`'s points on the outer and inner envelope, in normalised units.
-    fn shell_points<L: Index>(&self, mesh: &Mesh<'_, L, I>, v: usize) -> [V3; 2] {
-        let p = mesh.p(v);
-        self.offsets(v).map(|d| math::add(p, d))
+    /// Triangle `t`'s unit: each corner's position, outer and inner point.
+    fn unit<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> Unit {
+        self.corners_of(t).map(|v| {
+            let p = mesh.p(v);
+            let [u, d] = self.offsets(v).map(|o| math::add(p, o));
+            [p, u, d]
+        })
     }
 
-    /// The box of triangle `t`'s envelope (its surface too).
-    fn unit_box<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> Box3 {
-        let mut pts = [[0.0; 3]; 9];
-        for (i, v) in self.corners_of(t).into_iter().enumerate() {
-            let [u, d] = self.shell_points(mesh, v);
-            if let Some(x) = pts.get_mut(3 * i..3 * i + 3) {
-                x.copy_from_slice(&[mesh.p(v), u, d]);
-            }
-        }
-        bbox(&pts)
+    /// The box of triangle `t`'s envelope and surface.
+    fn box_of<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> Box3 {
+        unit_box(&self.unit(mesh, t))
     }
 
-    /// Triangle `t`'s envelope triangles on the grid: the outer and the inner offset, then two
-    /// walls per border edge; returns how many.
-    fn unit_triangles<L: Index>(
-        &self,
-        mesh: &Mesh<'_, L, I>,
-        t: usize,
-        out: &mut [[P; 3]; 8],
-    ) -> usize {
-        let v = self.corners_of(t);
-        let s = v.map(|x| self.shell_points(mesh, x).map(exact::snap));
+    /// Unit `t`'s envelope triangles on the grid (its points `u`): the outer and the inner
+    /// offset, then two walls per border edge; returns how many (at most 8: `out` keeps a
+    /// place for the surface).
+    fn unit_triangles(&self, t: usize, u: &Unit, out: &mut [[P; 3]; 9]) -> usize {
+        let s = u.map(|[_, up, down]| [exact::snap(up), exact::snap(down)]);
         let [a, b, c] = s;
         out[0] = [a[0], b[0], c[0]];
         out[1] = [a[1], b[1], c[1]];
@@ -270,47 +291,37 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         n
     }
 
-    /// Calls `f` once for each envelope unit whose box meets `b` (each unit once: in the cell
-    /// holding the low corner of the two boxes' overlap); stops when `f` returns `true` and
-    /// returns whether it did.
+    /// Calls `f` once for each envelope unit whose box meets `b`, with its points (each unit
+    /// once: in the cell holding the low corner of the two boxes' overlap); stops when `f`
+    /// returns `true` and returns whether it did.
     fn each_near<L: Index>(
         &self,
         mesh: &Mesh<'_, L, I>,
         b: &Box3,
-        mut f: impl FnMut(usize) -> bool,
+        mut f: impl FnMut(usize, &Unit) -> bool,
     ) -> bool {
         let g = self.grid;
         if g.cells() == 0 {
             return false;
         }
-        let (lo, hi) = (g.cell(b.0), g.cell(b.1));
-        for z in lo[2]..=hi[2] {
-            for y in lo[1]..=hi[1] {
-                for x in lo[0]..=hi[0] {
-                    let id = g.id([x, y, z]);
-                    let (s, e) = (self.word(g.starts + id), self.word(g.starts + id + 1));
-                    for i in s..e {
-                        let t = self.word(g.entries + i);
-                        let ub = self.unit_box(mesh, t);
-                        if !overlap(b, &ub) {
-                            continue;
-                        }
-                        let low = [
-                            b.0[0].max(ub.0[0]),
-                            b.0[1].max(ub.0[1]),
-                            b.0[2].max(ub.0[2]),
-                        ];
-                        if g.cell(low) != [x, y, z] {
-                            continue;
-                        }
-                        if f(t) {
-                            return true;
-                        }
-                    }
+        g.each_cell(g.cell(b.0), g.cell(b.1), |c| {
+            let id = g.id(c);
+            let (s, e) = (self.word(g.starts + id), self.word(g.starts + id + 1));
+            (s..e).any(|i| {
+                let t = self.word(g.entries + i);
+                let u = self.unit(mesh, t);
+                let ub = unit_box(&u);
+                if !overlap(b, &ub) {
+                    return false;
                 }
-            }
-        }
-        false
+                let low = [
+                    b.0[0].max(ub.0[0]),
+                    b.0[1].max(ub.0[1]),
+                    b.0[2].max(ub.0[2]),
+                ];
+                g.cell(low) == c && f(t, &u)
+            })
+        })
     }
 
     /// Whether the triangle `q` (on the grid, box `b`) meets the envelope (with `surface`,
@@ -323,16 +334,20 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         surface: bool,
         mut skip: impl FnMut(usize) -> bool,
     ) -> bool {
-        self.each_near(mesh, b, |t| {
+        self.each_near(mesh, b, |t, u| {
             if skip(t) {
                 return false;
             }
-            let mut e = [[[0; 3]; 3]; 8];
-            let n = self.unit_triangles(mesh, t, &mut e);
-            let own = self.corners_of(t).map(|v| exact::snap(mesh.p(v)));
+            let mut e = [[[0; 3]; 3]; 9];
+            let mut n = self.unit_triangles(t, u, &mut e);
+            if surface {
+                if let Some(x) = e.get_mut(n) {
+                    *x = u.map(|[p, ..]| exact::snap(p));
+                    n += 1;
+                }
+            }
             e.iter()
                 .take(n)
-                .chain(surface.then_some(&own))
                 .any(|s| exact::triangles_meet_beyond(*s, q))
         })
     }
@@ -493,7 +508,7 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         let mut all: Box3 = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         for t in 0..self.nt {
             if self.mask(t) & UNIT != 0 {
-                let b = self.unit_box(mesh, t);
+                let b = self.box_of(mesh, t);
                 for a in 0..3 {
                     all.0[a] = all.0[a].min(b.0[a]);
                     all.1[a] = all.1[a].max(b.1[a]);
@@ -538,8 +553,7 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
             let mut count = 0usize;
             for t in 0..self.nt {
                 if self.mask(t) & UNIT != 0 {
-                    let b = self.unit_box(mesh, t);
-                    let (l, h) = (g.cell(b.0), g.cell(b.1));
+                    let (l, h) = self.span(mesh, &g, t);
                     count = count
                         .saturating_add((h[0] + 1 - l[0]) * (h[1] + 1 - l[1]) * (h[2] + 1 - l[2]));
                 }
@@ -562,7 +576,7 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         g: &Grid,
         t: usize,
     ) -> ([usize; 3], [usize; 3]) {
-        let b = self.unit_box(mesh, t);
+        let b = self.box_of(mesh, t);
         (g.cell(b.0), g.cell(b.1))
     }
 
@@ -578,15 +592,12 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
                 continue;
             }
             let (l, h) = self.span(mesh, &g, t);
-            for z in l[2]..=h[2] {
-                for y in l[1]..=h[1] {
-                    for x in l[0]..=h[0] {
-                        let i = g.starts + g.id([x, y, z]) + 1;
-                        let w = self.word(i);
-                        self.set_word(i, w + 1);
-                    }
-                }
-            }
+            g.each_cell(l, h, |c| {
+                let i = g.starts + g.id(c) + 1;
+                let w = self.word(i);
+                self.set_word(i, w + 1);
+                false
+            });
         }
         // Ends of each cell's run.
         let mut sum = 0;
@@ -601,16 +612,13 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
                 continue;
             }
             let (l, h) = self.span(mesh, &g, t);
-            for z in l[2]..=h[2] {
-                for y in l[1]..=h[1] {
-                    for x in l[0]..=h[0] {
-                        let i = g.starts + g.id([x, y, z]) + 1;
-                        let pos = self.word(i).saturating_sub(1);
-                        self.set_word(i, pos);
-                        self.set_word(g.entries + pos, t);
-                    }
-                }
-            }
+            g.each_cell(l, h, |c| {
+                let i = g.starts + g.id(c) + 1;
+                let pos = self.word(i).saturating_sub(1);
+                self.set_word(i, pos);
+                self.set_word(g.entries + pos, t);
+                false
+            });
         }
         // Shifted down one word, closed by the total.
         for c in 0..cells {
@@ -680,10 +688,11 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
     /// unit it shares no vertex with.
     fn clashes<L: Index>(&self, mesh: &Mesh<'_, L, I>, t: usize) -> u8 {
         let tri = self.corners_of(t);
-        let mut e = [[[0; 3]; 3]; 8];
-        let n = self.unit_triangles(mesh, t, &mut e);
-        let surface = tri.map(|v| exact::snap(mesh.p(v)));
-        let b = self.unit_box(mesh, t);
+        let u = self.unit(mesh, t);
+        let mut e = [[[0; 3]; 3]; 9];
+        let n = self.unit_triangles(t, &u, &mut e);
+        let surface = u.map(|[p, ..]| exact::snap(p));
+        let b = unit_box(&u);
         let adjacent = |u: usize| {
             let o = self.corners_of(u);
             u == t || o.iter().any(|v| tri.contains(v))
