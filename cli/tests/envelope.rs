@@ -126,3 +126,47 @@ fn vertex_decimation_fills_stay_within_the_bound() {
         .collect();
     assert_within_bound(&paths, OperatorArg::VertexDecimation);
 }
+
+/// A mesh too small for a fine grid (`fuzz/regressions/envelope-cube-coarse-grid`: a cube of
+/// side 10⁻²⁰): the grid is coarse but exact, so a cube within 0.5 % keeps its twelve faces.
+/// Before, no grid fitted its index and every collapse went through, down to a tetrahedron.
+#[test]
+fn a_cube_keeps_its_faces_whatever_its_scale() {
+    for scale in [1.0f32, 1e-20] {
+        let corners = [
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [0.0, 1.0, 1.0],
+        ];
+        let mesh = MeshData {
+            positions: corners
+                .iter()
+                .map(|p: &[f32; 3]| p.map(|x| x * scale))
+                .collect(),
+            triangles: vec![
+                [0, 1, 3],
+                [1, 2, 3],
+                [4, 5, 7],
+                [5, 6, 7],
+                [0, 3, 4],
+                [3, 5, 4],
+                [1, 7, 2],
+                [7, 6, 2],
+                [0, 4, 1],
+                [4, 7, 1],
+                [3, 2, 5],
+                [2, 6, 5],
+            ],
+        };
+        for operator in [OperatorArg::Edge, OperatorArg::VertexDecimation] {
+            let (out, bound, h) = bounded(&mesh, 0.005, operator);
+            assert_eq!(out.triangles.len(), 12, "{scale} {operator:?}");
+            assert!(h <= bound, "{scale} {operator:?}");
+        }
+    }
+}

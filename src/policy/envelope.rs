@@ -302,7 +302,12 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
     ) -> bool {
         let g = self.grid;
         if g.cells() == 0 {
-            return false;
+            // No grid (no unit had a box): every unit, so that a missing index can only cost
+            // time, never let a triangle through.
+            return (0..self.nt).any(|t| {
+                let u = self.unit(mesh, t);
+                self.mask(t) & UNIT != 0 && overlap(b, &unit_box(&u)) && f(t, &u)
+            });
         }
         g.each_cell(g.cell(b.0), g.cell(b.1), |c| {
             let id = g.id(c);
@@ -529,7 +534,18 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         let max_cells = self.nt.min(room / 5).max(1);
         let dims_for = |k: usize| {
             let h = side / k as f32;
-            ext.map(|e| ((e / h) as usize).saturating_add(1).clamp(1, MAX_SIDE))
+            // Cells to cover the extent, rounded up (`cell` clamps the far side in): one
+            // cell for `k = 1`, whose entries (one per unit) always fit.
+            ext.map(|e| {
+                let x = e / h;
+                let c = x as usize;
+                let c = if (c as f32) < x {
+                    c.saturating_add(1)
+                } else {
+                    c
+                };
+                c.clamp(1, MAX_SIDE)
+            })
         };
         let mut k = 1;
         while k < MAX_SIDE {

@@ -196,6 +196,15 @@ fn read_case(
         || (entry == meshfmt::Entry::Bounded
             && (board::bound_bytes(nv, nt, h.index_type.bytes()) > board::BOUND_BYTES
                 || !board::HAS_QUADRICS))
+        || (entry.envelope()
+            && (meshfmt::envelope_bytes(
+                nv,
+                nt,
+                h.index_type.bytes(),
+                core::mem::size_of::<board::Link>(),
+            ) > board::BOUND_BYTES
+                || !board::HAS_QUADRICS))
+        || (entry == meshfmt::Entry::EnvelopeDecimation && !board::VERTEX_DECIMATION)
     {
         if !board::has_mode(entry) {
             defmt::warn!("no such mode of the pipeline on this board");
@@ -591,6 +600,7 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
     let left_out = match entry {
         Entry::Simplify => false,
         Entry::VertexDecimation => !board::VERTEX_DECIMATION,
+        Entry::EnvelopeDecimation => !board::VERTEX_DECIMATION || !board::HAS_QUADRICS,
         Entry::Fast
         | Entry::Lean
         | Entry::FastWedges
@@ -623,6 +633,8 @@ fn run_library<I: tinydecimate::Index + bytemuck::Pod>(
         ),
         Entry::VertexDecimation => run_decimation(ws, positions, triangles, config),
         Entry::Energy => run_energy(ws, positions, triangles, config, quadrics),
+        Entry::Envelope => run_envelope(ws, positions, triangles, config, quadrics, false),
+        Entry::EnvelopeDecimation => run_envelope(ws, positions, triangles, config, quadrics, true),
         Entry::Fast
         | Entry::Lean
         | Entry::FastWedges
@@ -889,6 +901,63 @@ fn run_bounded<I: tinydecimate::Index + bytemuck::Pod>(
             tinydecimate::EdgeCollapse,
         )?
         .run())
+}
+
+/// An envelope case (`bound::Envelope`), with the edge collapse or with vertex decimation
+/// (`removal`). Never inlined, for the same reason as [`run_bounded`].
+#[cfg(feature = "lib")]
+#[inline(never)]
+fn run_envelope<I: tinydecimate::Index + bytemuck::Pod>(
+    ws: &mut board::Workspace,
+    positions: &mut [[f32; 3]],
+    triangles: &mut [[I; 3]],
+    config: &tinydecimate::Config,
+    quadrics: &mut [[f32; 10]],
+    removal: bool,
+) -> Result<tinydecimate::Report, tinydecimate::Error> {
+    // The quadric storage lends its bytes (`meshfmt::envelope_bytes`, checked by
+    // `read_case`): the shell, the index words, then the input triangles' read-only copy.
+    let bytes: &mut [u8] = bytemuck::cast_slice_mut(quadrics);
+    let (shell, rest) = bytes.split_at_mut((positions.len() * 24).min(bytes.len()));
+    let words =
+        tinydecimate::bound::index_len(triangles.len()) * core::mem::size_of::<board::Link>();
+    let (index, rest) = rest.split_at_mut(words.min(rest.len()));
+    let orig = rest.get_mut(..triangles.len() * 3 * core::mem::size_of::<I>());
+    let (Ok(shell), Ok(index), Some(Ok(orig))) = (
+        bytemuck::try_cast_slice_mut::<u8, [[f32; 3]; 2]>(shell),
+        bytemuck::try_cast_slice_mut::<u8, board::Link>(index),
+        orig.map(bytemuck::try_cast_slice_mut::<u8, [I; 3]>),
+    ) else {
+        return Err(tinydecimate::Error::OriginalMismatch { triangle: 0 });
+    };
+    if orig.len() != triangles.len() {
+        return Err(tinydecimate::Error::OriginalMismatch { triangle: 0 });
+    }
+    orig.copy_from_slice(triangles);
+    let p = tinydecimate::Positions::Read(positions);
+    let bound = tinydecimate::Envelope::new(orig, shell, index);
+    let cost = tinydecimate::Builtin::new();
+    Ok(if removal {
+        ws.start(
+            p,
+            triangles,
+            config,
+            cost,
+            bound,
+            tinydecimate::VertexDecimation::new(),
+        )?
+        .run()
+    } else {
+        ws.start(
+            p,
+            triangles,
+            config,
+            cost,
+            bound,
+            tinydecimate::EdgeCollapse,
+        )?
+        .run()
+    })
 }
 
 /// Without the library: the output is the input (boot + semihosting + defmt smoke test).

@@ -177,6 +177,11 @@ pub enum MethodCode {
     /// The lean mode in integers (`LeanWorkspace<_, _, _, pipeline::Integer>::simplify`), as
     /// `FastInteger`.
     LeanInteger = 11,
+    /// The built-in cost under the envelope bound (`bound::Envelope`), edge collapse; the bound
+    /// is the header's `max_error`.
+    Envelope = 12,
+    /// `VertexDecimation::new()` under the envelope bound, as `Envelope`.
+    EnvelopeDecimation = 13,
 }
 
 /// The library entry point a case runs: its method and whether it is bounded, decided once
@@ -207,6 +212,10 @@ pub enum Entry {
     FastInteger,
     /// `pipeline::LeanWorkspace<_, _, _, Integer>::simplify`, grid positions read.
     LeanInteger,
+    /// The built-in cost under the envelope bound (`bound::Envelope`), edge collapse.
+    Envelope,
+    /// `VertexDecimation::new()` under the envelope bound.
+    EnvelopeDecimation,
 }
 
 impl Entry {
@@ -239,6 +248,20 @@ impl Entry {
     pub const fn integer(self) -> bool {
         matches!(self, Entry::FastInteger | Entry::LeanInteger)
     }
+
+    /// Whether the run is under the envelope bound, whose storage the firmware borrows from
+    /// its quadric storage ([`envelope_bytes`]).
+    pub const fn envelope(self) -> bool {
+        matches!(self, Entry::Envelope | Entry::EnvelopeDecimation)
+    }
+}
+
+/// Bytes an envelope case of `v` vertices and `t` triangles borrows: the shell (24 B per
+/// vertex, first, for its `f32` alignment), `bound::index_len(t) = 6t + 2` words of
+/// `word_bytes`, then the input triangles' read-only copy in `index_bytes` (written out: the
+/// firmware image without the library must build too).
+pub const fn envelope_bytes(v: usize, t: usize, index_bytes: usize, word_bytes: usize) -> usize {
+    24 * v + (6 * t + 2) * word_bytes + 3 * t * index_bytes
 }
 
 /// A position of an integer case as the library takes it: the case file carries each grid
@@ -443,6 +466,8 @@ impl CaseHeader {
             9 => MethodCode::LeanWedges,
             10 => MethodCode::FastInteger,
             11 => MethodCode::LeanInteger,
+            12 => MethodCode::Envelope,
+            13 => MethodCode::EnvelopeDecimation,
             _ => return Err(FormatError::Code),
         };
         r.skip(1);
@@ -472,11 +497,14 @@ impl CaseHeader {
         self.max_error > 0.0 && self.max_error.is_finite()
     }
 
-    /// The entry point the case runs: the error bound first (the built-in cost), else its
-    /// method.
+    /// The entry point the case runs: the envelope methods under their bound; else the
+    /// control-point bound first (the built-in cost), else its method.
     pub fn entry(&self) -> Entry {
-        if self.bounded() {
-            return Entry::Bounded;
+        match self.method {
+            MethodCode::Envelope => return Entry::Envelope,
+            MethodCode::EnvelopeDecimation => return Entry::EnvelopeDecimation,
+            _ if self.bounded() => return Entry::Bounded,
+            _ => {}
         }
         match self.method {
             MethodCode::Quadric | MethodCode::NormalVariation => Entry::Simplify,
@@ -490,6 +518,8 @@ impl CaseHeader {
             MethodCode::LeanWedges => Entry::LeanWedges,
             MethodCode::FastInteger => Entry::FastInteger,
             MethodCode::LeanInteger => Entry::LeanInteger,
+            MethodCode::Envelope => Entry::Envelope,
+            MethodCode::EnvelopeDecimation => Entry::EnvelopeDecimation,
         }
     }
 
@@ -819,7 +849,9 @@ pub mod lib {
                 | MethodCode::FastWedges
                 | MethodCode::LeanWedges
                 | MethodCode::FastInteger
-                | MethodCode::LeanInteger => CostKind::Quadric,
+                | MethodCode::LeanInteger
+                | MethodCode::Envelope
+                | MethodCode::EnvelopeDecimation => CostKind::Quadric,
                 MethodCode::NormalVariation => CostKind::NormalVariation,
             });
         c = c.with_features(h.feature_mode != FeatureCode::Off);
@@ -1218,6 +1250,12 @@ mod tests {
             (MethodCode::LeanWedges, 9, Entry::LeanWedges),
             (MethodCode::FastInteger, 10, Entry::FastInteger),
             (MethodCode::LeanInteger, 11, Entry::LeanInteger),
+            (MethodCode::Envelope, 12, Entry::Envelope),
+            (
+                MethodCode::EnvelopeDecimation,
+                13,
+                Entry::EnvelopeDecimation,
+            ),
         ];
         for (method, code, entry) in cases {
             let mut h = case();
@@ -1236,12 +1274,19 @@ mod tests {
             assert_eq!(entry.wedges(), matches!(code, 8 | 9), "{method:?}");
             assert_eq!(entry.pipeline(), matches!(code, 6..=9), "{method:?}");
             assert_eq!(entry.integer(), matches!(code, 10 | 11), "{method:?}");
-            // The bound comes first, as the firmware has always run it.
+            assert_eq!(entry.envelope(), matches!(code, 12 | 13), "{method:?}");
+            // The control-point bound comes first, as the firmware has always run it; the
+            // envelope methods are their own bound.
             h.max_error = 0.25;
-            assert_eq!(h.entry(), Entry::Bounded);
+            let bounded = if entry.envelope() {
+                entry
+            } else {
+                Entry::Bounded
+            };
+            assert_eq!(h.entry(), bounded);
         }
         let mut b = case().to_bytes();
-        b[30] = 12;
+        b[30] = 14;
         assert_eq!(CaseHeader::from_bytes(&b), Err(FormatError::Code));
     }
 

@@ -9,7 +9,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use meshfmt::file::{decode_result, encode_case, encode_result};
 use meshfmt::{Board, Entry, IndexType, MethodCode, ResultHeader};
 use serde::Deserialize;
-use tinydecimate::bound::Controls;
+use tinydecimate::bound::{Controls, Envelope};
 use tinydecimate::cost::Energy;
 use tinydecimate::{
     Builtin, Config, EdgeCollapse, FeatureMode, NoBound, Placement, Positions, Schedule,
@@ -90,6 +90,11 @@ pub enum MethodName {
     /// The lean mode in integers (`LeanWorkspace<_, _, _, pipeline::Integer>::simplify`), as
     /// `FastInteger`.
     LeanInteger,
+    /// The built-in cost with the edge collapse under the envelope bound (`bound::Envelope`),
+    /// `max_error` its `ε`.
+    Envelope,
+    /// `VertexDecimation::new()` under the envelope bound, `max_error` its `ε`.
+    EnvelopeDecimation,
 }
 
 impl MethodName {
@@ -104,6 +109,8 @@ impl MethodName {
             MethodName::LeanWedges => MethodCode::LeanWedges,
             MethodName::FastInteger => MethodCode::FastInteger,
             MethodName::LeanInteger => MethodCode::LeanInteger,
+            MethodName::Envelope => MethodCode::Envelope,
+            MethodName::EnvelopeDecimation => MethodCode::EnvelopeDecimation,
         }
     }
 
@@ -122,7 +129,10 @@ impl MethodName {
             MethodName::Lean | MethodName::LeanWedges | MethodName::LeanInteger => {
                 Some(Pipeline::Lean)
             }
-            MethodName::VertexDecimation | MethodName::Energy => None,
+            MethodName::VertexDecimation
+            | MethodName::Energy
+            | MethodName::Envelope
+            | MethodName::EnvelopeDecimation => None,
         }
     }
 }
@@ -302,7 +312,17 @@ impl Case {
         {
             bail!("case name {name:?}: use letters, digits, '-' and '_'");
         }
-        if spec.method.is_some() && (spec.quadric.is_some() || spec.max_error.is_some()) {
+        let envelope = matches!(
+            spec.method,
+            Some(MethodName::Envelope | MethodName::EnvelopeDecimation)
+        );
+        if envelope && (spec.quadric.is_some() || spec.max_error.is_none()) {
+            bail!("case {name}: an envelope method takes `max_error` and no `quadric`");
+        }
+        if !envelope
+            && spec.method.is_some()
+            && (spec.quadric.is_some() || spec.max_error.is_some())
+        {
             bail!("case {name}: `method` goes with neither `quadric` nor `max_error`");
         }
         let mut mesh = load_mesh(name, &spec.mesh)?;
@@ -575,6 +595,31 @@ fn run_reference<I: tinydecimate::Index>(
             storage
                 .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
                 .run()
+        }
+        Entry::Envelope | Entry::EnvelopeDecimation => {
+            // The grid's words are `u32` here and the board's `Link` there: the outcome does
+            // not depend on the grid (its tests are exact, each pair once).
+            let original = triangles.to_vec();
+            let mut shell = vec![[[0.0f32; 3]; 2]; positions.len()];
+            let mut index = vec![0u32; tinydecimate::bound::index_len(triangles.len())];
+            let bound = Envelope::new(&original, &mut shell, &mut index);
+            let p = Positions::Read(positions);
+            if entry == Entry::Envelope {
+                storage
+                    .start(p, triangles, config, Builtin::new(), bound, EdgeCollapse)?
+                    .run()
+            } else {
+                storage
+                    .start(
+                        p,
+                        triangles,
+                        config,
+                        Builtin::new(),
+                        bound,
+                        VertexDecimation::new(),
+                    )?
+                    .run()
+            }
         }
         Entry::StoredSubset => storage
             .start(

@@ -168,6 +168,14 @@ impl Golden {
                 w,
                 "method = \"the lean mode in integers (LeanWorkspace<_, _, _, Integer>)\""
             )?,
+            Some(super::case::MethodName::Envelope) => writeln!(
+                w,
+                "method = \"edge collapse under the envelope bound (bound::Envelope)\""
+            )?,
+            Some(super::case::MethodName::EnvelopeDecimation) => writeln!(
+                w,
+                "method = \"vertex decimation under the envelope bound (bound::Envelope)\""
+            )?,
             None => {}
         }
         if case.config.max_error().is_finite() {
@@ -344,6 +352,11 @@ pub fn judge(
                 " (the integer fast mode's workspace: the firmware's INT_FAST_VERTICES and INT_FAST_TRIANGLES, 0 without it)"
             } else if case.method == Some(super::case::MethodName::LeanInteger) {
                 " (the integer lean mode's workspace: the firmware's INT_LEAN_VERTICES and INT_LEAN_TRIANGLES, 0 without it)"
+            } else if matches!(
+                case.method,
+                Some(super::case::MethodName::Envelope | super::case::MethodName::EnvelopeDecimation)
+            ) {
+                " (envelope: shell, index words and original triangles in the firmware's BOUND_BYTES; vertex decimation also its VERTEX_DECIMATION)"
             } else if case.config.max_error().is_finite() {
                 " (error bound: original triangles and control links in the firmware's BOUND_BYTES)"
             } else {
