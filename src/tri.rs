@@ -3,6 +3,16 @@
 //! before simplifying (the simplifier and the progressive mesh must drop the same ones; each
 //! walks its own lists for the earlier triangles).
 
+/// Where two lists of triangles differ: the shorter one's length if their lengths differ, else
+/// the first triangle that differs, `None` if they are equal (a bound's original triangles
+/// against the ones to simplify).
+pub(crate) fn first_difference<T: PartialEq>(a: &[[T; 3]], b: &[[T; 3]]) -> Option<usize> {
+    if a.len() != b.len() {
+        return Some(a.len().min(b.len()));
+    }
+    a.iter().zip(b).position(|(x, y)| x != y)
+}
+
 /// Marks the end of a list, or "no vertex".
 pub(crate) const NIL: usize = usize::MAX;
 

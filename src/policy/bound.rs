@@ -39,13 +39,8 @@ pub(crate) fn same_triangles<I: Index>(
     original: &[[I; 3]],
     triangles: &[[I; 3]],
 ) -> Result<(), crate::Error> {
-    if original.len() != triangles.len() {
-        return Err(crate::Error::OriginalMismatch {
-            triangle: original.len().min(triangles.len()),
-        });
-    }
-    match original.iter().zip(triangles).position(|(a, b)| a != b) {
-        Some(t) => Err(crate::Error::OriginalMismatch { triangle: t }),
+    match crate::tri::first_difference(original, triangles) {
+        Some(triangle) => Err(crate::Error::OriginalMismatch { triangle }),
         None => Ok(()),
     }
 }

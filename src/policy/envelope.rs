@@ -187,7 +187,9 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         config: &crate::Config,
     ) -> Result<(), crate::Error> {
         use crate::{Capacity, ConfigField, Error};
-        super::bound::same_triangles(self.original, triangles)?;
+        if let Some(triangle) = crate::tri::first_difference(self.original, triangles) {
+            return Err(Error::OriginalMismatch { triangle });
+        }
         if !config.max_error.is_finite() {
             return Err(Error::InvalidConfig {
                 field: ConfigField::MaxError,
