@@ -175,8 +175,8 @@ pub(crate) fn triangles_meet_beyond(s: [P; 3], t: [P; 3]) -> bool {
     match (count, shared) {
         (0, _) => triangles_meet(s, t),
         (1, Some((i, j))) => {
-            let (x, a, b) = (s[i], s[(i + 1) % 3], s[(i + 2) % 3]);
-            let (c, d) = (t[(j + 1) % 3], t[(j + 2) % 3]);
+            let [x, a, b] = rotate(s, i);
+            let [_, c, d] = rotate(t, j);
             // Beyond `x` they meet along a segment from `x` whose far end is on `[a, b]`, on
             // `[c, d]`, or on an edge at `x` (which then lies in the other's plane).
             if orient3d(x, c, d, a) == 0
@@ -189,6 +189,15 @@ pub(crate) fn triangles_meet_beyond(s: [P; 3], t: [P; 3]) -> bool {
             segment_meets_triangle(a, b, t) || segment_meets_triangle(c, d, s)
         }
         _ => true,
+    }
+}
+
+/// `t`'s corners from corner `i` on, in winding order.
+fn rotate([p, q, r]: [P; 3], i: usize) -> [P; 3] {
+    match i {
+        1 => [q, r, p],
+        2 => [r, p, q],
+        _ => [p, q, r],
     }
 }
 

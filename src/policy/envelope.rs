@@ -85,10 +85,9 @@ impl Grid {
     /// The cell coordinates of `p` (clamped; NaN to 0).
     fn cell(&self, p: V3) -> [usize; 3] {
         let mut c = [0; 3];
-        for a in 0..3 {
-            let x = (p[a] - self.lo[a]) * self.inv;
+        for ((c, (&x, &lo)), &d) in c.iter_mut().zip(p.iter().zip(&self.lo)).zip(&self.dims) {
             // `as` saturates: negative and NaN to 0.
-            c[a] = (x as usize).min(self.dims[a].saturating_sub(1));
+            *c = (((x - lo) * self.inv) as usize).min(d.saturating_sub(1));
         }
         c
     }
@@ -135,16 +134,22 @@ fn bbox(points: &[V3]) -> Box3 {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     for p in points {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
+        grow(&mut lo, &mut hi, (p, p));
     }
     (lo, hi)
 }
 
+/// Widens `(lo, hi)` to hold the box `(l, h)`.
+fn grow(lo: &mut V3, hi: &mut V3, (l, h): (&V3, &V3)) {
+    for ((lo, hi), (&l, &h)) in lo.iter_mut().zip(hi.iter_mut()).zip(l.iter().zip(h)) {
+        *lo = lo.min(l);
+        *hi = hi.max(h);
+    }
+}
+
 fn overlap(a: &Box3, b: &Box3) -> bool {
-    (0..3).all(|i| a.0[i] <= b.1[i] && b.0[i] <= a.1[i])
+    let le = |x: &V3, y: &V3| x.iter().zip(y).all(|(p, q)| p <= q);
+    le(&a.0, &b.1) && le(&b.0, &a.1)
 }
 
 /// The envelope bound (see the module documentation), given to
@@ -282,7 +287,9 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         let m = self.mask(t);
         for k in 0..3 {
             if m & (1 << k) != 0 {
-                let (x, y) = (s[k], s[next3(k)]);
+                let (Some(&x), Some(&y)) = (s.get(k), s.get(next3(k))) else {
+                    continue;
+                };
                 if let Some(w) = out.get_mut(n..n + 2) {
                     w[0] = [x[0], x[1], y[1]];
                     w[1] = [x[0], y[1], y[0]];
@@ -419,8 +426,7 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
             let n = normal(mesh, tri);
             if !is_dead(tri) && self.corners_of(t) == tri && n != [0.0; 3] {
                 m = UNIT;
-                for k in 0..3 {
-                    let (x, y) = (tri[k], tri[next3(k)]);
+                for (k, (x, y)) in edges(tri).into_iter().enumerate() {
                     let mut count = 0;
                     for (u, _) in mesh.corners(x) {
                         count += mesh.tri(u).contains(&y) as usize;
@@ -467,11 +473,10 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
             }
             let tri = self.corners_of(t);
             let n = normal(mesh, tri);
-            for k in 0..3 {
+            for (k, (x, y)) in edges(tri).into_iter().enumerate() {
                 if m & (1 << k) == 0 {
                     continue;
                 }
-                let (x, y) = (tri[k], tri[next3(k)]);
                 let o = math::cross(math::sub(mesh.p(y), mesh.p(x)), n);
                 let l2 = math::dot(o, o);
                 if !(l2 > math::TINY2 && l2.is_finite()) {
@@ -516,10 +521,7 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         for t in 0..self.nt {
             if self.mask(t) & UNIT != 0 {
                 let b = self.box_of(mesh, t);
-                for a in 0..3 {
-                    all.0[a] = all.0[a].min(b.0[a]);
-                    all.1[a] = all.1[a].max(b.1[a]);
-                }
+                grow(&mut all.0, &mut all.1, (&b.0, &b.1));
             }
         }
         let ext = [
@@ -733,6 +735,11 @@ impl<'a, I: Index, K: Index> Envelope<'a, I, K> {
         }
         hit
     }
+}
+
+/// A triangle's edges in winding order, edge `k` from corner `k` to the next.
+fn edges([a, b, c]: [usize; 3]) -> [(usize, usize); 3] {
+    [(a, b), (b, c), (c, a)]
 }
 
 /// The (unnormalised) normal of triangle `tri`: twice its area in length.

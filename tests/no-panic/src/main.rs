@@ -402,6 +402,24 @@ fn run<L: Index, I: Index, const V: usize, const T: usize>() {
             Ok(s) => drive(s),
             Err(e) => display(&e),
         }
+        // The envelope bound, with the edge collapse and with vertex decimation.
+        let mut shell: [[[f32; 3]; 2]; 256] = black_box([[[0.0; 3]; 2]; 256]);
+        if let Some(sh) = shell.get_mut(..input(17) as usize) {
+            let bound = tinydecimate::Envelope::new(o, sh, l16);
+            match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound, EdgeCollapse) {
+                Ok(s) => drive(s),
+                Err(e) => display(&e),
+            }
+        }
+        if let Some(sh) = shell.get_mut(..input(18) as usize) {
+            black_box(tinydecimate::bound::index_len(input(19) as usize));
+            let bound = tinydecimate::Envelope::new(o, sh, l32);
+            let op = VertexDecimation::new();
+            match ws.start(Positions::Read(p), t, &config, Builtin::new(), bound, op) {
+                Ok(s) => drive(s),
+                Err(e) => display(&e),
+            }
+        }
         // Stored quadrics with a bound.
         if let Some(q) = quadrics.get_mut(..nq) {
             let bound = tinydecimate::Controls::new(o, l32);
